@@ -1,0 +1,188 @@
+//! The `chocmodal` command line.
+//!
+//! `chocmodal run <processId> <body.json | ->` runs one execution request in-process,
+//! with no server: the results document goes to stdout, invalid inputs give the same
+//! problem document as the HTTP API on stderr and exit status 2, a failed run exits 1.
+
+use std::io::Read;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::problem::Problem;
+use crate::processes::{InvalidInputs, Registry, RunError, RunOutput};
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "chocmodal",
+    version,
+    about = "Modal multi-contact dynamics of slender beam bundles"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run one execution request in-process and print its results document.
+    Run(RunArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct RunArgs {
+    /// Process id, e.g. `cantilever-impact`.
+    pub process_id: String,
+    /// Execution request body (`{"inputs": {...}}`): a file path, or `-` for stdin.
+    pub body: String,
+    /// Also write every history as `DIR/<name>.csv` at full output resolution.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Print progress to stderr.
+    #[arg(long)]
+    pub progress: bool,
+}
+
+/// Entry point of the binary.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run(args) => run_command(&args, &Registry::builtin()),
+    }
+}
+
+/// Exit status of `chocmodal run`: 0 success, 1 failed run or IO error, 2 invalid inputs.
+pub fn run_command(args: &RunArgs, registry: &Registry) -> ExitCode {
+    match execute(args, registry) {
+        Ok(document) => {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&document).expect("results serialize")
+            );
+            ExitCode::SUCCESS
+        }
+        Err(CliFailure::Problem(problem)) => {
+            eprintln!("{}", problem.to_json_pretty());
+            ExitCode::from(
+                if problem.status == 422 || problem.status == 400 || problem.status == 404 {
+                    2
+                } else {
+                    1
+                },
+            )
+        }
+        Err(CliFailure::Failed(message)) => {
+            eprintln!("chocmodal: {message}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+enum CliFailure {
+    Problem(Problem),
+    Failed(String),
+}
+
+fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, CliFailure> {
+    let process = registry
+        .get(&args.process_id)
+        .ok_or_else(|| CliFailure::Problem(Problem::no_such_process(&args.process_id)))?;
+    let text = read_body(&args.body).map_err(CliFailure::Failed)?;
+    let inputs = parse_envelope(&text).map_err(CliFailure::Problem)?;
+    process
+        .validate(&inputs)
+        .map_err(|e| CliFailure::Problem(Problem::invalid_inputs(&e)))?;
+
+    let show_progress = args.progress;
+    let mut last_percent = -1i64;
+    let mut progress = |fraction: f64| {
+        let percent = (fraction * 100.0).floor() as i64;
+        if show_progress && percent != last_percent {
+            last_percent = percent;
+            eprint!("\r{percent:3}%");
+        }
+        ControlFlow::Continue(())
+    };
+    let output = process.run(&inputs, &mut progress).map_err(|e| match e {
+        RunError::Invalid(invalid) => CliFailure::Problem(Problem::invalid_inputs(&invalid)),
+        other => CliFailure::Failed(other.to_string()),
+    })?;
+    if show_progress {
+        eprintln!();
+    }
+    if let Some(dir) = &args.out {
+        write_histories(dir, &output).map_err(CliFailure::Failed)?;
+    }
+    Ok(document_with_outputs(output, |name| match &args.out {
+        Some(dir) => dir.join(format!("{name}.csv")).display().to_string(),
+        None => format!("{name}.csv"),
+    }))
+}
+
+/// Adds the `outputs` links (`{name: {href}}`) to a run's results document.
+pub fn document_with_outputs(output: RunOutput, href: impl Fn(&str) -> String) -> serde_json::Value {
+    let mut document = output.document;
+    let outputs: serde_json::Map<String, serde_json::Value> = output
+        .histories
+        .iter()
+        .map(|h| (h.name.clone(), serde_json::json!({ "href": href(&h.name) })))
+        .collect();
+    if let serde_json::Value::Object(map) = &mut document {
+        map.insert("outputs".into(), serde_json::Value::Object(outputs));
+    }
+    document
+}
+
+fn read_body(source: &str) -> Result<String, String> {
+    let mut text = String::new();
+    if source == "-" {
+        std::io::stdin()
+            .read_to_string(&mut text)
+            .map_err(|e| format!("cannot read stdin: {e}"))?;
+    } else {
+        text = std::fs::read_to_string(source).map_err(|e| format!("cannot read {source}: {e}"))?;
+    }
+    Ok(text)
+}
+
+/// Parses an execution request body and returns its `inputs` object.
+pub fn parse_envelope(text: &str) -> Result<serde_json::Value, Problem> {
+    let body: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| Problem::malformed_body(format!("not valid JSON: {e}")))?;
+    let serde_json::Value::Object(mut map) = body else {
+        return Err(Problem::malformed_body(
+            "the body must be a JSON object `{\"inputs\": {...}}`",
+        ));
+    };
+    if let Some(unknown) = map
+        .keys()
+        .find(|k| !matches!(k.as_str(), "inputs" | "outputs" | "response" | "subscriber"))
+    {
+        let invalid = InvalidInputs(vec![crate::processes::FieldError::new(
+            format!("/{unknown}"),
+            "unknown member of the execution request",
+        )]);
+        return Err(Problem::invalid_inputs(&invalid));
+    }
+    match map.remove("inputs") {
+        Some(inputs @ serde_json::Value::Object(_)) => Ok(inputs),
+        Some(_) => Err(Problem::invalid_inputs(&InvalidInputs(vec![
+            crate::processes::FieldError::new("/inputs", "must be an object"),
+        ]))),
+        None => Err(Problem::invalid_inputs(&InvalidInputs(vec![
+            crate::processes::FieldError::new("/inputs", "is required"),
+        ]))),
+    }
+}
+
+fn write_histories(dir: &Path, output: &RunOutput) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    for history in &output.histories {
+        let path = dir.join(format!("{}.csv", history.name));
+        std::fs::write(&path, history.to_csv())
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    }
+    Ok(())
+}

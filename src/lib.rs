@@ -1,0 +1,13 @@
+//! chocmodal: modal multi-contact dynamics of slender beam bundles.
+//!
+//! Data flows one way: HTTP/CLI → validated process inputs → queue → worker →
+//! physics → results store → HTTP. The physics core is pure (no IO, no async).
+
+/// The `chocmodal` command line (serve, run).
+pub mod cli;
+/// Pure numerics: beams, modal bases, contacts, explicit integration, reference solution.
+pub mod physics;
+/// RFC 9457 problem details shared by the HTTP API and the CLI.
+pub mod problem;
+/// One module per process: JSON inputs (validated) → physics → results document + histories.
+pub mod processes;

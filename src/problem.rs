@@ -1,0 +1,89 @@
+//! RFC 9457 problem details: the one error format of the HTTP API and the CLI.
+//!
+//! Type URIs follow OGC API – Processes where it defines one (`no-such-process`,
+//! `no-such-job`, `result-not-ready`); chocmodal's own types live under
+//! `https://chocmodal.dev/problems/`.
+
+use crate::processes::{FieldError, InvalidInputs};
+
+/// OGC exception type prefix.
+pub const OGC_EXCEPTIONS: &str = "http://www.opengis.net/def/exceptions/ogcapi-processes-1/1.0";
+/// chocmodal's own problem type prefix.
+pub const CHOCMODAL_PROBLEMS: &str = "https://chocmodal.dev/problems";
+
+/// A problem details document.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Problem {
+    /// URI identifying the problem type.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Short summary of the problem type.
+    pub title: String,
+    /// HTTP status code.
+    pub status: u16,
+    /// Explanation specific to this occurrence.
+    pub detail: String,
+    /// For invalid inputs: every field at fault, by JSON pointer into the request body.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub errors: Vec<FieldError>,
+}
+
+impl Problem {
+    pub fn new(
+        kind: impl Into<String>,
+        title: impl Into<String>,
+        status: u16,
+        detail: impl Into<String>,
+    ) -> Self {
+        Self {
+            kind: kind.into(),
+            title: title.into(),
+            status,
+            detail: detail.into(),
+            errors: Vec::new(),
+        }
+    }
+
+    /// 422: the request parsed as JSON but its inputs are not acceptable.
+    pub fn invalid_inputs(invalid: &InvalidInputs) -> Self {
+        let count = invalid.0.len();
+        let detail = if count == 1 {
+            format!("{}: {}", invalid.0[0].pointer, invalid.0[0].detail)
+        } else {
+            format!("{count} inputs are invalid; see `errors`")
+        };
+        Self {
+            errors: invalid.0.clone(),
+            ..Self::new(
+                format!("{CHOCMODAL_PROBLEMS}/invalid-inputs"),
+                "Invalid inputs",
+                422,
+                detail,
+            )
+        }
+    }
+
+    /// 400: the body is not JSON, or not the expected envelope.
+    pub fn malformed_body(detail: impl Into<String>) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/malformed-body"),
+            "Malformed request body",
+            400,
+            detail,
+        )
+    }
+
+    /// 404: no process with this id.
+    pub fn no_such_process(id: &str) -> Self {
+        Self::new(
+            format!("{OGC_EXCEPTIONS}/no-such-process"),
+            "No such process",
+            404,
+            format!("there is no process `{id}`"),
+        )
+    }
+
+    pub fn to_json_pretty(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_else(|_| self.detail.clone())
+    }
+}

@@ -1,0 +1,144 @@
+//! Processes: the named computations the service and the CLI run.
+//!
+//! A process owns its input schema, its validation (every problem reported with a JSON
+//! pointer into the execution request body, e.g. `/inputs/beam/modes`), and the mapping
+//! from validated inputs to the physics core and back to a results document plus
+//! time histories. It knows nothing about HTTP, the queue or the database: the service
+//! and the CLI drive it through [`Process`].
+
+use std::ops::ControlFlow;
+use std::sync::Arc;
+
+/// One problem with the inputs: where (JSON pointer into the request body) and why.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FieldError {
+    /// JSON pointer into the execution request body, e.g. `/inputs/beam/modes`.
+    pub pointer: String,
+    /// Human-readable reason, e.g. `must be between 1 and 78`.
+    pub detail: String,
+}
+
+impl FieldError {
+    pub fn new(pointer: impl Into<String>, detail: impl Into<String>) -> Self {
+        Self {
+            pointer: pointer.into(),
+            detail: detail.into(),
+        }
+    }
+}
+
+/// Every problem found in one set of inputs (never empty).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("invalid inputs: {}", .0.iter().map(|e| format!("{}: {}", e.pointer, e.detail)).collect::<Vec<_>>().join("; "))]
+pub struct InvalidInputs(pub Vec<FieldError>);
+
+/// A sampled time history: one shared time column and named series of equal length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct History {
+    /// Output name, used in URLs and file names (`tip_displacement`).
+    pub name: String,
+    /// Sample times (s), strictly increasing.
+    pub time: Vec<f64>,
+    /// Named columns (`numerical`, `reference`, `c0`, ...), each `time.len()` long.
+    pub series: Vec<(String, Vec<f64>)>,
+}
+
+impl History {
+    /// CSV text with a `time,<series...>` header, full precision.
+    pub fn to_csv(&self) -> String {
+        let mut out = String::with_capacity(self.time.len() * (self.series.len() + 1) * 24);
+        out.push_str("time");
+        for (name, _) in &self.series {
+            out.push(',');
+            out.push_str(name);
+        }
+        out.push('\n');
+        for (row, t) in self.time.iter().enumerate() {
+            out.push_str(&format_number(*t));
+            for (_, values) in &self.series {
+                out.push(',');
+                out.push_str(&format_number(values[row]));
+            }
+            out.push('\n');
+        }
+        out
+    }
+}
+
+/// Shortest representation that parses back to the same f64.
+fn format_number(value: f64) -> String {
+    format!("{value:e}")
+}
+
+/// What a successful run produces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutput {
+    /// Results document without its `outputs` links (the caller adds those, since
+    /// only it knows where histories are served from).
+    pub document: serde_json::Value,
+    /// Time histories, served as `/jobs/{id}/results/{name}` or written as CSV.
+    pub histories: Vec<History>,
+}
+
+/// Why a run did not produce results.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RunError {
+    /// The progress callback asked to stop.
+    #[error("cancelled")]
+    Cancelled,
+    /// The inputs were invalid (only when `run` is called without `validate`).
+    #[error(transparent)]
+    Invalid(#[from] InvalidInputs),
+    /// A deterministic failure of the computation (divergence, ...): retrying will not help.
+    #[error("{0}")]
+    Failed(String),
+}
+
+/// Progress and cancellation: called with the fraction done (0..=1); returning
+/// `ControlFlow::Break(())` stops the run promptly with [`RunError::Cancelled`].
+pub type ProgressFn<'a> = dyn FnMut(f64) -> ControlFlow<()> + 'a;
+
+/// A computation the service can queue and the CLI can run.
+pub trait Process: Send + Sync + std::fmt::Debug {
+    /// Stable identifier used in URLs (`cantilever-impact`).
+    fn id(&self) -> &'static str;
+    /// One-line title.
+    fn title(&self) -> &'static str;
+    /// A paragraph for the process list.
+    fn description(&self) -> &'static str;
+    /// OGC process description `inputs` object: `{name: {title, description, schema}}`.
+    fn inputs_description(&self) -> serde_json::Value;
+    /// OGC process description `outputs` object: `{name: {title, description, schema}}`.
+    fn outputs_description(&self) -> serde_json::Value;
+    /// Parses and checks the `inputs` object of an execution request. Pointers in the
+    /// errors start with `/inputs`.
+    fn validate(&self, inputs: &serde_json::Value) -> Result<(), InvalidInputs>;
+    /// Runs the computation on inputs that passed [`Process::validate`].
+    fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError>;
+}
+
+/// The processes this build offers, looked up by id.
+#[derive(Debug, Clone)]
+pub struct Registry {
+    processes: Vec<Arc<dyn Process>>,
+}
+
+impl Registry {
+    /// A registry of exactly these processes (tests use their own).
+    pub fn new(processes: Vec<Arc<dyn Process>>) -> Self {
+        Self { processes }
+    }
+
+    /// The processes shipped with chocmodal.
+    pub fn builtin() -> Self {
+        Self::new(vec![])
+    }
+
+    pub fn get(&self, id: &str) -> Option<Arc<dyn Process>> {
+        self.processes.iter().find(|p| p.id() == id).cloned()
+    }
+
+    pub fn all(&self) -> &[Arc<dyn Process>] {
+        &self.processes
+    }
+}
