@@ -1,3 +1,70 @@
 //! Pure numerics. Nothing in here performs IO, spawns threads or knows about the
 //! service: functions take inputs (SI units) and a progress/cancel callback and return
 //! results or a typed error.
+//!
+//! Validation errors name the offending field by a slash path relative to the struct
+//! being checked (`section/outer_diameter`); callers prefix it with where that struct
+//! sits in their own input document (`/inputs/beam/`).
+
+pub mod beam;
+pub mod contact;
+pub mod integrate;
+pub mod loads;
+pub mod modal;
+/// Exact (up to modal truncation) cantilever / tip-spring impact solution (paper §2).
+pub mod reference;
+/// One-sided periodogram and the spectral error function f_err (paper eq. 11).
+pub mod spectrum;
+pub mod stability;
+pub mod statistics;
+
+/// One problem with a physics input: which field (slash path relative to the checked
+/// struct) and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputIssue {
+    pub field: String,
+    pub reason: String,
+}
+
+impl InputIssue {
+    pub fn new(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        Self {
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// The same issue, seen from a containing struct (`prefix/field`).
+    pub fn within(self, prefix: &str) -> Self {
+        let field = if self.field.is_empty() {
+            prefix.to_owned()
+        } else {
+            format!("{prefix}/{}", self.field)
+        };
+        Self {
+            field,
+            reason: self.reason,
+        }
+    }
+}
+
+/// Checks that `value` is finite and strictly positive; records an issue otherwise.
+pub(crate) fn require_positive(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
+    if !value.is_finite() {
+        issues.push(InputIssue::new(field, "must be a finite number"));
+    } else if value <= 0.0 {
+        issues.push(InputIssue::new(field, format!("must be positive (got {value})")));
+    }
+}
+
+/// Checks that `value` is finite and non-negative; records an issue otherwise.
+pub(crate) fn require_non_negative(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
+    if !value.is_finite() {
+        issues.push(InputIssue::new(field, "must be a finite number"));
+    } else if value < 0.0 {
+        issues.push(InputIssue::new(
+            field,
+            format!("must not be negative (got {value})"),
+        ));
+    }
+}

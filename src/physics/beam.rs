@@ -1,0 +1,360 @@
+//! Euler–Bernoulli beam: section, material, supports, and the finite-element model with
+//! 2-node Hermite cubic elements (DOFs per node: deflection w (m), rotation θ (rad)) and
+//! consistent mass.
+//!
+//! Nodes are numbered from the foot (x = 0) to the top (x = L); the global DOF of node
+//! `n` are `2n` (w) and `2n + 1` (θ). Matrices are dense, row-major, over all DOFs;
+//! [`BeamModel::free_dofs`] lists the DOFs left free by the supports.
+
+use super::{InputIssue, require_non_negative, require_positive};
+
+/// Cross-section of the beam.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Section {
+    /// Circular tube: outer and inner diameters (m); inner 0 gives a solid rod.
+    Tube {
+        outer_diameter: f64,
+        inner_diameter: f64,
+    },
+    /// Explicit area (m²) and second moment of area (m⁴).
+    Explicit { area: f64, inertia: f64 },
+}
+
+impl Section {
+    /// Area A (m²).
+    pub fn area(&self) -> f64 {
+        match *self {
+            Section::Tube {
+                outer_diameter: d_o,
+                inner_diameter: d_i,
+            } => std::f64::consts::PI / 4.0 * (d_o * d_o - d_i * d_i),
+            Section::Explicit { area, .. } => area,
+        }
+    }
+
+    /// Second moment of area I (m⁴).
+    pub fn inertia(&self) -> f64 {
+        match *self {
+            Section::Tube {
+                outer_diameter: d_o,
+                inner_diameter: d_i,
+            } => std::f64::consts::PI / 64.0 * (d_o.powi(4) - d_i.powi(4)),
+            Section::Explicit { inertia, .. } => inertia,
+        }
+    }
+
+    fn validate(&self, issues: &mut Vec<InputIssue>) {
+        match *self {
+            Section::Tube {
+                outer_diameter,
+                inner_diameter,
+            } => {
+                require_positive(issues, "section/outer_diameter", outer_diameter);
+                require_non_negative(issues, "section/inner_diameter", inner_diameter);
+                if inner_diameter.is_finite()
+                    && outer_diameter.is_finite()
+                    && inner_diameter >= outer_diameter
+                {
+                    issues.push(InputIssue::new(
+                        "section/inner_diameter",
+                        format!("must be smaller than the outer diameter ({outer_diameter} m)"),
+                    ));
+                }
+            }
+            Section::Explicit { area, inertia } => {
+                require_positive(issues, "section/area", area);
+                require_positive(issues, "section/inertia", inertia);
+            }
+        }
+    }
+}
+
+/// Boundary condition at one end of the beam.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Support {
+    /// No constraint.
+    Free,
+    /// Deflection fixed, rotation free.
+    Pinned,
+    /// Deflection and rotation fixed.
+    Clamped,
+}
+
+/// A beam as the user describes it (SI units).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeamSpec {
+    /// Length L (m).
+    pub length: f64,
+    /// Young's modulus E (Pa).
+    pub young_modulus: f64,
+    /// Density ρ (kg/m³).
+    pub density: f64,
+    pub section: Section,
+    /// Added mass per unit length (kg/m): fuel column, surrounding fluid.
+    pub added_mass_per_length: f64,
+    /// Number of finite elements along the beam.
+    pub elements: usize,
+    /// Support at the foot (x = 0); clamped by default.
+    pub foot: Support,
+    /// Support at the top (x = L); free by default.
+    pub top: Support,
+}
+
+/// Largest mesh accepted: the eigenproblem is dense, O(n³).
+pub const MAX_ELEMENTS: usize = 400;
+
+impl BeamSpec {
+    /// Mass per unit length m = ρA + added mass (kg/m).
+    pub fn mass_per_length(&self) -> f64 {
+        self.density * self.section.area() + self.added_mass_per_length
+    }
+
+    /// Bending stiffness EI (N·m²).
+    pub fn bending_stiffness(&self) -> f64 {
+        self.young_modulus * self.section.inertia()
+    }
+
+    /// Every problem with this beam (empty when valid). Fields are relative to the beam.
+    pub fn validate(&self) -> Vec<InputIssue> {
+        let mut issues = Vec::new();
+        require_positive(&mut issues, "length", self.length);
+        require_positive(&mut issues, "young_modulus", self.young_modulus);
+        require_positive(&mut issues, "density", self.density);
+        require_non_negative(&mut issues, "added_mass_per_length", self.added_mass_per_length);
+        self.section.validate(&mut issues);
+        if !(1..=MAX_ELEMENTS).contains(&self.elements) {
+            issues.push(InputIssue::new(
+                "elements",
+                format!("must be between 1 and {MAX_ELEMENTS}"),
+            ));
+        }
+        let translation_held = self.foot != Support::Free || self.top != Support::Free;
+        let rotation_held = self.foot == Support::Clamped
+            || self.top == Support::Clamped
+            || (self.foot == Support::Pinned && self.top == Support::Pinned);
+        if !(translation_held && rotation_held) {
+            issues.push(InputIssue::new(
+                "supports",
+                "must prevent rigid-body motion: clamp one end, or pin both",
+            ));
+        }
+        issues
+    }
+
+    /// Number of DOFs left free by the supports: the most modes this mesh can give.
+    pub fn free_dof_count(&self) -> usize {
+        let constrained = |s: Support| match s {
+            Support::Free => 0,
+            Support::Pinned => 1,
+            Support::Clamped => 2,
+        };
+        2 * (self.elements + 1) - constrained(self.foot) - constrained(self.top)
+    }
+}
+
+/// Assembled finite-element matrices of a valid beam.
+#[derive(Debug, Clone)]
+pub struct BeamModel {
+    pub length: f64,
+    pub elements: usize,
+    /// Element length h = L / elements (m).
+    pub element_length: f64,
+    /// Stiffness matrix over all DOFs, row-major (N/m, N, N·m).
+    pub stiffness: Vec<f64>,
+    /// Consistent mass matrix over all DOFs, row-major (kg, kg·m, kg·m²).
+    pub mass: Vec<f64>,
+    /// DOFs not fixed by the supports, increasing.
+    pub free_dofs: Vec<usize>,
+}
+
+impl BeamModel {
+    /// Assembles K and M. The spec must be valid ([`BeamSpec::validate`]).
+    pub fn assemble(spec: &BeamSpec) -> Self {
+        let elements = spec.elements;
+        let dofs = 2 * (elements + 1);
+        let h = spec.length / elements as f64;
+        let ei = spec.bending_stiffness();
+        let m = spec.mass_per_length();
+        let k_elem = element_stiffness(ei, h);
+        let m_elem = element_mass(m, h);
+        let mut stiffness = vec![0.0; dofs * dofs];
+        let mut mass = vec![0.0; dofs * dofs];
+        for e in 0..elements {
+            for a in 0..4 {
+                for b in 0..4 {
+                    let (row, col) = (2 * e + a, 2 * e + b);
+                    stiffness[row * dofs + col] += k_elem[a][b];
+                    mass[row * dofs + col] += m_elem[a][b];
+                }
+            }
+        }
+        let mut fixed = Vec::new();
+        let mut constrain = |node: usize, support: Support| match support {
+            Support::Free => {}
+            Support::Pinned => fixed.push(2 * node),
+            Support::Clamped => fixed.extend([2 * node, 2 * node + 1]),
+        };
+        constrain(0, spec.foot);
+        constrain(elements, spec.top);
+        let free_dofs = (0..dofs).filter(|d| !fixed.contains(d)).collect();
+        Self {
+            length: spec.length,
+            elements,
+            element_length: h,
+            stiffness,
+            mass,
+            free_dofs,
+        }
+    }
+
+    /// Total number of DOFs (free and fixed).
+    pub fn dof_count(&self) -> usize {
+        2 * (self.elements + 1)
+    }
+
+    /// Element index and local coordinate ξ ∈ [0, 1] of height `x` (clamped to the beam).
+    pub fn locate(&self, x: f64) -> (usize, f64) {
+        let position = (x / self.element_length).clamp(0.0, self.elements as f64);
+        let element = (position.floor() as usize).min(self.elements - 1);
+        (element, position - element as f64)
+    }
+
+    /// Hermite interpolation weights of height `x`: w(x) = Σ weights[k] · u[first_dof + k].
+    pub fn interpolation(&self, x: f64) -> (usize, [f64; 4]) {
+        let (element, xi) = self.locate(x);
+        (2 * element, hermite_shape_functions(xi, self.element_length))
+    }
+}
+
+/// Hermite cubic shape functions on an element of length `h` at local coordinate ξ:
+/// N1 = 1 − 3ξ² + 2ξ³, N2 = h(ξ − 2ξ² + ξ³), N3 = 3ξ² − 2ξ³, N4 = h(ξ³ − ξ²).
+pub fn hermite_shape_functions(xi: f64, h: f64) -> [f64; 4] {
+    let xi2 = xi * xi;
+    let xi3 = xi2 * xi;
+    [
+        1.0 - 3.0 * xi2 + 2.0 * xi3,
+        h * (xi - 2.0 * xi2 + xi3),
+        3.0 * xi2 - 2.0 * xi3,
+        h * (xi3 - xi2),
+    ]
+}
+
+/// Element stiffness EI/h³ [[12, 6h, −12, 6h], [6h, 4h², −6h, 2h²], ...].
+fn element_stiffness(ei: f64, h: f64) -> [[f64; 4]; 4] {
+    let c = ei / (h * h * h);
+    let h2 = h * h;
+    [
+        [12.0 * c, 6.0 * h * c, -12.0 * c, 6.0 * h * c],
+        [6.0 * h * c, 4.0 * h2 * c, -6.0 * h * c, 2.0 * h2 * c],
+        [-12.0 * c, -6.0 * h * c, 12.0 * c, -6.0 * h * c],
+        [6.0 * h * c, 2.0 * h2 * c, -6.0 * h * c, 4.0 * h2 * c],
+    ]
+}
+
+/// Consistent element mass m h/420 [[156, 22h, 54, −13h], ...].
+fn element_mass(mass_per_length: f64, h: f64) -> [[f64; 4]; 4] {
+    let c = mass_per_length * h / 420.0;
+    let h2 = h * h;
+    [
+        [156.0 * c, 22.0 * h * c, 54.0 * c, -13.0 * h * c],
+        [22.0 * h * c, 4.0 * h2 * c, 13.0 * h * c, -3.0 * h2 * c],
+        [54.0 * c, 13.0 * h * c, 156.0 * c, -22.0 * h * c],
+        [-13.0 * h * c, -3.0 * h2 * c, -22.0 * h * c, 4.0 * h2 * c],
+    ]
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// The public default tube (BRIEF §7).
+    pub(crate) fn default_tube(elements: usize) -> BeamSpec {
+        BeamSpec {
+            length: 1.0,
+            young_modulus: 2.1e11,
+            density: 7800.0,
+            section: Section::Tube {
+                outer_diameter: 0.010,
+                inner_diameter: 0.009,
+            },
+            added_mass_per_length: 0.0,
+            elements,
+            foot: Support::Clamped,
+            top: Support::Free,
+        }
+    }
+
+    /// Total mass: a rigid translation r (w = 1, θ = 0) has kinetic mass rᵀMr = m L, and
+    /// strain energy rᵀKr = 0 (rigid motion does not strain the beam).
+    #[test]
+    fn rigid_translation_has_total_mass_and_no_strain() {
+        let spec = default_tube(7);
+        let model = BeamModel::assemble(&spec);
+        let n = model.dof_count();
+        let r: Vec<f64> = (0..n).map(|d| if d % 2 == 0 { 1.0 } else { 0.0 }).collect();
+        let quad = |matrix: &[f64]| -> f64 {
+            (0..n)
+                .map(|i| (0..n).map(|j| r[i] * matrix[i * n + j] * r[j]).sum::<f64>())
+                .sum()
+        };
+        let expected_mass = spec.mass_per_length() * spec.length;
+        let mass = quad(&model.mass);
+        assert!(
+            (mass - expected_mass).abs() < 1e-12 * expected_mass,
+            "mass {mass} vs {expected_mass}"
+        );
+        let strain = quad(&model.stiffness);
+        assert!(strain.abs() < 1e-6, "strain energy of rigid translation {strain}");
+    }
+
+    /// A static tip load P on a cantilever gives the exact cubic w(L) = P L³ / 3EI with
+    /// Hermite elements (the exact solution is a cubic, inside the element space).
+    #[test]
+    fn cantilever_tip_load_gives_textbook_deflection() {
+        let spec = default_tube(3);
+        let model = BeamModel::assemble(&spec);
+        let n = model.dof_count();
+        let free = &model.free_dofs;
+        let k: Vec<f64> = free
+            .iter()
+            .flat_map(|&i| free.iter().map(move |&j| (i, j)))
+            .map(|(i, j)| model.stiffness[i * n + j])
+            .collect();
+        let mut rhs = vec![0.0; free.len()];
+        let tip = free.iter().position(|&d| d == 2 * spec.elements).unwrap();
+        rhs[tip] = 1.0;
+        let solution = solve_dense(&k, &rhs);
+        let expected = spec.length.powi(3) / (3.0 * spec.bending_stiffness());
+        assert!(
+            (solution[tip] - expected).abs() < 1e-9 * expected,
+            "tip {} vs {expected}",
+            solution[tip]
+        );
+    }
+
+    fn solve_dense(matrix: &[f64], rhs: &[f64]) -> Vec<f64> {
+        let n = rhs.len();
+        let a = faer::Mat::from_fn(n, n, |i, j| matrix[i * n + j]);
+        let b = faer::Mat::from_fn(n, 1, |i, _| rhs[i]);
+        let lu = a.partial_piv_lu();
+        let x = faer::linalg::solvers::Solve::solve(&lu, &b);
+        (0..n).map(|i| x[(i, 0)]).collect()
+    }
+
+    #[test]
+    fn invalid_beam_names_each_field() {
+        let mut spec = default_tube(0);
+        spec.length = -1.0;
+        spec.section = Section::Tube {
+            outer_diameter: 0.01,
+            inner_diameter: 0.02,
+        };
+        spec.top = Support::Free;
+        spec.foot = Support::Pinned;
+        let fields: Vec<String> = spec.validate().into_iter().map(|i| i.field).collect();
+        assert_eq!(
+            fields,
+            ["length", "section/inner_diameter", "elements", "supports"]
+        );
+    }
+}

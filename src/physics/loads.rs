@@ -1,0 +1,194 @@
+//! Time-dependent loads: base acceleration of the wrapper (applied in the wrapper frame
+//! as the inertial load −M r a(t), i.e. −Γᵢ a(t) on mode i) and point forces at a height.
+
+use super::{InputIssue, require_non_negative, require_positive};
+
+/// Imposed acceleration of the wrapper (walls and pin feet), m/s², in the direction of
+/// positive deflection.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BaseAcceleration {
+    /// a(t) = amplitude · sin(π t / duration) for 0 ≤ t ≤ duration, 0 after.
+    HalfSine { amplitude: f64, duration: f64 },
+    /// a(t) = amplitude · sin(2π frequency t) for `cycles` periods, 0 after.
+    Sine {
+        amplitude: f64,
+        frequency: f64,
+        cycles: f64,
+    },
+    /// Samples (s, m/s²), linear between them, 0 before the first and after the last.
+    Table(Table),
+}
+
+impl BaseAcceleration {
+    /// a(t) (m/s²).
+    pub fn at(&self, t: f64) -> f64 {
+        match self {
+            BaseAcceleration::HalfSine { amplitude, duration } => {
+                if (0.0..=*duration).contains(&t) {
+                    amplitude * (std::f64::consts::PI * t / duration).sin()
+                } else {
+                    0.0
+                }
+            }
+            BaseAcceleration::Sine {
+                amplitude,
+                frequency,
+                cycles,
+            } => {
+                if t >= 0.0 && t * frequency <= *cycles {
+                    amplitude * (std::f64::consts::TAU * frequency * t).sin()
+                } else {
+                    0.0
+                }
+            }
+            BaseAcceleration::Table(table) => table.at(t),
+        }
+    }
+
+    /// Every problem (fields relative to the excitation object).
+    pub fn validate(&self) -> Vec<InputIssue> {
+        let mut issues = Vec::new();
+        match self {
+            BaseAcceleration::HalfSine { amplitude, duration } => {
+                require_finite(&mut issues, "amplitude", *amplitude);
+                require_positive(&mut issues, "duration", *duration);
+            }
+            BaseAcceleration::Sine {
+                amplitude,
+                frequency,
+                cycles,
+            } => {
+                require_finite(&mut issues, "amplitude", *amplitude);
+                require_positive(&mut issues, "frequency", *frequency);
+                require_positive(&mut issues, "cycles", *cycles);
+            }
+            BaseAcceleration::Table(table) => issues.extend(table.validate("acceleration")),
+        }
+        issues
+    }
+}
+
+/// A sampled function of time, linear between samples, 0 outside them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    /// Sample times (s), non-negative and strictly increasing.
+    pub time: Vec<f64>,
+    /// Values at those times.
+    pub values: Vec<f64>,
+}
+
+impl Table {
+    pub fn at(&self, t: f64) -> f64 {
+        let (times, values) = (&self.time, &self.values);
+        if times.is_empty() || t < times[0] || t > times[times.len() - 1] {
+            return 0.0;
+        }
+        let upper = times.partition_point(|&s| s <= t);
+        if upper == 0 {
+            return values[0];
+        }
+        if upper >= times.len() {
+            return values[times.len() - 1];
+        }
+        let (t0, t1) = (times[upper - 1], times[upper]);
+        let weight = (t - t0) / (t1 - t0);
+        values[upper - 1] + weight * (values[upper] - values[upper - 1])
+    }
+
+    /// Checks the table; `values_field` names the value column (`acceleration`, `force`).
+    pub fn validate(&self, values_field: &str) -> Vec<InputIssue> {
+        let mut issues = Vec::new();
+        if self.time.len() < 2 {
+            issues.push(InputIssue::new("time", "needs at least two samples"));
+        }
+        if self.time.len() != self.values.len() {
+            issues.push(InputIssue::new(
+                values_field,
+                format!(
+                    "must have as many samples as `time` ({} vs {})",
+                    self.values.len(),
+                    self.time.len()
+                ),
+            ));
+        }
+        for (k, t) in self.time.iter().enumerate() {
+            require_non_negative(&mut issues, &format!("time/{k}"), *t);
+            if k > 0 && *t <= self.time[k - 1] {
+                issues.push(InputIssue::new(
+                    format!("time/{k}"),
+                    "times must be strictly increasing",
+                ));
+                break;
+            }
+        }
+        for (k, v) in self.values.iter().enumerate() {
+            require_finite(&mut issues, &format!("{values_field}/{k}"), *v);
+        }
+        issues
+    }
+}
+
+/// A force history applied at a height of one pin, in the direction of positive
+/// deflection (N).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointForce {
+    pub pin: usize,
+    /// Height from the foot (m).
+    pub height: f64,
+    pub force: Table,
+}
+
+fn require_finite(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
+    if !value.is_finite() {
+        issues.push(InputIssue::new(field, "must be a finite number"));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_sine_peaks_at_mid_duration_and_stops() {
+        let shock = BaseAcceleration::HalfSine {
+            amplitude: 50.0,
+            duration: 0.01,
+        };
+        assert!((shock.at(0.005) - 50.0).abs() < 1e-12);
+        assert_eq!(shock.at(0.0101), 0.0);
+        assert_eq!(shock.at(-1.0), 0.0);
+    }
+
+    #[test]
+    fn table_interpolates_linearly_and_is_zero_outside() {
+        let table = Table {
+            time: vec![0.0, 1.0, 3.0],
+            values: vec![0.0, 2.0, -2.0],
+        };
+        assert!((table.at(0.5) - 1.0).abs() < 1e-15);
+        assert!((table.at(2.0) - 0.0).abs() < 1e-15);
+        assert_eq!(table.at(3.0), -2.0);
+        assert_eq!(table.at(3.5), 0.0);
+        let bad = Table {
+            time: vec![0.0, 0.0],
+            values: vec![1.0, f64::NAN],
+        };
+        let fields: Vec<String> = bad
+            .validate("acceleration")
+            .into_iter()
+            .map(|i| i.field)
+            .collect();
+        assert_eq!(fields, ["time/1", "acceleration/1"]);
+    }
+
+    #[test]
+    fn sine_lasts_its_cycles() {
+        let sine = BaseAcceleration::Sine {
+            amplitude: 2.0,
+            frequency: 10.0,
+            cycles: 2.0,
+        };
+        assert!((sine.at(0.025) - 2.0).abs() < 1e-12);
+        assert_eq!(sine.at(0.21), 0.0);
+    }
+}
