@@ -212,10 +212,10 @@ mod tests {
     /// Roots λᵢ of 1 + cos λ cosh λ = 0 (clamped-free Euler-Bernoulli beam).
     const CLAMPED_FREE_ROOTS: [f64; 5] = [
         1.8751040687119611,
-        4.6940911329741745,
-        7.8547574382376126,
+        4.694_091_132_974_174,
+        7.854_757_438_237_613,
         10.995540734875467,
-        14.137168391046470,
+        14.137_168_391_046_47,
     ];
 
     fn analytic_omega(spec: &BeamSpec, lambda: f64) -> f64 {

@@ -6,6 +6,9 @@
 //! time histories. It knows nothing about HTTP, the queue or the database: the service
 //! and the CLI drive it through [`Process`].
 
+pub mod cantilever_impact;
+pub mod inputs;
+
 use std::ops::ControlFlow;
 use std::sync::Arc;
 
@@ -131,7 +134,7 @@ impl Registry {
 
     /// The processes shipped with chocmodal.
     pub fn builtin() -> Self {
-        Self::new(vec![])
+        Self::new(vec![Arc::new(cantilever_impact::CantileverImpact)])
     }
 
     pub fn get(&self, id: &str) -> Option<Arc<dyn Process>> {

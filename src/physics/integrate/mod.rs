@@ -67,7 +67,7 @@ pub struct Settings {
     /// Simulated duration (s).
     pub duration: f64,
     /// Time between two history samples (s), rounded to a whole number of steps;
-    /// `None` samples every step.
+    /// `None` samples every step. Samples are uniform: t = 0, k·interval, ... ≤ duration.
     pub output_interval: Option<f64>,
     /// Heights (m) where every pin's deflection is recorded.
     pub output_heights: Vec<f64>,
@@ -170,7 +170,8 @@ fn integrate_with_step(
     progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
 ) -> Result<Simulation, SimulationError> {
     let mut run = Integrator::new(model, settings, dt, critical);
-    let total_steps = ((settings.duration / dt) - 1e-9).ceil().max(1.0) as u64;
+    // Never past the duration: the last step ends at or (by rounding) just before it.
+    let total_steps = ((settings.duration / dt) * (1.0 + 1e-12)).floor().max(1.0) as u64;
     let output_every = settings
         .output_interval
         .map_or(1, |interval| ((interval / dt).round() as u64).max(1));
@@ -181,7 +182,7 @@ fn integrate_with_step(
         if n % DIVERGENCE_CHECK_EVERY == 0 || n == total_steps {
             run.check_divergence(t)?;
         }
-        if n % output_every == 0 || n == total_steps {
+        if n % output_every == 0 {
             run.record_sample(t);
         }
         if n % PROGRESS_EVERY == 0 && progress(n as f64 / total_steps as f64).is_break() {
@@ -491,7 +492,9 @@ impl<'m> Integrator<'m> {
             let penetration = self.penetration(c, contact);
             let previous = self.previous_penetration[c];
             let stats = &mut self.statistics[c];
-            if penetration > 0.0 {
+            // A contact without stiffness or dashpot exerts nothing: it never impacts.
+            let active = contact.stiffness > 0.0 || contact.damping > 0.0;
+            if penetration > 0.0 && active {
                 if previous <= 0.0 {
                     stats.impacts += 1;
                     if stats.first_impact_time.is_none() {

@@ -1,0 +1,366 @@
+//! Input pieces shared by the processes: the beam/pin description, the solver block,
+//! parsing with JSON-pointer errors, and self-contained JSON schemas for process
+//! descriptions.
+//!
+//! Parsing is strict: unknown fields are refused (a typo must not silently fall back
+//! to a default), and every serde failure is reported at the pointer where it happened.
+
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
+use utoipa::ToSchema;
+
+use super::{FieldError, InvalidInputs};
+use crate::physics::InputIssue;
+use crate::physics::beam::{BeamSpec, Section, Support};
+use crate::physics::integrate::TimeStep;
+use crate::physics::stability::Scheme;
+
+/// A uniform, slender Euler–Bernoulli beam (one fuel pin) and its modal truncation.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BeamInput {
+    /// Length L (m).
+    pub length: f64,
+    /// Young's modulus E (Pa).
+    pub young_modulus: f64,
+    /// Density ρ (kg/m³).
+    pub density: f64,
+    pub section: SectionInput,
+    /// Added mass per unit length (kg/m): fuel column, surrounding fluid.
+    #[serde(default)]
+    #[schema(default = 0.0)]
+    pub added_mass_per_length: f64,
+    /// Number of Hermite beam elements.
+    #[serde(default = "default_elements")]
+    #[schema(default = 40, minimum = 1, maximum = 400)]
+    pub elements: usize,
+    /// Number of modes kept in the modal basis.
+    #[serde(default = "default_modes")]
+    #[schema(default = 10, minimum = 1)]
+    pub modes: usize,
+    /// Modal damping ratio ξ (dimensionless): one value for every mode, or one per
+    /// mode (a shorter list repeats its last value).
+    #[serde(default = "default_damping")]
+    pub damping_ratio: DampingInput,
+    /// Boundary conditions (clamped foot, free top by default).
+    #[serde(default)]
+    pub supports: SupportsInput,
+}
+
+fn default_elements() -> usize {
+    40
+}
+fn default_modes() -> usize {
+    10
+}
+fn default_damping() -> DampingInput {
+    DampingInput::Uniform(0.01)
+}
+
+/// Cross-section.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum SectionInput {
+    /// Circular tube (m).
+    Tube {
+        outer_diameter: f64,
+        inner_diameter: f64,
+    },
+    /// Area (m²) and second moment of area (m⁴).
+    Explicit { area: f64, inertia: f64 },
+}
+
+/// Modal damping ratio: a number for every mode, or a list, one per mode.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(untagged, expecting = "a damping ratio or a list of damping ratios")]
+pub enum DampingInput {
+    Uniform(f64),
+    PerMode(Vec<f64>),
+}
+
+/// Boundary condition at one end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum SupportInput {
+    Free,
+    Pinned,
+    Clamped,
+}
+
+/// Supports at the foot (x = 0) and the top (x = L).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SupportsInput {
+    #[serde(default = "clamped")]
+    pub foot: SupportInput,
+    #[serde(default = "free")]
+    pub top: SupportInput,
+}
+
+impl Default for SupportsInput {
+    fn default() -> Self {
+        Self {
+            foot: SupportInput::Clamped,
+            top: SupportInput::Free,
+        }
+    }
+}
+fn clamped() -> SupportInput {
+    SupportInput::Clamped
+}
+fn free() -> SupportInput {
+    SupportInput::Free
+}
+
+impl From<SupportInput> for Support {
+    fn from(value: SupportInput) -> Self {
+        match value {
+            SupportInput::Free => Support::Free,
+            SupportInput::Pinned => Support::Pinned,
+            SupportInput::Clamped => Support::Clamped,
+        }
+    }
+}
+
+impl BeamInput {
+    pub fn spec(&self) -> BeamSpec {
+        BeamSpec {
+            length: self.length,
+            young_modulus: self.young_modulus,
+            density: self.density,
+            section: match self.section {
+                SectionInput::Tube {
+                    outer_diameter,
+                    inner_diameter,
+                } => Section::Tube {
+                    outer_diameter,
+                    inner_diameter,
+                },
+                SectionInput::Explicit { area, inertia } => Section::Explicit { area, inertia },
+            },
+            added_mass_per_length: self.added_mass_per_length,
+            elements: self.elements,
+            foot: self.supports.foot.into(),
+            top: self.supports.top.into(),
+        }
+    }
+
+    /// Damping ratio of every mode of the basis.
+    pub fn damping_ratios(&self) -> Vec<f64> {
+        match &self.damping_ratio {
+            DampingInput::Uniform(xi) => vec![*xi; self.modes],
+            DampingInput::PerMode(list) => {
+                let last = list.last().copied().unwrap_or(0.0);
+                (0..self.modes)
+                    .map(|i| list.get(i).copied().unwrap_or(last))
+                    .collect()
+            }
+        }
+    }
+
+    /// Every problem with the beam and its truncation, as physics issues relative to it.
+    pub fn validate(&self) -> Vec<InputIssue> {
+        let spec = self.spec();
+        let mut issues = spec.validate();
+        if spec.elements >= 1 && (self.modes == 0 || self.modes > spec.free_dof_count()) {
+            issues.push(InputIssue::new(
+                "modes",
+                format!(
+                    "must be between 1 and {} (the free DOFs of {} elements)",
+                    spec.free_dof_count(),
+                    spec.elements
+                ),
+            ));
+        }
+        let ratios: Vec<(String, f64)> = match &self.damping_ratio {
+            DampingInput::Uniform(xi) => vec![("damping_ratio".into(), *xi)],
+            DampingInput::PerMode(list) if list.is_empty() => {
+                issues.push(InputIssue::new("damping_ratio", "must not be an empty list"));
+                vec![]
+            }
+            DampingInput::PerMode(list) => list
+                .iter()
+                .enumerate()
+                .map(|(i, xi)| (format!("damping_ratio/{i}"), *xi))
+                .collect(),
+        };
+        for (field, xi) in ratios {
+            if !(xi.is_finite() && (0.0..1.0).contains(&xi)) {
+                issues.push(InputIssue::new(field, format!("must be in [0, 1) (got {xi})")));
+            }
+        }
+        issues
+    }
+}
+
+/// Explicit integration scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum SchemeInput {
+    /// Central difference (second order, no numerical damping).
+    #[default]
+    CentralDifference,
+    /// Tchamwa–Wielgosz (first order, damps high frequencies; parameter `phi`).
+    Tchamwa,
+}
+
+/// A time step in seconds, or `"auto"` (0.8 × the critical step).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(untagged, expecting = "a time step in seconds or \"auto\"")]
+pub enum TimeStepInput {
+    Seconds(f64),
+    Keyword(AutoKeyword),
+}
+
+/// The keyword `auto`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum AutoKeyword {
+    Auto,
+}
+
+/// Largest number of time steps one run may take.
+pub const MAX_STEPS: f64 = 5e7;
+
+/// Builds the physics scheme, checking `phi` (pointers relative to the solver block).
+pub fn scheme(scheme: SchemeInput, phi: Option<f64>, issues: &mut Vec<InputIssue>) -> Scheme {
+    match scheme {
+        SchemeInput::CentralDifference => {
+            if phi.is_some() {
+                issues.push(InputIssue::new("phi", "only applies to the `tchamwa` scheme"));
+            }
+            Scheme::CentralDifference
+        }
+        SchemeInput::Tchamwa => {
+            let phi = phi.unwrap_or(1.1);
+            if !(phi.is_finite() && (1.0..=2.0).contains(&phi)) {
+                issues.push(InputIssue::new(
+                    "phi",
+                    format!("must be between 1 and 2 (got {phi})"),
+                ));
+            }
+            Scheme::Tchamwa { phi }
+        }
+    }
+}
+
+/// Checks a time step and duration (pointers relative to the solver block).
+pub fn time_step(step: TimeStepInput, duration: f64, issues: &mut Vec<InputIssue>) -> TimeStep {
+    crate::physics::require_positive(issues, "duration", duration);
+    match step {
+        TimeStepInput::Keyword(AutoKeyword::Auto) => TimeStep::Auto,
+        TimeStepInput::Seconds(dt) => {
+            crate::physics::require_positive(issues, "time_step", dt);
+            if dt > 0.0 && duration > 0.0 && duration / dt > MAX_STEPS {
+                issues.push(InputIssue::new(
+                    "time_step",
+                    format!(
+                        "duration / time_step = {:.3e} steps, above the limit of {MAX_STEPS:e}",
+                        duration / dt
+                    ),
+                ));
+            }
+            TimeStep::Fixed(dt)
+        }
+    }
+}
+
+/// Turns physics issues into field errors under `prefix` (a JSON pointer).
+pub fn at(prefix: &str, issues: Vec<InputIssue>) -> Vec<FieldError> {
+    issues
+        .into_iter()
+        .map(|i| FieldError::new(join_pointer(prefix, &i.field), i.reason))
+        .collect()
+}
+
+fn join_pointer(prefix: &str, field: &str) -> String {
+    if field.is_empty() {
+        prefix.to_owned()
+    } else {
+        format!("{prefix}/{field}")
+    }
+}
+
+/// Deserializes process inputs strictly; a failure names its JSON pointer (under `/inputs`).
+pub fn parse<T: DeserializeOwned>(inputs: &serde_json::Value) -> Result<T, InvalidInputs> {
+    serde_path_to_error::deserialize(inputs).map_err(|error| {
+        let mut pointer = String::from("/inputs");
+        for segment in error.path().iter() {
+            match segment {
+                serde_path_to_error::Segment::Seq { index } => pointer.push_str(&format!("/{index}")),
+                serde_path_to_error::Segment::Map { key } => {
+                    pointer.push('/');
+                    pointer.push_str(&key.replace('~', "~0").replace('/', "~1"));
+                }
+                serde_path_to_error::Segment::Enum { .. } | serde_path_to_error::Segment::Unknown => {}
+            }
+        }
+        InvalidInputs(vec![FieldError::new(pointer, error.into_inner().to_string())])
+    })
+}
+
+/// A self-contained JSON schema of `T` (component references inlined).
+pub fn schema_of<T: ToSchema>() -> serde_json::Value {
+    let mut components = Vec::new();
+    T::schemas(&mut components);
+    let components: std::collections::HashMap<String, serde_json::Value> = components
+        .into_iter()
+        .map(|(name, schema)| (name, serde_json::to_value(schema).unwrap_or_default()))
+        .collect();
+    let mut root = serde_json::to_value(T::schema()).unwrap_or_default();
+    inline_references(&mut root, &components, 0);
+    root
+}
+
+fn inline_references(
+    value: &mut serde_json::Value,
+    components: &std::collections::HashMap<String, serde_json::Value>,
+    depth: usize,
+) {
+    const PREFIX: &str = "#/components/schemas/";
+    match value {
+        serde_json::Value::Object(map) => {
+            if let Some(serde_json::Value::String(reference)) = map.get("$ref")
+                && let Some(name) = reference.strip_prefix(PREFIX)
+                && let Some(schema) = components.get(name)
+                && depth < 32
+            {
+                *value = schema.clone();
+                inline_references(value, components, depth + 1);
+                return;
+            }
+            for child in map.values_mut() {
+                inline_references(child, components, depth);
+            }
+        }
+        serde_json::Value::Array(items) => items
+            .iter_mut()
+            .for_each(|v| inline_references(v, components, depth)),
+        _ => {}
+    }
+}
+
+/// OGC `inputs` description from the schema of the whole inputs object: one entry per
+/// top-level property, with its title, description, schema and occurrence.
+pub fn ogc_inputs(schema: &serde_json::Value) -> serde_json::Value {
+    let required: Vec<&str> = schema["required"]
+        .as_array()
+        .map(|r| r.iter().filter_map(|v| v.as_str()).collect())
+        .unwrap_or_default();
+    let mut inputs = serde_json::Map::new();
+    if let Some(properties) = schema["properties"].as_object() {
+        for (name, property) in properties {
+            inputs.insert(
+                name.clone(),
+                serde_json::json!({
+                    "title": name,
+                    "description": property.get("description").cloned().unwrap_or_default(),
+                    "schema": property,
+                    "minOccurs": if required.contains(&name.as_str()) { 1 } else { 0 },
+                    "maxOccurs": 1,
+                }),
+            );
+        }
+    }
+    serde_json::Value::Object(inputs)
+}

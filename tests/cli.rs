@@ -1,0 +1,79 @@
+//! The `chocmodal run` command through the real binary: results on stdout, histories
+//! as CSV with `--out`, invalid inputs as a problem document on stderr with exit 2.
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+fn chocmodal() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_chocmodal"))
+}
+
+fn example() -> String {
+    format!("{}/examples/cantilever-impact.json", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn run_prints_the_results_document_and_writes_csv_histories() {
+    let out = std::env::temp_dir().join(format!("chocmodal-cli-{}", std::process::id()));
+    let output = chocmodal()
+        .args(["run", "cantilever-impact", &example(), "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let document: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON on stdout");
+    for block in ["numerical", "reference", "comparison", "outputs"] {
+        assert!(document.get(block).is_some(), "missing `{block}`");
+    }
+    assert_eq!(document["comparison"]["agrees"], true);
+    for name in ["tip_displacement", "contact_force"] {
+        let csv = std::fs::read_to_string(out.join(format!("{name}.csv"))).unwrap();
+        let mut lines = csv.lines();
+        assert_eq!(lines.next(), Some("time,numerical,reference"));
+        assert_eq!(lines.count(), 50_001, "{name}: one row per step");
+    }
+    std::fs::remove_dir_all(&out).ok();
+}
+
+#[test]
+fn invalid_inputs_give_a_problem_document_and_exit_status_2() {
+    let mut child = chocmodal()
+        .args(["run", "cantilever-impact", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let body = r#"{"inputs": {"beam": {"length": -1, "young_modulus": 2.1e11, "density": 7800,
+        "section": {"type": "tube", "outer_diameter": 0.01, "inner_diameter": 0.009}}}}"#;
+    child.stdin.take().unwrap().write_all(body.as_bytes()).unwrap();
+    let output = child.wait_with_output().unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    let problem: serde_json::Value = serde_json::from_slice(&output.stderr).expect("problem JSON on stderr");
+    assert_eq!(problem["status"], 422);
+    assert_eq!(problem["errors"][0]["pointer"], "/inputs/beam/length");
+}
+
+#[test]
+fn malformed_json_and_unknown_process_exit_with_status_2() {
+    let mut child = chocmodal()
+        .args(["run", "cantilever-impact", "-"])
+        .stdin(Stdio::piped())
+        .stderr(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(b"{not json").unwrap();
+    let output = child.wait_with_output().unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    let output = chocmodal()
+        .args(["run", "no-such-process", &example()])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("no-such-process"));
+}
