@@ -7,6 +7,7 @@
 //! sits in their own input document (`/inputs/beam/`).
 
 pub mod beam;
+pub mod bundle;
 pub mod contact;
 pub mod integrate;
 pub mod loads;

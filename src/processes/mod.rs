@@ -6,6 +6,8 @@
 //! time histories. It knows nothing about HTTP, the queue or the database: the service
 //! and the CLI drive it through [`Process`].
 
+pub mod bundle_dynamics;
+pub mod bundle_inputs;
 pub mod cantilever_impact;
 pub mod inputs;
 
@@ -134,7 +136,10 @@ impl Registry {
 
     /// The processes shipped with chocmodal.
     pub fn builtin() -> Self {
-        Self::new(vec![Arc::new(cantilever_impact::CantileverImpact)])
+        Self::new(vec![
+            Arc::new(cantilever_impact::CantileverImpact),
+            Arc::new(bundle_dynamics::BundleDynamics),
+        ])
     }
 
     pub fn get(&self, id: &str) -> Option<Arc<dyn Process>> {

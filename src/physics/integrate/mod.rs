@@ -331,7 +331,13 @@ impl<'m> Integrator<'m> {
         for (c, contact) in model.contacts.iter().enumerate() {
             let penetration = integrator.penetration(c, contact);
             integrator.previous_penetration[c] = penetration;
-            integrator.statistics[c].max_penetration = penetration;
+            let stats = &mut integrator.statistics[c];
+            stats.max_penetration = penetration;
+            // Released already pressed together: the first impact is at t = 0.
+            if penetration > 0.0 && (contact.stiffness > 0.0 || contact.damping > 0.0) {
+                stats.impacts = 1;
+                stats.first_impact_time = Some(0.0);
+            }
         }
         integrator.assemble_forces(0.0, 0.0);
         for i in 0..modes {

@@ -1,0 +1,394 @@
+//! Process `bundle-dynamics`: a row of identical pins (one shared modal basis) between
+//! two wrapper walls, with point contacts at given heights, shaken by the wrapper or
+//! released from bent shapes. The generator form is expanded to the explicit contact
+//! list, which the results echo.
+
+use serde_json::json;
+
+use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
+use super::inputs::{self, at};
+use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput};
+use crate::physics::contact::Contact;
+use crate::physics::integrate::{Model, Settings, SimulationError, resolve_time_step, simulate};
+use crate::physics::modal::ModalBasis;
+
+/// Most pins in one row.
+pub const MAX_PINS: usize = 2000;
+/// Largest pins × modes × steps (about a minute of computation).
+pub const MAX_WORK: f64 = 2e11;
+/// Largest number of history values (samples × columns) per history.
+pub const MAX_HISTORY_VALUES: f64 = 5e7;
+/// Default history interval (s).
+pub const DEFAULT_OUTPUT_INTERVAL: f64 = 1e-4;
+
+#[derive(Debug)]
+struct Prepared {
+    inputs: BundleInputs,
+    pins: usize,
+    contacts: Vec<Contact>,
+    basis: ModalBasis,
+    settings: Settings,
+}
+
+impl Prepared {
+    fn model(&self) -> Model<'_> {
+        let tips = &self.inputs.initial.tip_displacements;
+        Model {
+            basis: &self.basis,
+            pins: self.pins,
+            damping_ratios: self.inputs.pin.damping_ratios(),
+            contacts: self.contacts.clone(),
+            initial_tip_displacements: tips.clone(),
+            base_acceleration: self
+                .inputs
+                .excitation
+                .base_acceleration
+                .as_ref()
+                .map(|b| b.physics()),
+            point_forces: self
+                .inputs
+                .excitation
+                .point_forces
+                .iter()
+                .map(|f| f.physics())
+                .collect(),
+        }
+    }
+}
+
+fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
+    let inputs: BundleInputs = inputs::parse(json)?;
+    let length = inputs.pin.length;
+    let mut errors: Vec<FieldError> = at("/inputs/pin", inputs.pin.validate());
+
+    let (pins, contacts) = match (&inputs.bundle, inputs.pins, &inputs.contacts) {
+        (Some(generator), None, None) => {
+            let layout = generator.layout();
+            match layout.expand(length) {
+                Ok(contacts) => (generator.pins, contacts),
+                Err(issues) => {
+                    errors.extend(at("/inputs/bundle", issues));
+                    (generator.pins, vec![])
+                }
+            }
+        }
+        (None, Some(pins), contacts) => {
+            if !(1..=MAX_PINS).contains(&pins) {
+                errors.push(FieldError::new(
+                    "/inputs/pins",
+                    format!("must be between 1 and {MAX_PINS}"),
+                ));
+            }
+            let contacts: Vec<Contact> = contacts.iter().flatten().map(ContactInput::contact).collect();
+            if pins >= 1 {
+                for (k, contact) in contacts.iter().enumerate() {
+                    errors.extend(at(
+                        &format!("/inputs/contacts/{k}"),
+                        contact.validate(pins, length),
+                    ));
+                }
+            }
+            (pins, contacts)
+        }
+        (Some(_), _, _) => {
+            let field = if inputs.pins.is_some() {
+                "/inputs/pins"
+            } else {
+                "/inputs/contacts"
+            };
+            return Err(InvalidInputs(vec![FieldError::new(
+                field,
+                "give either `pins` and `contacts`, or `bundle`, not both",
+            )]));
+        }
+        (None, None, _) => {
+            return Err(InvalidInputs(vec![FieldError::new(
+                "/inputs/pins",
+                "is required (or use the `bundle` generator form)",
+            )]));
+        }
+    };
+    if pins > MAX_PINS {
+        errors.push(FieldError::new(
+            "/inputs/bundle/pins",
+            format!("must be at most {MAX_PINS}"),
+        ));
+    }
+
+    let tips = &inputs.initial.tip_displacements;
+    if !tips.is_empty() && tips.len() != pins {
+        errors.push(FieldError::new(
+            "/inputs/initial/tip_displacements",
+            format!("needs one value per pin ({pins}), got {}", tips.len()),
+        ));
+    }
+    for (p, tip) in tips.iter().enumerate() {
+        if !tip.is_finite() {
+            errors.push(FieldError::new(
+                format!("/inputs/initial/tip_displacements/{p}"),
+                "must be a finite number",
+            ));
+        }
+    }
+    if tips.iter().any(|t| *t != 0.0) && inputs.pin.supports.top != super::inputs::SupportInput::Free {
+        errors.push(FieldError::new(
+            "/inputs/initial/tip_displacements",
+            "a tip release needs a free top",
+        ));
+    }
+    if let Some(base) = &inputs.excitation.base_acceleration {
+        errors.extend(at(
+            "/inputs/excitation/base_acceleration",
+            base.physics().validate(),
+        ));
+    }
+    for (k, force) in inputs.excitation.point_forces.iter().enumerate() {
+        let prefix = format!("/inputs/excitation/point_forces/{k}");
+        if force.pin >= pins {
+            errors.push(FieldError::new(
+                format!("{prefix}/pin"),
+                format!("pin {} does not exist", force.pin),
+            ));
+        }
+        if !(force.height.is_finite() && (0.0..=length).contains(&force.height)) {
+            errors.push(FieldError::new(
+                format!("{prefix}/height"),
+                format!("must be within the pin, 0 to {length} m"),
+            ));
+        }
+        errors.extend(at(&prefix, force.physics().force.validate("force")));
+    }
+
+    let mut solver_issues = Vec::new();
+    let scheme = inputs::scheme(inputs.solver.scheme, inputs.solver.phi, &mut solver_issues);
+    let time_step = inputs::time_step(
+        inputs.solver.time_step,
+        inputs.solver.duration,
+        &mut solver_issues,
+    );
+    errors.extend(at("/inputs/solver", solver_issues));
+    if let Some(interval) = inputs.output.interval
+        && !(interval.is_finite() && interval > 0.0)
+    {
+        errors.push(FieldError::new(
+            "/inputs/output/interval",
+            "must be a positive number of seconds",
+        ));
+    }
+    let heights = inputs.output.heights.clone().unwrap_or_else(|| vec![length]);
+    if heights.is_empty() {
+        errors.push(FieldError::new(
+            "/inputs/output/heights",
+            "must list at least one height",
+        ));
+    }
+    for (k, h) in heights.iter().enumerate() {
+        if !(h.is_finite() && (0.0..=length).contains(h)) {
+            errors.push(FieldError::new(
+                format!("/inputs/output/heights/{k}"),
+                format!("must be within the pin, 0 to {length} m"),
+            ));
+        }
+    }
+    if !errors.is_empty() {
+        return Err(InvalidInputs(errors));
+    }
+
+    let basis = ModalBasis::compute(&inputs.pin.spec(), inputs.pin.modes)
+        .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/pin/modes", e.to_string())]))?;
+    let settings = Settings {
+        scheme,
+        time_step,
+        duration: inputs.solver.duration,
+        output_interval: Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
+        output_heights: heights,
+    };
+    let prepared = Prepared {
+        inputs,
+        pins,
+        contacts,
+        basis,
+        settings,
+    };
+    check_costs(&prepared)?;
+    Ok(prepared)
+}
+
+fn check_costs(prepared: &Prepared) -> Result<(), InvalidInputs> {
+    let model = prepared.model();
+    let (dt, _) = resolve_time_step(&model, &prepared.settings)
+        .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())]))?;
+    let duration = prepared.settings.duration;
+    let steps = duration / dt;
+    let mut errors = Vec::new();
+    let work = steps * (prepared.pins * prepared.basis.modes() + prepared.contacts.len()) as f64;
+    if steps > inputs::MAX_STEPS || work > MAX_WORK {
+        errors.push(FieldError::new(
+            "/inputs/solver/duration",
+            format!(
+                "{steps:.3e} steps of {dt:e} s over this row is too much work ({work:.3e} > {MAX_WORK:e})"
+            ),
+        ));
+    }
+    let interval = prepared.settings.output_interval.unwrap_or(dt).max(dt);
+    let columns =
+        (prepared.contacts.len()).max(prepared.pins * prepared.settings.output_heights.len()) as f64;
+    if duration / interval * columns > MAX_HISTORY_VALUES {
+        errors.push(FieldError::new(
+            "/inputs/output/interval",
+            format!(
+                "histories would hold {:.3e} values, above {MAX_HISTORY_VALUES:e}: sample less often",
+                duration / interval * columns
+            ),
+        ));
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(InvalidInputs(errors))
+    }
+}
+
+/// The `bundle-dynamics` process.
+#[derive(Debug, Default)]
+pub struct BundleDynamics;
+
+impl Process for BundleDynamics {
+    fn id(&self) -> &'static str {
+        "bundle-dynamics"
+    }
+
+    fn title(&self) -> &'static str {
+        "Row of pins rattling between two wrapper walls"
+    }
+
+    fn description(&self) -> &'static str {
+        "Integrates a row of identical pins (one shared modal basis) with penalty point contacts between \
+         pins and against the walls, under a base acceleration of the wrapper, initial releases and point \
+         forces. Returns per-contact statistics (peak force, impacts, contact time, impulse), per-pin \
+         extremes, the energy balance, and contact-force and deflection histories."
+    }
+
+    fn inputs_description(&self) -> serde_json::Value {
+        inputs::ogc_inputs(&inputs::schema_of::<BundleInputs>())
+    }
+
+    fn outputs_description(&self) -> serde_json::Value {
+        json!({
+            "contact_forces": {"title": "Contact forces (N)", "description": "CSV columns time (s), c0, c1, ... in contact order",
+                               "schema": {"type": "string", "contentMediaType": "text/csv"}},
+            "displacements": {"title": "Pin deflections (m)", "description": "CSV columns time (s), p0, p1, ... (pin tips; `p<pin>@<height>` for other heights)",
+                              "schema": {"type": "string", "contentMediaType": "text/csv"}},
+        })
+    }
+
+    fn validate(&self, inputs: &serde_json::Value) -> Result<(), InvalidInputs> {
+        prepare(inputs).map(|_| ())
+    }
+
+    fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
+        let prepared = prepare(inputs)?;
+        let model = prepared.model();
+        let simulation = simulate(&model, &prepared.settings, progress).map_err(|e| match e {
+            SimulationError::Cancelled => RunError::Cancelled,
+            other => RunError::Failed(other.to_string()),
+        })?;
+
+        let contacts: Vec<serde_json::Value> = prepared
+            .contacts
+            .iter()
+            .zip(&simulation.contact_statistics)
+            .map(|(c, s)| {
+                json!({
+                    "left": body_json(c.left), "right": body_json(c.right), "height": c.height, "gap": c.gap,
+                    "stiffness": c.stiffness, "damping": c.damping,
+                    "max_force": s.max_force, "max_force_time": s.max_force_time, "impacts": s.impacts,
+                    "contact_time": s.contact_time, "impulse": s.impulse, "first_impact_time": s.first_impact_time,
+                    "max_penetration": s.max_penetration,
+                })
+            })
+            .collect();
+        let peak = simulation
+            .contact_statistics
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.max_force.total_cmp(&b.1.max_force))
+            .map(|(k, s)| json!({"contact": k, "force": s.max_force, "time": s.max_force_time}));
+        let pins: Vec<serde_json::Value> = simulation
+            .pin_extremes
+            .iter()
+            .enumerate()
+            .map(|(p, e)| json!({"pin": p, "max_abs_deflection": e.max_abs_deflection, "height": e.height, "time": e.time}))
+            .collect();
+        let mut document = json!({
+            "contacts": contacts,
+            "max_contact_force": peak,
+            "impacts": simulation.contact_statistics.iter().map(|s| s.impacts).sum::<u64>(),
+            "pins": pins,
+            "energy": {
+                "kinetic": simulation.energy.kinetic, "strain": simulation.energy.strain,
+                "contact": simulation.energy.contact, "dissipated_modal": simulation.energy.dissipated_modal,
+                "dissipated_contact": simulation.energy.dissipated_contact,
+                "external_work": simulation.energy.external_work, "initial": simulation.energy.initial,
+                "residual": simulation.energy.residual(), "relative_residual": simulation.energy.relative_residual(),
+            },
+            "time_step": simulation.time_step,
+            "critical_time_step": simulation.critical_time_step,
+            "steps": simulation.steps,
+            "frequencies_hz": prepared.basis.frequencies_hz(),
+        });
+        if prepared.inputs.bundle.is_some() {
+            let explicit: Vec<serde_json::Value> = prepared
+                .contacts
+                .iter()
+                .map(|c| {
+                    json!({"left": body_json(c.left), "right": body_json(c.right), "height": c.height,
+                                "gap": c.gap, "stiffness": c.stiffness, "damping": c.damping})
+                })
+                .collect();
+            document["expansion"] = json!({"pins": prepared.pins, "contacts": explicit});
+        }
+        Ok(RunOutput {
+            document,
+            histories: histories(&prepared, simulation),
+        })
+    }
+}
+
+fn histories(prepared: &Prepared, simulation: crate::physics::integrate::Simulation) -> Vec<History> {
+    let tips_only = prepared.inputs.output.heights.is_none();
+    let mut displacement_series = Vec::new();
+    for (h, per_pin) in simulation.deflections.into_iter().enumerate() {
+        let height = prepared.settings.output_heights[h];
+        for (p, values) in per_pin.into_iter().enumerate() {
+            let name = if tips_only {
+                format!("p{p}")
+            } else {
+                format!("p{p}@{height}")
+            };
+            displacement_series.push((name, values));
+        }
+    }
+    let force_series = simulation
+        .contact_forces
+        .into_iter()
+        .enumerate()
+        .map(|(c, v)| (format!("c{c}"), v))
+        .collect();
+    vec![
+        History {
+            name: "contact_forces".into(),
+            time: simulation.time.clone(),
+            series: force_series,
+        },
+        History {
+            name: "displacements".into(),
+            time: simulation.time,
+            series: displacement_series,
+        },
+    ]
+}
+
+#[cfg(test)]
+#[path = "bundle_dynamics_tests.rs"]
+mod tests;

@@ -1,0 +1,197 @@
+//! `bundle-dynamics` against physics: a one-pin row is the cantilever case, mirror
+//! symmetric inputs give mirror symmetric responses, pin–pin forces act equally and
+//! oppositely (the energy balance closes only then), the generator form expands as the
+//! explicit one, and validation names every bad field.
+
+use std::ops::ControlFlow;
+
+use serde_json::{Value, json};
+
+use super::*;
+use crate::processes::cantilever_impact::CantileverImpact;
+
+fn pin() -> Value {
+    json!({"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
+           "section": {"type": "tube", "outer_diameter": 0.010, "inner_diameter": 0.009},
+           "elements": 20, "modes": 8, "damping_ratio": 0.01})
+}
+
+fn run(inputs: &Value) -> RunOutput {
+    BundleDynamics.validate(inputs).expect("valid inputs");
+    BundleDynamics
+        .run(inputs, &mut |_| ControlFlow::Continue(()))
+        .expect("run succeeds")
+}
+
+fn pointers(inputs: &Value) -> Vec<String> {
+    BundleDynamics
+        .validate(inputs)
+        .expect_err("invalid")
+        .0
+        .into_iter()
+        .map(|e| e.pointer)
+        .collect()
+}
+
+fn series<'a>(history: &'a History, name: &str) -> &'a [f64] {
+    &history
+        .series
+        .iter()
+        .find(|(n, _)| n == name)
+        .unwrap_or_else(|| panic!("no column {name}"))
+        .1
+}
+
+/// A row of one pin with a wall contact at its tip is the cantilever-impact model: the
+/// numerical peak force, impacts and first impact must be identical.
+#[test]
+fn one_pin_row_reproduces_the_cantilever_numerical_result() {
+    let beam = json!({"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
+        "section": {"type": "tube", "outer_diameter": 0.010, "inner_diameter": 0.009}, "elements": 40, "modes": 10});
+    let stiffness = 3.0 * 2.1e11 * std::f64::consts::PI / 64.0 * (0.01f64.powi(4) - 0.009f64.powi(4));
+    let cantilever = CantileverImpact
+        .run(
+            &json!({"beam": beam, "contact": {"stiffness": stiffness}, "solver": {"duration": 0.2}}),
+            &mut |_| ControlFlow::Continue(()),
+        )
+        .unwrap();
+    let bundle = run(&json!({"pin": beam, "pins": 1,
+        "contacts": [{"left": "wall", "right": 0, "height": 1.0, "stiffness": stiffness}],
+        "initial": {"tip_displacements": [1e-3]},
+        "solver": {"time_step": 1e-5, "duration": 0.2}}));
+    let numerical = &cantilever.document["numerical"];
+    let contact = &bundle.document["contacts"][0];
+    assert_eq!(contact["impacts"], numerical["impacts"]);
+    assert_eq!(contact["max_force"], numerical["max_contact_force"]);
+    assert_eq!(contact["first_impact_time"], numerical["first_impact_time"]);
+}
+
+/// Two pins between two walls, released in opposite directions with mirrored contacts:
+/// the mirror image about the centre line is the same motion, so w₀ = −w₁ and the two
+/// wall contacts carry identical forces at every instant.
+#[test]
+fn mirror_symmetric_inputs_give_mirror_symmetric_forces() {
+    let contact = |left: Value, right: Value, h: f64| {
+        json!({"left": left, "right": right, "height": h, "gap": 1e-4,
+                                                             "stiffness": 5e4, "damping": 1.0})
+    };
+    let inputs = json!({"pin": pin(), "pins": 2,
+        "contacts": [contact(json!("wall"), json!(0), 1.0), contact(json!(0), json!(1), 1.0), contact(json!(1), json!("wall"), 1.0),
+                     contact(json!("wall"), json!(0), 0.5), contact(json!(0), json!(1), 0.5), contact(json!(1), json!("wall"), 0.5)],
+        "initial": {"tip_displacements": [-1e-3, 1e-3]},
+        "solver": {"time_step": 2e-6, "duration": 0.1}, "output": {"interval": 1e-4}});
+    let output = run(&inputs);
+    let forces = &output.histories[0];
+    let displacements = &output.histories[1];
+    let (left_wall, right_wall) = (series(forces, "c0"), series(forces, "c2"));
+    let peak = left_wall.iter().copied().fold(0.0, f64::max);
+    assert!(peak > 0.0, "the walls must be hit");
+    for (a, b) in left_wall.iter().zip(right_wall) {
+        assert!((a - b).abs() <= 1e-9 * peak, "wall forces {a} vs {b}");
+    }
+    for (a, b) in series(displacements, "p0")
+        .iter()
+        .zip(series(displacements, "p1"))
+    {
+        assert!((a + b).abs() <= 1e-12, "mirror deflections {a} vs {b}");
+    }
+}
+
+/// Two pins that only touch each other, undamped: the contact force is internal. It
+/// conserves the energy only if it acts equally and oppositely on both pins (its work
+/// is then −F δ̇, stored in the contact spring).
+#[test]
+fn pin_to_pin_forces_are_equal_and_opposite() {
+    let mut pin = pin();
+    pin["damping_ratio"] = json!(0.0);
+    let inputs = json!({"pin": pin, "pins": 2,
+        "contacts": [{"left": 0, "right": 1, "height": 1.0, "gap": 0.0, "stiffness": 2e4},
+                     {"left": 0, "right": 1, "height": 0.6, "gap": 2e-4, "stiffness": 2e4}],
+        "initial": {"tip_displacements": [-1e-3, 5e-4]},
+        "solver": {"time_step": 2e-6, "duration": 0.1}});
+    let output = run(&inputs);
+    assert!(output.document["impacts"].as_u64().unwrap() > 2);
+    let residual = output.document["energy"]["relative_residual"].as_f64().unwrap();
+    assert!(residual < 1e-4, "energy residual {residual}");
+}
+
+/// The generator form expands level by level (wall–0, 0–1, …, n−1–wall) and gives the
+/// same run as its explicit expansion.
+#[test]
+fn generator_form_matches_its_explicit_expansion() {
+    let generated = json!({"pin": pin(), "bundle": {"pins": 3, "levels": {"first": 0.5, "spacing": 0.5, "count": 2},
+        "stiffness": 1e5, "damping": 2.0, "wall_gap": 1e-4, "pin_gap": 5e-5,
+        "gaps": {"type": "random", "seed": 7, "distribution": {"type": "uniform", "low": 2e-5, "high": 1e-4}}},
+        "excitation": {"base_acceleration": {"type": "half_sine", "amplitude": 30.0, "duration": 0.01}},
+        "solver": {"duration": 0.05}});
+    let output = run(&generated);
+    let expansion = &output.document["expansion"];
+    assert_eq!(expansion["contacts"].as_array().unwrap().len(), 8);
+    assert_eq!(expansion["contacts"][0]["left"], "wall");
+    assert_eq!(expansion["contacts"][3]["right"], "wall");
+    assert_eq!(expansion["contacts"][4]["height"], 1.0);
+    let explicit = json!({"pin": pin(), "pins": 3, "contacts": expansion["contacts"],
+        "excitation": generated["excitation"], "solver": generated["solver"]});
+    let again = run(&explicit);
+    assert_eq!(again.document["contacts"], output.document["contacts"]);
+    assert!(
+        output.document["impacts"].as_u64().unwrap() > 0,
+        "the shock must close gaps"
+    );
+}
+
+/// A damped row shaken by the base: the energy balance (kinetic + strain + contact +
+/// dissipated − base work = initial) closes to a small fraction.
+#[test]
+fn energy_balance_closes_under_base_excitation() {
+    let inputs = json!({"pin": pin(), "bundle": {"pins": 4, "levels": [0.5, 1.0], "stiffness": 5e4, "damping": 5.0,
+        "wall_gap": 1e-4, "pin_gap": 1e-4},
+        "excitation": {"base_acceleration": {"type": "sine", "amplitude": 20.0, "frequency": 15.0, "cycles": 3}},
+        "solver": {"time_step": 2e-6, "duration": 0.3}});
+    let output = run(&inputs);
+    let energy = &output.document["energy"];
+    assert!(energy["external_work"].as_f64().unwrap() > 0.0);
+    let residual = energy["relative_residual"].as_f64().unwrap();
+    assert!(residual < 1e-3, "energy residual {residual}: {energy}");
+}
+
+#[test]
+fn invalid_inputs_name_each_field() {
+    let inputs = json!({"pin": pin(), "pins": 2,
+        "contacts": [{"left": "wall", "right": 2, "height": 1.2, "stiffness": 1e4},
+                     {"left": 0, "right": 0, "height": 0.5, "stiffness": -1.0}],
+        "initial": {"tip_displacements": [1e-3]},
+        "excitation": {"base_acceleration": {"type": "half_sine", "amplitude": 1.0, "duration": 0.0}}});
+    assert_eq!(
+        pointers(&inputs),
+        [
+            "/inputs/contacts/0/right",
+            "/inputs/contacts/0/height",
+            "/inputs/contacts/1/right",
+            "/inputs/contacts/1/stiffness",
+            "/inputs/initial/tip_displacements",
+            "/inputs/excitation/base_acceleration/duration"
+        ]
+    );
+    let both = json!({"pin": pin(), "pins": 2, "bundle": {"pins": 2, "levels": [1.0], "stiffness": 1.0, "wall_gap": 0.0, "pin_gap": 0.0}});
+    assert_eq!(pointers(&both), ["/inputs/pins"]);
+    let bad_left = json!({"pin": pin(), "pins": 1, "contacts": [{"left": "floor", "right": 0, "height": 1.0, "stiffness": 1.0}]});
+    assert_eq!(pointers(&bad_left), ["/inputs/contacts/0/left"]);
+}
+
+/// The shipped benchmark example is valid and describes 17 pins and 180 contacts.
+#[test]
+fn row17_example_is_the_benchmark_case() {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/bundle-row17.json")).unwrap();
+    let body: Value = serde_json::from_str(&text).unwrap();
+    let inputs = &body["inputs"];
+    assert!(BundleDynamics.validate(inputs).is_ok());
+    assert_eq!(inputs["contacts"].as_array().unwrap().len(), 180);
+    for name in ["bundle-random-gaps.json", "bundle-local-closure.json"] {
+        let text =
+            std::fs::read_to_string(format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap();
+        let body: Value = serde_json::from_str(&text).unwrap();
+        assert!(BundleDynamics.validate(&body["inputs"]).is_ok(), "{name}");
+    }
+}

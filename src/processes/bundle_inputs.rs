@@ -1,0 +1,361 @@
+//! Inputs of `bundle-dynamics`: the explicit form (pins + contacts) and the generator
+//! form (`bundle`), excitation, initial state, solver and output, with their mapping to
+//! the physics types.
+
+use serde::Deserialize;
+use utoipa::ToSchema;
+
+use super::inputs::{BeamInput, SchemeInput, TimeStepInput};
+use crate::physics::bundle::{BundleLayout, GapDistribution, GapState, Levels, LocalClosure};
+use crate::physics::contact::{Body, Contact};
+use crate::physics::loads::{BaseAcceleration, PointForce, Table};
+
+/// Inputs of `bundle-dynamics`: give either `pins` and `contacts`, or `bundle`.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BundleInputs {
+    /// The pin shared by the whole row (one modal basis).
+    pub pin: BeamInput,
+    /// Explicit form: number of pins, numbered 0.. from the left wall.
+    pub pins: Option<usize>,
+    /// Explicit form: every potential contact.
+    pub contacts: Option<Vec<ContactInput>>,
+    /// Generator form, instead of `pins` and `contacts`.
+    pub bundle: Option<BundleGenerator>,
+    #[serde(default)]
+    pub initial: InitialInput,
+    #[serde(default)]
+    pub excitation: ExcitationInput,
+    #[serde(default)]
+    pub solver: SolverInput,
+    #[serde(default)]
+    pub output: OutputInput,
+}
+
+/// A potential point contact between `left` and `right` ("wall" or a pin number).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ContactInput {
+    pub left: BodyInput,
+    pub right: BodyInput,
+    /// Height from the pin feet (m).
+    pub height: f64,
+    /// Gap at rest (m).
+    #[serde(default)]
+    pub gap: f64,
+    /// Penalty stiffness (N/m).
+    pub stiffness: f64,
+    /// Dashpot (N·s/m).
+    #[serde(default)]
+    pub damping: f64,
+}
+
+/// "wall" or a pin number.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[serde(untagged, expecting = "\"wall\" or a pin number")]
+pub enum BodyInput {
+    Pin(usize),
+    Wall(WallKeyword),
+}
+
+/// The keyword `wall`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum WallKeyword {
+    Wall,
+}
+
+impl From<BodyInput> for Body {
+    fn from(value: BodyInput) -> Self {
+        match value {
+            BodyInput::Pin(p) => Body::Pin(p),
+            BodyInput::Wall(_) => Body::Wall,
+        }
+    }
+}
+
+/// JSON form of a body in results: "wall" or the pin number.
+pub fn body_json(body: Body) -> serde_json::Value {
+    match body {
+        Body::Wall => serde_json::json!("wall"),
+        Body::Pin(p) => serde_json::json!(p),
+    }
+}
+
+impl ContactInput {
+    pub fn contact(&self) -> Contact {
+        Contact {
+            left: self.left.into(),
+            right: self.right.into(),
+            height: self.height,
+            gap: self.gap,
+            stiffness: self.stiffness,
+            damping: self.damping,
+        }
+    }
+}
+
+/// Generator form of a row of pins between two walls.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BundleGenerator {
+    /// Number of pins.
+    pub pins: usize,
+    /// Contact levels: `{first, spacing, count}` or a list of heights (m).
+    pub levels: LevelsInput,
+    /// Stiffness of every contact (N/m).
+    pub stiffness: f64,
+    /// Dashpot of every contact (N·s/m).
+    #[serde(default)]
+    pub damping: f64,
+    /// Nominal wall–pin gap (m).
+    pub wall_gap: f64,
+    /// Nominal pin–pin gap (m).
+    pub pin_gap: f64,
+    /// Gap state (default uniform: the nominal gaps).
+    #[serde(default)]
+    pub gaps: GapsInput,
+    /// Local gap changes (irradiation swelling), applied after `gaps`, in order.
+    #[serde(default)]
+    pub closures: Vec<ClosureInput>,
+}
+
+/// Contact levels.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(untagged, expecting = "{first, spacing, count} or a list of heights")]
+pub enum LevelsInput {
+    Regular(RegularLevels),
+    Explicit(Vec<f64>),
+}
+
+/// Levels first + k·spacing, k = 0..count (m).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RegularLevels {
+    pub first: f64,
+    pub spacing: f64,
+    pub count: usize,
+}
+
+/// Gap state.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum GapsInput {
+    /// Nominal gaps everywhere.
+    #[default]
+    Uniform,
+    /// One gap per contact (m), in expansion order (level by level: wall–0, 0–1, …, n−1–wall).
+    PerContact { values: Vec<f64> },
+    /// Independent draws in expansion order, reproducible from the seed on every machine.
+    Random {
+        distribution: DistributionInput,
+        seed: u64,
+        /// Draws multiply the nominal gaps instead of being gaps (m).
+        #[serde(default)]
+        relative: bool,
+    },
+}
+
+/// Law of random gaps.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum DistributionInput {
+    Uniform {
+        low: f64,
+        high: f64,
+    },
+    /// Normal law truncated at 0 (resampled, a true truncated normal).
+    Normal {
+        mean: f64,
+        std: f64,
+    },
+}
+
+/// Gaps of the contacts in levels first_level..=last_level touching a pin in
+/// first_pin..=last_pin are multiplied by `factor` (0 closes them).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ClosureInput {
+    pub first_level: usize,
+    pub last_level: usize,
+    pub first_pin: usize,
+    pub last_pin: usize,
+    pub factor: f64,
+}
+
+impl BundleGenerator {
+    pub fn layout(&self) -> BundleLayout {
+        BundleLayout {
+            pins: self.pins,
+            levels: match &self.levels {
+                LevelsInput::Regular(r) => Levels::Regular {
+                    first: r.first,
+                    spacing: r.spacing,
+                    count: r.count,
+                },
+                LevelsInput::Explicit(list) => Levels::Explicit(list.clone()),
+            },
+            stiffness: self.stiffness,
+            damping: self.damping,
+            wall_gap: self.wall_gap,
+            pin_gap: self.pin_gap,
+            gaps: match &self.gaps {
+                GapsInput::Uniform => GapState::Uniform,
+                GapsInput::PerContact { values } => GapState::PerContact(values.clone()),
+                GapsInput::Random {
+                    distribution,
+                    seed,
+                    relative,
+                } => GapState::Random {
+                    distribution: match *distribution {
+                        DistributionInput::Uniform { low, high } => GapDistribution::Uniform { low, high },
+                        DistributionInput::Normal { mean, std } => GapDistribution::Normal { mean, std },
+                    },
+                    seed: *seed,
+                    relative: *relative,
+                },
+            },
+            closures: self
+                .closures
+                .iter()
+                .map(|c| LocalClosure {
+                    first_level: c.first_level,
+                    last_level: c.last_level,
+                    first_pin: c.first_pin,
+                    last_pin: c.last_pin,
+                    factor: c.factor,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Initial state.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InitialInput {
+    /// Release of each pin from its static tip-load shape with this tip deflection (m);
+    /// one per pin, or empty for all at rest.
+    #[serde(default)]
+    pub tip_displacements: Vec<f64>,
+}
+
+/// Loads.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ExcitationInput {
+    /// Acceleration of the wrapper (walls and pin feet), toward the right wall (m/s²).
+    pub base_acceleration: Option<BaseAccelerationInput>,
+    /// Force histories at a height of a pin, toward the right wall (N).
+    #[serde(default)]
+    pub point_forces: Vec<PointForceInput>,
+}
+
+/// Base acceleration a(t).
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum BaseAccelerationInput {
+    /// amplitude (m/s²) · sin(π t / duration (s)) during `duration`, then 0.
+    HalfSine { amplitude: f64, duration: f64 },
+    /// amplitude (m/s²) · sin(2π frequency (Hz) t) for `cycles` periods, then 0.
+    Sine {
+        amplitude: f64,
+        frequency: f64,
+        cycles: f64,
+    },
+    /// Samples: time (s), acceleration (m/s²); linear between them, 0 outside.
+    Table { time: Vec<f64>, acceleration: Vec<f64> },
+}
+
+impl BaseAccelerationInput {
+    pub fn physics(&self) -> BaseAcceleration {
+        match self {
+            Self::HalfSine { amplitude, duration } => BaseAcceleration::HalfSine {
+                amplitude: *amplitude,
+                duration: *duration,
+            },
+            Self::Sine {
+                amplitude,
+                frequency,
+                cycles,
+            } => BaseAcceleration::Sine {
+                amplitude: *amplitude,
+                frequency: *frequency,
+                cycles: *cycles,
+            },
+            Self::Table { time, acceleration } => BaseAcceleration::Table(Table {
+                time: time.clone(),
+                values: acceleration.clone(),
+            }),
+        }
+    }
+}
+
+/// A force table applied at a height of one pin.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PointForceInput {
+    pub pin: usize,
+    /// Height from the foot (m).
+    pub height: f64,
+    /// Sample times (s).
+    pub time: Vec<f64>,
+    /// Force at those times (N), linear between them, 0 outside.
+    pub force: Vec<f64>,
+}
+
+impl PointForceInput {
+    pub fn physics(&self) -> PointForce {
+        PointForce {
+            pin: self.pin,
+            height: self.height,
+            force: Table {
+                time: self.time.clone(),
+                values: self.force.clone(),
+            },
+        }
+    }
+}
+
+/// Explicit integration settings.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SolverInput {
+    #[serde(default)]
+    pub scheme: SchemeInput,
+    /// Tchamwa–Wielgosz parameter φ in [1, 2] (default 1.1).
+    pub phi: Option<f64>,
+    /// Time step (s) or "auto" (0.8 × the critical step; the default).
+    #[serde(default = "auto")]
+    pub time_step: TimeStepInput,
+    /// Simulated duration (s), default 0.2 s.
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+}
+impl Default for SolverInput {
+    fn default() -> Self {
+        Self {
+            scheme: SchemeInput::default(),
+            phi: None,
+            time_step: auto(),
+            duration: default_duration(),
+        }
+    }
+}
+fn auto() -> TimeStepInput {
+    TimeStepInput::Keyword(super::inputs::AutoKeyword::Auto)
+}
+fn default_duration() -> f64 {
+    0.2
+}
+
+/// History sampling.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OutputInput {
+    /// Time between two history samples (s), a whole number of steps; default 1e-4 s
+    /// (every step when the step is longer).
+    pub interval: Option<f64>,
+    /// Heights (m) of the deflections recorded for every pin; default: the pin tips.
+    pub heights: Option<Vec<f64>>,
+}
