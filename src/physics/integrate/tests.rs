@@ -4,6 +4,7 @@
 
 use super::*;
 use crate::physics::beam::tests::default_tube;
+use crate::physics::contact::Body;
 use crate::physics::loads::Table;
 
 fn basis(elements: usize, modes: usize) -> ModalBasis {

@@ -1,0 +1,79 @@
+//! Benchmarks of the numerical core (run with `cargo bench`): the row17 bundle case of
+//! issue 5 (17 pins × 20 modes, 180 contacts, 200 000 steps) through the whole
+//! `bundle-dynamics` process, modal analysis included, and the semi-analytic reference
+//! of the default cantilever case. Prints wall times and steps per second; targets are
+//! ratios read in one run, not asserted (machines are shared and noisy).
+
+use std::ops::ControlFlow;
+use std::time::Instant;
+
+use chocmodal::processes::Process;
+use chocmodal::processes::bundle_dynamics::BundleDynamics;
+use chocmodal::processes::cantilever_impact::CantileverImpact;
+
+fn example(name: &str) -> serde_json::Value {
+    let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
+    let body: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).expect("example")).expect("JSON");
+    body["inputs"].clone()
+}
+
+fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut best = f64::INFINITY;
+    let mut last = None;
+    for _ in 0..runs {
+        let start = Instant::now();
+        let value = f();
+        best = best.min(start.elapsed().as_secs_f64());
+        last = Some(value);
+    }
+    (best, last.expect("at least one run"))
+}
+
+fn main() {
+    let row17 = example("bundle-row17.json");
+    let (seconds, output) = best_of(3, || {
+        BundleDynamics
+            .run(&row17, &mut |_| ControlFlow::Continue(()))
+            .expect("row17 runs")
+    });
+    let steps = output.document["steps"].as_f64().unwrap_or(0.0);
+    println!(
+        "row17 bundle-dynamics: {seconds:.3} s for {steps} steps = {:.3e} steps/s ({:.2} µs/step), target 0.3 s",
+        steps / seconds,
+        1e6 * seconds / steps
+    );
+
+    let cantilever = example("cantilever-impact.json");
+    let (seconds, _) = best_of(3, || {
+        CantileverImpact
+            .run(&cantilever, &mut |_| ControlFlow::Continue(()))
+            .expect("cantilever runs")
+    });
+    println!("cantilever-impact default case (numerical + reference + f_err): {seconds:.3} s");
+
+    let reference = chocmodal::physics::reference::CantileverReference {
+        length: 1.0,
+        young_modulus: 2.1e11,
+        density: 7800.0,
+        area: std::f64::consts::PI / 4.0 * (0.01f64.powi(2) - 0.009f64.powi(2)),
+        inertia: std::f64::consts::PI / 64.0 * (0.01f64.powi(4) - 0.009f64.powi(4)),
+        added_mass_per_length: 0.0,
+        contact_stiffness: 3.0 * 2.1e11 * std::f64::consts::PI / 64.0 * (0.01f64.powi(4) - 0.009f64.powi(4)),
+        gap: 0.0,
+        damping_ratios: vec![0.01],
+        tip_displacement: 1e-3,
+        duration: 0.5,
+        modes: 30,
+        max_events: 100_000,
+    };
+    let (seconds, _) = best_of(5, || {
+        reference
+            .solve(&mut |_| ControlFlow::Continue(()))
+            .expect("reference solves")
+    });
+    println!(
+        "semi-analytic reference, default case, 30 modes: {:.1} ms",
+        1e3 * seconds
+    );
+}
