@@ -17,7 +17,7 @@ use crate::physics::stability::Scheme;
 /// Pins per block of the dense sweeps.
 const LANES: usize = 4;
 
-/// Sentinel pin index of a wall.
+/// Sentinel pin index of a wall (for force projection; reads use the zero lane).
 const WALL: usize = usize::MAX;
 
 pub(super) struct Integrator<'m> {
@@ -41,6 +41,16 @@ pub(super) struct Integrator<'m> {
     contact_level: Vec<usize>,
     contact_left: Vec<usize>,
     contact_right: Vec<usize>,
+    /// Per contact: index into `level_deflections` of its left and right side (a wall
+    /// reads the always-zero padded lane `pins` of its level).
+    left_slot: Vec<usize>,
+    right_slot: Vec<usize>,
+    gaps: Vec<f64>,
+    /// Per contact: penetration at the previous step and largest penetration so far.
+    previous_penetration: Vec<f64>,
+    max_penetration: Vec<f64>,
+    /// Base acceleration at the current step (m/s²).
+    base_now: f64,
     /// w at every level for every pin (`levels × stride`).
     level_deflections: Vec<f64>,
     point_force_shapes: Vec<Vec<f64>>,
@@ -116,7 +126,8 @@ impl<'m> Integrator<'m> {
     pub(super) fn new(model: &'m Model<'m>, settings: &Settings, dt: f64, critical: f64) -> Self {
         let basis = model.basis;
         let (pins, modes) = (model.pins, basis.modes());
-        let stride = pins.div_ceil(LANES) * LANES;
+        // At least one padded lane: walls read their (zero) deflection there.
+        let stride = (pins + 1).div_ceil(LANES) * LANES;
         let omega = basis.angular_frequencies();
         let damping: Vec<f64> = omega
             .iter()
@@ -167,6 +178,12 @@ impl<'m> Integrator<'m> {
             contact_level,
             contact_left: model.contacts.iter().map(|c| pin_index(c.left)).collect(),
             contact_right: model.contacts.iter().map(|c| pin_index(c.right)).collect(),
+            left_slot: Vec::new(),
+            right_slot: Vec::new(),
+            gaps: model.contacts.iter().map(|c| c.gap).collect(),
+            previous_penetration: vec![0.0; contacts],
+            max_penetration: vec![f64::NEG_INFINITY; contacts],
+            base_now: 0.0,
             level_deflections: vec![0.0; heights.len() * stride],
             point_force_shapes: model
                 .point_forces
@@ -199,12 +216,20 @@ impl<'m> Integrator<'m> {
             mechanical_energy: Vec::new(),
             pin_extremes: vec![PinExtreme::default(); pins],
         };
+        let slot = |c: usize, pin: usize| {
+            integrator.contact_level[c] * stride + if pin == WALL { pins } else { pin }
+        };
+        integrator.left_slot = (0..contacts)
+            .map(|c| slot(c, integrator.contact_left[c]))
+            .collect();
+        integrator.right_slot = (0..contacts)
+            .map(|c| slot(c, integrator.contact_right[c]))
+            .collect();
         // The state at t = 0: contacts already closed count as impacts at t = 0; a₀ from
         // equilibrium (velocities are zero).
         integrator.contact_forces_and_statistics(0.0, false);
         for (c, contact) in model.contacts.iter().enumerate() {
             let stats = &mut integrator.statistics[c];
-            stats.max_penetration = integrator.penetration[c];
             if integrator.penetration[c] > 0.0 && (contact.stiffness > 0.0 || contact.damping > 0.0) {
                 stats.impacts = 1;
                 stats.first_impact_time = Some(0.0);
@@ -224,6 +249,7 @@ impl<'m> Integrator<'m> {
     fn external_forces(&mut self, t: f64) -> f64 {
         let (pins, stride) = (self.pins, self.stride);
         let base = self.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
+        self.base_now = base;
         for (row, gamma) in self.force.chunks_exact_mut(stride).zip(&self.participation) {
             row[..pins].fill(-gamma * base);
         }
@@ -250,27 +276,30 @@ impl<'m> Integrator<'m> {
             stride,
             &mut self.level_deflections,
         );
+        // Pass 1, every contact, branch-free: penetration and its running maximum.
+        for c in 0..self.gaps.len() {
+            let penetration = self.level_deflections[self.left_slot[c]]
+                - self.level_deflections[self.right_slot[c]]
+                - self.gaps[c];
+            self.previous_penetration[c] = self.penetration[c];
+            self.penetration[c] = penetration;
+            self.max_penetration[c] = self.max_penetration[c].max(penetration);
+        }
+        // Pass 2, only contacts closed now or a step ago (a few percent of them).
         let mut dissipation_power = 0.0;
         for (c, contact) in self.model.contacts.iter().enumerate() {
-            let row = self.contact_level[c] * stride;
-            let (left, right) = (self.contact_left[c], self.contact_right[c]);
-            let at = |values: &[f64], pin: usize| if pin == WALL { 0.0 } else { values[row + pin] };
-            let penetration =
-                at(&self.level_deflections, left) - at(&self.level_deflections, right) - contact.gap;
-            let previous = self.penetration[c];
-            self.penetration[c] = penetration;
+            let (penetration, previous) = (self.penetration[c], self.previous_penetration[c]);
             if penetration <= 0.0 {
-                self.contact_force[c] = 0.0;
-                if record {
-                    let stats = &mut self.statistics[c];
-                    stats.max_penetration = stats.max_penetration.max(penetration);
+                if previous > 0.0 {
+                    self.contact_force[c] = 0.0;
                 }
                 continue;
             }
+            let (left, right) = (self.contact_left[c], self.contact_right[c]);
+            let shape = &self.level_shapes[self.contact_level[c] * modes..][..modes];
             // Few contacts are closed at a time: their δ̇ = ψ·(ṽ_L − ṽ_R) costs less one by
             // one than a dense sweep of velocities over every level.
             let rate = if contact.damping > 0.0 {
-                let shape = &self.level_shapes[self.contact_level[c] * modes..][..modes];
                 let velocity = |pin: usize| -> f64 {
                     if pin == WALL {
                         return 0.0;
@@ -288,26 +317,22 @@ impl<'m> Integrator<'m> {
             let force = contact.force(penetration, rate);
             self.contact_force[c] = force;
             dissipation_power += (force - contact.stiffness * penetration) * rate;
-            if record {
+            if record && (contact.stiffness > 0.0 || contact.damping > 0.0) {
                 let stats = &mut self.statistics[c];
-                stats.max_penetration = stats.max_penetration.max(penetration);
-                if contact.stiffness > 0.0 || contact.damping > 0.0 {
-                    if previous <= 0.0 {
-                        stats.impacts += 1;
-                        if stats.first_impact_time.is_none() {
-                            stats.first_impact_time = Some(t - dt * penetration / (penetration - previous));
-                        }
+                if previous <= 0.0 {
+                    stats.impacts += 1;
+                    if stats.first_impact_time.is_none() {
+                        stats.first_impact_time = Some(t - dt * penetration / (penetration - previous));
                     }
-                    stats.contact_time += dt;
-                    stats.impulse += force * dt;
-                    if force > stats.max_force {
-                        stats.max_force = force;
-                        stats.max_force_time = t;
-                    }
+                }
+                stats.contact_time += dt;
+                stats.impulse += force * dt;
+                if force > stats.max_force {
+                    stats.max_force = force;
+                    stats.max_force_time = t;
                 }
             }
             if force != 0.0 {
-                let shape = &self.level_shapes[self.contact_level[c] * modes..][..modes];
                 for (i, s) in shape.iter().enumerate() {
                     if left != WALL {
                         self.force[i * stride + left] -= force * s;
@@ -360,7 +385,7 @@ impl<'m> Integrator<'m> {
             }
         }
         let contact_damping = self.contact_forces_and_statistics(t, true);
-        let base = self.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
+        let base = self.base_now;
         let stride = self.stride;
         let mut modal_damping = 0.0;
         let mut base_power = 0.0;
@@ -497,6 +522,9 @@ impl<'m> Integrator<'m> {
         self.energy.kinetic = 0.5 * self.v.iter().map(|v| v * v).sum::<f64>();
         self.energy.contact = self.contact_energy_now();
         self.energy.strain = self.mechanical_energy_now() - self.energy.kinetic - self.energy.contact;
+        for (stats, max) in self.statistics.iter_mut().zip(&self.max_penetration) {
+            stats.max_penetration = *max;
+        }
         Simulation {
             time_step: dt,
             critical_time_step: critical,
