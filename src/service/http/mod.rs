@@ -65,8 +65,9 @@ pub fn router(state: AppState, max_body_bytes: usize) -> Router {
         .route("/jobs/{jobId}/results", get(results::results))
         .route("/jobs/{jobId}/results/{output}", get(results::output))
         .fallback(not_found)
+        // Layers run outside-in from the last one added: trace and count every request,
+        // then turn any bare error below (timeout, panic, 405, 413) into a problem.
         .layer(DefaultBodyLimit::max(max_body_bytes))
-        .layer(middleware::map_response(problem_for_bare_errors))
         .layer(CatchPanicLayer::custom(|_panic| {
             tracing::error!("a request handler panicked");
             problem_response(&Problem::internal())
@@ -75,6 +76,7 @@ pub fn router(state: AppState, max_body_bytes: usize) -> Router {
             StatusCode::REQUEST_TIMEOUT,
             REQUEST_TIMEOUT,
         ))
+        .layer(middleware::map_response(problem_for_bare_errors))
         .layer(middleware::from_fn_with_state(state.clone(), track_request))
         .layer(
             TraceLayer::new_for_http()

@@ -1,7 +1,8 @@
 //! The OpenAPI document, generated from the handlers' annotations and the models.
 //!
-//! Committed as `openapi/openapi.json`; `tests/service_openapi.rs` fails when the
-//! committed file differs from [`json`] (run it with `UPDATE_OPENAPI=1` to rewrite it).
+//! Committed as `openapi/openapi.json`; a test (`tests/api/capabilities.rs`) fails when
+//! the committed file differs from [`json`]. Regenerate it with
+//! `UPDATE_OPENAPI=1 cargo test --test api openapi`.
 
 use utoipa::OpenApi;
 

@@ -3,7 +3,7 @@
 //! The computation gets its own OS thread, never a runtime thread, so the API answers
 //! while every worker computes. The supervising task wakes every `progress_interval` to
 //! copy progress into the row (only when the percent changed), renew the lease (every
-//! third of it), and check that the job is still ours (once a second: a dismissal or a
+//! third of it), and check that the job is still ours (twice a second: a dismissal or a
 //! lost lease sets the cancel flag, and the run stops at its next progress callback).
 //! The outcome is then written under the lease guard.
 
@@ -20,8 +20,9 @@ use crate::processes::{RunError, RunOutput};
 use crate::service::queue::{ClaimedJob, Lease};
 use crate::service::store;
 
-/// How often a running job checks, by a read, that its row still says it is ours.
-const OWNERSHIP_CHECK: Duration = Duration::from_secs(1);
+/// How often a running job checks, by a read, that its row still says it is ours (so a
+/// dismissal made through another API process stops it within about a second too).
+const OWNERSHIP_CHECK: Duration = Duration::from_millis(500);
 
 /// What the compute thread sends back: the run's result, or the panic message.
 type ThreadOutcome = Result<Result<RunOutput, RunError>, String>;
