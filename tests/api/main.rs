@@ -10,6 +10,7 @@ mod dismissal;
 mod errors;
 mod execution;
 mod listing;
+mod load;
 mod recovery;
 mod responsiveness;
 mod results;
