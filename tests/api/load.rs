@@ -27,7 +27,10 @@ async fn load_submission_latency_at_200_per_second_while_workers_are_busy() {
     let app = Arc::new(spawn_app_with(|config| config.workers = workers).await);
     let mut busy = Vec::new();
     for _ in 0..workers {
-        busy.push(app.submit(json!({"steps": 1000000, "step_ms": 0.1, "busy": true})).await);
+        busy.push(
+            app.submit(json!({"steps": 1000000, "step_ms": 0.1, "busy": true}))
+                .await,
+        );
     }
     for job in &busy {
         app.wait_for(job, &["running"], Duration::from_secs(5)).await;
@@ -83,7 +86,10 @@ async fn load_a_thousand_small_jobs_complete() {
         if done == jobs.len() {
             break;
         }
-        assert!(started.elapsed() < Duration::from_secs(300), "only {done} of 1000 jobs done");
+        assert!(
+            started.elapsed() < Duration::from_secs(300),
+            "only {done} of 1000 jobs done"
+        );
         tokio::time::sleep(Duration::from_millis(50)).await;
     }
     let total = started.elapsed();
