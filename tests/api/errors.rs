@@ -132,3 +132,23 @@ async fn bad_query_parameters_are_400_problems() {
         assert_problem(app.get(&path).await, StatusCode::BAD_REQUEST, "/invalid-query").await;
     }
 }
+
+#[tokio::test]
+async fn a_server_fault_is_a_500_problem_that_reveals_no_internals() {
+    let app = spawn_app().await;
+    // Make every database access fail.
+    app.queue.pool().close().await;
+    let problem = assert_problem(
+        app.get("/jobs").await,
+        StatusCode::INTERNAL_SERVER_ERROR,
+        "/internal",
+    )
+    .await;
+    let detail = problem["detail"].as_str().unwrap().to_lowercase();
+    assert!(
+        !detail.contains("pool") && !detail.contains("sqlite"),
+        "{problem}"
+    );
+    let health = app.get("/healthz").await;
+    assert_eq!(health.status(), StatusCode::SERVICE_UNAVAILABLE);
+}
