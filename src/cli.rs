@@ -3,6 +3,7 @@
 //! `chocmodal run <processId> <body.json | ->` runs one execution request in-process,
 //! with no server: the results document goes to stdout, invalid inputs give the same
 //! problem document as the HTTP API on stderr and exit status 2, a failed run exits 1.
+//! `chocmodal serve` runs the HTTP API and its workers (see [`crate::service`]).
 
 use std::io::Read;
 use std::ops::ControlFlow;
@@ -29,6 +30,8 @@ pub struct Cli {
 pub enum Command {
     /// Run one execution request in-process and print its results document.
     Run(RunArgs),
+    /// Serve the HTTP API and run jobs on an embedded SQLite database.
+    Serve(crate::service::ServeArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -50,6 +53,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Run(args) => run_command(&args, &Registry::builtin()),
+        Command::Serve(args) => crate::service::serve(&args, Registry::builtin()),
     }
 }
 

@@ -11,3 +11,5 @@ pub mod physics;
 pub mod problem;
 /// One module per process: JSON inputs (validated) → physics → results document + histories.
 pub mod processes;
+/// The HTTP service: OGC API – Processes, SQLite job queue, workers, results store.
+pub mod service;

@@ -83,6 +83,107 @@ impl Problem {
         )
     }
 
+    /// 404: no job with this id.
+    pub fn no_such_job(id: &str) -> Self {
+        Self::new(
+            format!("{OGC_EXCEPTIONS}/no-such-job"),
+            "No such job",
+            404,
+            format!("there is no job `{id}`"),
+        )
+    }
+
+    /// 404: the job has not finished yet (poll `/jobs/{id}` and retry).
+    pub fn result_not_ready(id: &str, status: &str) -> Self {
+        Self::new(
+            format!("{OGC_EXCEPTIONS}/result-not-ready"),
+            "Result not ready",
+            404,
+            format!("job `{id}` is {status}; its results are not ready yet"),
+        )
+    }
+
+    /// 404: the job finished without this output.
+    pub fn no_such_output(id: &str, output: &str) -> Self {
+        Self::new(
+            format!("{OGC_EXCEPTIONS}/no-such-output"),
+            "No such output",
+            404,
+            format!("job `{id}` has no output `{output}`"),
+        )
+    }
+
+    /// 404: the job was dismissed; it has no results.
+    pub fn job_dismissed(id: &str) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/job-dismissed"),
+            "Job dismissed",
+            404,
+            format!("job `{id}` was dismissed; it has no results"),
+        )
+    }
+
+    /// 422 (stored with a failed job): the computation failed deterministically
+    /// (divergence, ...); running it again with the same inputs fails again.
+    pub fn job_failed(detail: impl Into<String>) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/job-failed"),
+            "Job failed",
+            422,
+            detail,
+        )
+    }
+
+    /// 400: a query parameter is missing, unknown or out of range.
+    pub fn invalid_query(detail: impl Into<String>) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/invalid-query"),
+            "Invalid query parameter",
+            400,
+            detail,
+        )
+    }
+
+    /// 413: the request body is larger than the configured limit.
+    pub fn payload_too_large(detail: impl Into<String>) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/payload-too-large"),
+            "Request body too large",
+            413,
+            detail,
+        )
+    }
+
+    /// 415: the request body is not declared as JSON.
+    pub fn unsupported_media_type(detail: impl Into<String>) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/unsupported-media-type"),
+            "Unsupported media type",
+            415,
+            detail,
+        )
+    }
+
+    /// 500: something went wrong on the server; the details are in its log, not here.
+    pub fn internal() -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/internal"),
+            "Internal server error",
+            500,
+            "the server failed to handle this request; the incident is logged",
+        )
+    }
+
+    /// Any other HTTP error status, with its standard reason as title.
+    pub fn from_status(status: u16, title: &str, detail: impl Into<String>) -> Self {
+        let slug: String = title
+            .to_ascii_lowercase()
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+            .collect();
+        Self::new(format!("{CHOCMODAL_PROBLEMS}/{slug}"), title, status, detail)
+    }
+
     pub fn to_json_pretty(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_else(|_| self.detail.clone())
     }

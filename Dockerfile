@@ -1,0 +1,27 @@
+# chocmodal service image: `docker build -t chocmodal .` then
+# `docker run -p 8080:8080 -v chocmodal-data:/data chocmodal`
+FROM rust:1.95-bookworm AS build
+WORKDIR /src
+COPY Cargo.toml Cargo.lock ./
+COPY src src
+COPY migrations migrations
+RUN cargo build --release --locked --bin chocmodal
+
+FROM debian:bookworm-slim
+RUN apt-get update \
+    && apt-get install -y --no-install-recommends curl ca-certificates \
+    && rm -rf /var/lib/apt/lists/* \
+    && useradd --system --uid 10001 --home-dir /data chocmodal \
+    && mkdir -p /data && chown chocmodal /data
+COPY --from=build /src/target/release/chocmodal /usr/local/bin/chocmodal
+USER chocmodal
+ENV CHOCMODAL_BIND=0.0.0.0:8080 \
+    CHOCMODAL_DATA_DIR=/data \
+    CHOCMODAL_LOG_FORMAT=json
+VOLUME ["/data"]
+EXPOSE 8080
+HEALTHCHECK --interval=30s --timeout=3s --start-period=10s \
+    CMD curl -fsS http://127.0.0.1:8080/healthz || exit 1
+# SIGTERM starts a graceful shutdown: give running jobs their grace period.
+STOPSIGNAL SIGTERM
+ENTRYPOINT ["chocmodal", "serve"]

@@ -1,0 +1,67 @@
+//! The API's one error type and its rendering as RFC 9457 problem details.
+//!
+//! Handlers return `Result<_, ApiError>`. Client errors carry their [`Problem`] as is;
+//! server errors are logged with their cause and answered with a generic 500 problem
+//! that reveals nothing of the internals.
+
+use axum::http::{HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+
+use crate::problem::Problem;
+
+/// Media type of problem documents.
+pub const PROBLEM_JSON: &str = "application/problem+json";
+
+/// Why a request failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ApiError {
+    /// The problem's own status (4xx): shown to the client as is.
+    #[error("{}", .0.detail)]
+    Problem(Box<Problem>),
+    /// 500: the database failed; logged, hidden from the client.
+    #[error("database: {0}")]
+    Database(#[from] sqlx::Error),
+    /// 500: any other unexpected failure; logged, hidden from the client.
+    #[error("internal: {0}")]
+    Internal(String),
+}
+
+impl From<Problem> for ApiError {
+    fn from(problem: Problem) -> Self {
+        ApiError::Problem(Box::new(problem))
+    }
+}
+
+impl IntoResponse for ApiError {
+    fn into_response(self) -> Response {
+        match self {
+            ApiError::Problem(problem) => problem_response(&problem),
+            ApiError::Database(error) => {
+                tracing::error!(%error, "database error while handling a request");
+                problem_response(&Problem::internal())
+            }
+            ApiError::Internal(error) => {
+                tracing::error!(%error, "internal error while handling a request");
+                problem_response(&Problem::internal())
+            }
+        }
+    }
+}
+
+/// A problem document with its status and `application/problem+json`.
+pub fn problem_response(problem: &Problem) -> Response {
+    let status = StatusCode::from_u16(problem.status).unwrap_or(StatusCode::INTERNAL_SERVER_ERROR);
+    let body = serde_json::to_vec(problem).unwrap_or_default();
+    (
+        status,
+        [(header::CONTENT_TYPE, HeaderValue::from_static(PROBLEM_JSON))],
+        body,
+    )
+        .into_response()
+}
+
+impl IntoResponse for Problem {
+    fn into_response(self) -> Response {
+        problem_response(&self)
+    }
+}

@@ -1,0 +1,63 @@
+//! Extractors whose rejections are problem documents, not axum's plain-text defaults.
+
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
+use axum::extract::{FromRequest, FromRequestParts, Query, Request};
+use axum::http::request::Parts;
+use axum::http::{StatusCode, header};
+use serde::de::DeserializeOwned;
+
+use super::error::ApiError;
+use crate::cli::parse_envelope;
+use crate::problem::Problem;
+
+/// The `inputs` object of an execution request body `{"inputs": {...}}`.
+///
+/// Rejections: 413 over the body limit, 415 when the body is declared as something else
+/// than JSON, 400 when it is not JSON, 422 when it is not the expected envelope.
+#[derive(Debug)]
+pub struct ExecutionInputs(pub serde_json::Value);
+
+impl<S: Send + Sync> FromRequest<S> for ExecutionInputs {
+    type Rejection = ApiError;
+
+    async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
+        if let Some(content_type) = req.headers().get(header::CONTENT_TYPE) {
+            let content_type = content_type.to_str().unwrap_or_default().to_ascii_lowercase();
+            let essence = content_type.split(';').next().unwrap_or_default().trim();
+            if !(essence == "application/json" || essence.ends_with("+json")) {
+                return Err(Problem::unsupported_media_type(format!(
+                    "the execution request must be `application/json`, not `{essence}`"
+                ))
+                .into());
+            }
+        }
+        let bytes = Bytes::from_request(req, state).await.map_err(body_rejection)?;
+        let text = std::str::from_utf8(&bytes)
+            .map_err(|_| Problem::malformed_body("the body is not valid UTF-8"))?;
+        Ok(Self(parse_envelope(text)?))
+    }
+}
+
+fn body_rejection(rejection: BytesRejection) -> ApiError {
+    if rejection.status() == StatusCode::PAYLOAD_TOO_LARGE {
+        Problem::payload_too_large("the request body is larger than this server accepts").into()
+    } else {
+        Problem::malformed_body(format!("cannot read the request body: {rejection}")).into()
+    }
+}
+
+/// Query parameters parsed with serde; a bad value is a 400 problem.
+#[derive(Debug)]
+pub struct ApiQuery<T>(pub T);
+
+impl<T: DeserializeOwned, S: Send + Sync> FromRequestParts<S> for ApiQuery<T> {
+    type Rejection = ApiError;
+
+    async fn from_request_parts(parts: &mut Parts, state: &S) -> Result<Self, Self::Rejection> {
+        Query::<T>::from_request_parts(parts, state)
+            .await
+            .map(|Query(value)| Self(value))
+            .map_err(|rejection| Problem::invalid_query(rejection.body_text()).into())
+    }
+}

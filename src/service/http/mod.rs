@@ -1,0 +1,150 @@
+//! The HTTP API (OGC API – Processes): routes, shared state, and the layers every
+//! request goes through (tracing, metrics, body limit, timeout, panic catching, and the
+//! rewrite of any bare error response into a problem document).
+
+pub mod conditional;
+pub mod error;
+pub mod extract;
+pub mod jobs;
+pub mod landing;
+pub mod models;
+pub mod openapi;
+pub mod processes;
+pub mod results;
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use axum::Router;
+use axum::extract::{DefaultBodyLimit, MatchedPath, Request, State};
+use axum::http::{StatusCode, Uri, header};
+use axum::middleware::{self, Next};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use tokio::sync::Notify;
+use tower_http::catch_panic::CatchPanicLayer;
+use tower_http::timeout::TimeoutLayer;
+use tower_http::trace::{DefaultMakeSpan, DefaultOnResponse, TraceLayer};
+use tracing::Level;
+
+use super::metrics::Metrics;
+use super::queue::JobQueue;
+use super::worker::RunningJobs;
+use crate::problem::Problem;
+use crate::processes::Registry;
+use error::{PROBLEM_JSON, problem_response};
+
+/// What every handler can reach.
+#[derive(Debug, Clone)]
+pub struct AppState {
+    pub queue: JobQueue,
+    pub registry: Registry,
+    /// Jobs running in this instance (to cancel them at once on dismissal).
+    pub running: RunningJobs,
+    pub metrics: Metrics,
+    /// Wakes an idle worker when a job is queued.
+    pub wake: Arc<Notify>,
+}
+
+/// Longest time a request may take before a 408 problem.
+const REQUEST_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// The application's router with all its layers.
+pub fn router(state: AppState, max_body_bytes: usize) -> Router {
+    Router::new()
+        .route("/", get(landing::landing))
+        .route("/conformance", get(landing::conformance))
+        .route("/healthz", get(landing::healthz))
+        .route("/metrics", get(landing::metrics))
+        .route("/openapi.json", get(landing::openapi_document))
+        .route("/processes", get(processes::list))
+        .route("/processes/{processId}", get(processes::describe))
+        .route("/processes/{processId}/execution", post(processes::execute))
+        .route("/jobs", get(jobs::list))
+        .route("/jobs/{jobId}", get(jobs::status).delete(jobs::dismiss))
+        .route("/jobs/{jobId}/results", get(results::results))
+        .route("/jobs/{jobId}/results/{output}", get(results::output))
+        .fallback(not_found)
+        // Layers run outside-in from the last one added: trace and count every request,
+        // then turn any bare error below (timeout, panic, 405, 413) into a problem.
+        .layer(DefaultBodyLimit::max(max_body_bytes))
+        .layer(CatchPanicLayer::custom(|_panic| {
+            tracing::error!("a request handler panicked");
+            problem_response(&Problem::internal())
+        }))
+        .layer(TimeoutLayer::with_status_code(
+            StatusCode::REQUEST_TIMEOUT,
+            REQUEST_TIMEOUT,
+        ))
+        .layer(middleware::map_response(problem_for_bare_errors))
+        .layer(middleware::from_fn_with_state(state.clone(), track_request))
+        .layer(
+            TraceLayer::new_for_http()
+                .make_span_with(DefaultMakeSpan::new().level(Level::INFO))
+                .on_response(DefaultOnResponse::new().level(Level::INFO)),
+        )
+        .with_state(state)
+}
+
+/// Unknown routes: 404 problem.
+async fn not_found(uri: Uri) -> Response {
+    Problem::from_status(
+        404,
+        "Not Found",
+        format!("there is no resource at `{}`", uri.path()),
+    )
+    .into_response()
+}
+
+/// Turns error responses produced outside the handlers (405 from the method router,
+/// 413 from the body limit, 408 from the timeout, ...) into problem documents, keeping
+/// their status and headers (`Allow` on 405).
+async fn problem_for_bare_errors(response: Response) -> Response {
+    let status = response.status();
+    let is_problem = response
+        .headers()
+        .get(header::CONTENT_TYPE)
+        .is_some_and(|v| v.as_bytes().starts_with(PROBLEM_JSON.as_bytes()));
+    if !(status.is_client_error() || status.is_server_error()) || is_problem {
+        return response;
+    }
+    let title = status.canonical_reason().unwrap_or("Error");
+    let detail = match status {
+        StatusCode::METHOD_NOT_ALLOWED => {
+            "this resource does not support this method; see `Allow`".to_owned()
+        }
+        StatusCode::PAYLOAD_TOO_LARGE => "the request body is larger than this server accepts".to_owned(),
+        StatusCode::REQUEST_TIMEOUT => "the request took too long".to_owned(),
+        _ => title.to_lowercase(),
+    };
+    let problem = if status == StatusCode::PAYLOAD_TOO_LARGE {
+        Problem::payload_too_large(detail)
+    } else if status.is_server_error() {
+        Problem::internal()
+    } else {
+        Problem::from_status(status.as_u16(), title, detail)
+    };
+    let (mut parts, _) = response.into_parts();
+    let rendered = problem_response(&problem);
+    parts.headers.remove(header::CONTENT_LENGTH);
+    parts.headers.insert(
+        header::CONTENT_TYPE,
+        header::HeaderValue::from_static(PROBLEM_JSON),
+    );
+    Response::from_parts(parts, rendered.into_body())
+}
+
+/// Counts and times every request by method, route template and status.
+async fn track_request(State(state): State<AppState>, request: Request, next: Next) -> Response {
+    let method = request.method().to_string();
+    let route = request
+        .extensions()
+        .get::<MatchedPath>()
+        .map_or_else(|| "unmatched".to_owned(), |p| p.as_str().to_owned());
+    let started = Instant::now();
+    let response = next.run(request).await;
+    state
+        .metrics
+        .observe_request(&method, &route, response.status().as_u16(), started.elapsed());
+    response
+}

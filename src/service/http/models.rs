@@ -1,0 +1,207 @@
+//! The JSON documents of the API (OGC API – Processes shapes), with their OpenAPI schemas.
+
+use serde::Serialize;
+use utoipa::ToSchema;
+
+use crate::service::clock::rfc3339;
+use crate::service::queue::{JobRecord, JobStatus};
+
+/// A link to a related resource.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct Link {
+    /// Target, relative to the service root (e.g. `/jobs/7f3c...`).
+    pub href: String,
+    /// Relation type: `self`, `next`, `results`, `status`, `service-desc`, ...
+    pub rel: String,
+    /// Media type of the target.
+    #[serde(rename = "type", skip_serializing_if = "Option::is_none")]
+    pub media_type: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub title: Option<String>,
+}
+
+impl Link {
+    pub fn new(href: impl Into<String>, rel: &str, media_type: &str) -> Self {
+        Self {
+            href: href.into(),
+            rel: rel.to_owned(),
+            media_type: Some(media_type.to_owned()),
+            title: None,
+        }
+    }
+
+    pub fn titled(mut self, title: &str) -> Self {
+        self.title = Some(title.to_owned());
+        self
+    }
+}
+
+/// The state of one job (OGC `statusInfo`).
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct StatusInfo {
+    #[serde(rename = "jobID")]
+    pub job_id: String,
+    #[serde(rename = "processID")]
+    pub process_id: String,
+    /// Always `process`.
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    pub status: JobStatus,
+    /// Human-readable state, e.g. `queued`, `running`, `failed: <reason>`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub message: Option<String>,
+    /// Percent done (0–100).
+    #[schema(minimum = 0, maximum = 100)]
+    pub progress: u8,
+    /// When the job was submitted (RFC 3339, UTC).
+    pub created: String,
+    /// When its current (or last) run started (RFC 3339, UTC).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub started: Option<String>,
+    /// When it finished (RFC 3339, UTC).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finished: Option<String>,
+    /// Last change of status, progress or message (RFC 3339, UTC).
+    pub updated: String,
+    pub links: Vec<Link>,
+}
+
+impl StatusInfo {
+    pub fn from_record(job: &JobRecord) -> Self {
+        let href = format!("/jobs/{}", job.id);
+        let mut links = vec![Link::new(&href, "self", "application/json").titled("Job status")];
+        if job.status == JobStatus::Successful || job.status == JobStatus::Failed {
+            links.push(
+                Link::new(
+                    format!("{href}/results"),
+                    "http://www.opengis.net/def/rel/ogc/1.0/results",
+                    "application/json",
+                )
+                .titled("Job results"),
+            );
+        }
+        links.push(Link::new(
+            format!("/processes/{}", job.process_id),
+            "up",
+            "application/json",
+        ));
+        Self {
+            job_id: job.id.clone(),
+            process_id: job.process_id.clone(),
+            kind: "process",
+            status: job.status,
+            message: job.message.clone(),
+            progress: job.progress,
+            created: rfc3339(job.created_at),
+            started: job.started_at.map(rfc3339),
+            finished: job.finished_at.map(rfc3339),
+            updated: rfc3339(job.updated_at),
+            links,
+        }
+    }
+}
+
+/// A page of jobs, newest first; follow the `next` link for older ones.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct JobList {
+    pub jobs: Vec<StatusInfo>,
+    pub links: Vec<Link>,
+}
+
+/// A process as listed by `GET /processes`.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct ProcessSummary {
+    /// Identifier used in URLs, e.g. `cantilever-impact`.
+    pub id: String,
+    pub title: String,
+    pub description: String,
+    pub version: &'static str,
+    /// Always `["async-execute", "dismiss"]`: every execution is a job.
+    #[serde(rename = "jobControlOptions")]
+    pub job_control_options: Vec<&'static str>,
+    pub links: Vec<Link>,
+}
+
+/// The processes this service offers.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct ProcessList {
+    pub processes: Vec<ProcessSummary>,
+    pub links: Vec<Link>,
+}
+
+/// A process with its inputs and outputs (OGC process description).
+#[derive(Debug, Serialize, ToSchema)]
+pub struct ProcessDescription {
+    #[serde(flatten)]
+    pub summary: ProcessSummary,
+    /// `{name: {title, description, schema}}` for each input (JSON Schema, SI units).
+    #[schema(value_type = Object)]
+    pub inputs: serde_json::Value,
+    /// `{name: {title, description, schema}}` for each output.
+    #[schema(value_type = Object)]
+    pub outputs: serde_json::Value,
+}
+
+/// An execution request.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct ExecuteRequest {
+    /// The process inputs (see the process description).
+    #[schema(value_type = Object)]
+    pub inputs: serde_json::Value,
+}
+
+/// A results document: the process's summary figures plus `outputs` links to its
+/// histories, `{"outputs": {"tip_displacement": {"href": "/jobs/{id}/results/tip_displacement"}}}`.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct Results {
+    /// Links to the time histories, by output name.
+    #[schema(value_type = Object)]
+    pub outputs: serde_json::Value,
+}
+
+/// One named column of a history.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct Series {
+    /// Column name, e.g. `numerical`, `reference`, `c0`, `p1`.
+    pub name: String,
+    /// One value per sample, in the output's unit (m for displacements, N for forces).
+    pub values: Vec<f64>,
+}
+
+/// A time history (or a window of it, thinned on request) as JSON.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct HistoryDocument {
+    /// Output name, e.g. `tip_displacement`.
+    pub output: String,
+    /// Samples in this document.
+    pub points: usize,
+    /// Samples in the whole history.
+    pub total_points: usize,
+    /// Whether min/max thinning was applied (`max_points`).
+    pub thinned: bool,
+    /// Sample times (s), increasing.
+    pub time: Vec<f64>,
+    pub series: Vec<Series>,
+}
+
+/// The landing page.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct LandingPage {
+    pub title: &'static str,
+    pub description: &'static str,
+    pub links: Vec<Link>,
+}
+
+/// The conformance classes this service claims.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct Conformance {
+    #[serde(rename = "conformsTo")]
+    pub conforms_to: Vec<&'static str>,
+}
+
+/// Liveness.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct Health {
+    /// `ok` when the service answers and its database responds.
+    pub status: &'static str,
+}

@@ -1,0 +1,116 @@
+//! `/processes`: what can run, and execution (validate, then queue a job).
+
+use std::sync::Arc;
+
+use axum::Json;
+use axum::extract::{Path, State};
+use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+
+use super::AppState;
+use super::error::ApiError;
+use super::extract::ExecutionInputs;
+use super::models::{ExecuteRequest, Link, ProcessDescription, ProcessList, ProcessSummary, StatusInfo};
+use crate::problem::Problem;
+use crate::processes::Process;
+
+fn summary(process: &dyn Process) -> ProcessSummary {
+    let href = format!("/processes/{}", process.id());
+    ProcessSummary {
+        id: process.id().to_owned(),
+        title: process.title().to_owned(),
+        description: process.description().to_owned(),
+        version: env!("CARGO_PKG_VERSION"),
+        job_control_options: vec!["async-execute", "dismiss"],
+        links: vec![
+            Link::new(&href, "self", "application/json").titled("Process description"),
+            Link::new(
+                format!("{href}/execution"),
+                "http://www.opengis.net/def/rel/ogc/1.0/execute",
+                "application/json",
+            )
+            .titled("Execute (POST)"),
+        ],
+    }
+}
+
+/// List the processes
+#[utoipa::path(get, path = "/processes", operation_id = "getProcesses", tag = "Processes",
+    responses((status = 200, description = "Every process this service runs", body = ProcessList)))]
+pub async fn list(State(state): State<AppState>) -> Json<ProcessList> {
+    Json(ProcessList {
+        processes: state.registry.all().iter().map(|p| summary(p.as_ref())).collect(),
+        links: vec![Link::new("/processes", "self", "application/json")],
+    })
+}
+
+/// Describe a process
+///
+/// Its inputs (JSON Schema, with SI units in the descriptions) and outputs.
+#[utoipa::path(get, path = "/processes/{processId}", operation_id = "getProcessDescription", tag = "Processes",
+    params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`")),
+    responses(
+        (status = 200, description = "The process description", body = ProcessDescription),
+        (status = 404, description = "No such process (`no-such-process`)", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json")))]
+pub async fn describe(
+    State(state): State<AppState>,
+    Path(process_id): Path<String>,
+) -> Result<Json<ProcessDescription>, ApiError> {
+    let process = state
+        .registry
+        .get(&process_id)
+        .ok_or_else(|| Problem::no_such_process(&process_id))?;
+    Ok(Json(ProcessDescription {
+        summary: summary(process.as_ref()),
+        inputs: process.inputs_description(),
+        outputs: process.outputs_description(),
+    }))
+}
+
+/// Execute a process (asynchronously)
+///
+/// Validates the inputs and queues a job: `201 Created`, `Location: /jobs/{jobId}` and the
+/// job's status. Invalid inputs never reach a worker: 422 with one `errors` entry per
+/// field, each with a JSON pointer into the request body (`/inputs/beam/modes`).
+#[utoipa::path(post, path = "/processes/{processId}/execution", operation_id = "execute", tag = "Processes",
+    params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`")),
+    request_body(content = ExecuteRequest, description = "`{\"inputs\": {...}}`, see the process description"),
+    responses(
+        (status = 201, description = "Job queued", body = StatusInfo,
+            headers(("Location" = String, description = "`/jobs/{jobId}`"))),
+        (status = 400, description = "Malformed JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 404, description = "No such process", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 413, description = "Body over the size limit", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 415, description = "Body not declared as JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 422, description = "Invalid inputs, with `errors` pointers", body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
+pub async fn execute(
+    State(state): State<AppState>,
+    Path(process_id): Path<String>,
+    body: Result<ExecutionInputs, ApiError>,
+) -> Result<Response, ApiError> {
+    // An unknown process is reported before anything about the body.
+    let process = state
+        .registry
+        .get(&process_id)
+        .ok_or_else(|| Problem::no_such_process(&process_id))?;
+    let ExecutionInputs(inputs) = body?;
+    let inputs = Arc::new(inputs);
+    // Validation may expand generators and check large inputs: keep it off the runtime.
+    let validated = {
+        let inputs = inputs.clone();
+        tokio::task::spawn_blocking(move || process.validate(&inputs))
+            .await
+            .map_err(|e| ApiError::Internal(format!("validation panicked: {e}")))?
+    };
+    validated.map_err(|invalid| Problem::invalid_inputs(&invalid))?;
+    let job = state.queue.enqueue(&process_id, &inputs).await?;
+    state.wake.notify_one();
+    tracing::info!(job = %job.id, process = %process_id, "job queued");
+    let mut headers = HeaderMap::new();
+    headers.insert(
+        header::LOCATION,
+        HeaderValue::from_str(&format!("/jobs/{}", job.id)).expect("uuid is a valid header value"),
+    );
+    Ok((StatusCode::CREATED, headers, Json(StatusInfo::from_record(&job))).into_response())
+}

@@ -1,0 +1,204 @@
+//! `/jobs/{jobId}/results`: the results document, and each time history as CSV or JSON.
+
+use axum::extract::{Path, State};
+use axum::http::{HeaderMap, HeaderValue, header};
+use axum::response::Response;
+
+use super::AppState;
+use super::conditional::tagged;
+use super::error::ApiError;
+use super::extract::ApiQuery;
+use super::models::{HistoryDocument, Results, Series};
+use crate::problem::Problem;
+use crate::service::queue::JobStatus;
+use crate::service::queue::read::JobOutcome;
+use crate::service::{store, thinning};
+
+/// Query of `GET /jobs/{jobId}/results/{output}`.
+#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct HistoryQuery {
+    /// `csv` or `json` (default: JSON, or CSV when `Accept` prefers `text/csv`).
+    pub format: Option<String>,
+    /// Start of the window (s), inclusive.
+    pub t_start: Option<f64>,
+    /// End of the window (s), inclusive.
+    pub t_end: Option<f64>,
+    /// Thin the window to at most this many rows (at least 2 per series), keeping each
+    /// series' minimum and maximum of every bucket so that peaks survive.
+    pub max_points: Option<usize>,
+}
+
+/// Why a finished-or-not job has no results to show; `Ok` carries the outcome of a successful one.
+fn successful(job_id: &str, outcome: Option<JobOutcome>) -> Result<JobOutcome, ApiError> {
+    let outcome = outcome.ok_or_else(|| Problem::no_such_job(job_id))?;
+    match outcome.record.status {
+        JobStatus::Successful => Ok(outcome),
+        JobStatus::Accepted | JobStatus::Running => {
+            Err(Problem::result_not_ready(job_id, outcome.record.status.as_str()).into())
+        }
+        JobStatus::Dismissed => Err(Problem::job_dismissed(job_id).into()),
+        JobStatus::Failed => {
+            let problem = outcome
+                .error
+                .as_deref()
+                .and_then(|text| serde_json::from_str::<Problem>(text).ok())
+                .unwrap_or_else(|| Problem::job_failed("the job failed"));
+            Err(problem.into())
+        }
+    }
+}
+
+/// Retry-After on "not ready" answers, so pollers back off.
+fn with_retry_after(result: Result<Response, ApiError>) -> Result<Response, ApiError> {
+    match result {
+        Err(ApiError::Problem(problem)) if problem.kind.ends_with("/result-not-ready") => {
+            let mut response = axum::response::IntoResponse::into_response(ApiError::Problem(problem));
+            response
+                .headers_mut()
+                .insert(header::RETRY_AFTER, HeaderValue::from_static("1"));
+            Ok(response)
+        }
+        other => other,
+    }
+}
+
+/// A job's results
+///
+/// The results document of a successful job, with `outputs` links to its histories.
+/// Immutable once there: strong `ETag`, `304` on `If-None-Match`. A job not finished
+/// yet: 404 `result-not-ready` (with `Retry-After`); a failed job: its error as a problem.
+#[utoipa::path(get, path = "/jobs/{jobId}/results", operation_id = "getResult", tag = "Results",
+    params(("jobId" = String, Path, description = "Job id")),
+    responses(
+        (status = 200, description = "Results document (fields per process, see its description)", body = Results,
+            headers(("ETag" = String))),
+        (status = 304, description = "Unchanged since the `If-None-Match` tag"),
+        (status = 404, description = "No such job, job not finished (`result-not-ready`), or dismissed",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 422, description = "The job failed (`job-failed`, e.g. divergence)",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 500, description = "The job crashed or lost its worker too many times",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
+pub async fn results(
+    State(state): State<AppState>,
+    Path(job_id): Path<String>,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    with_retry_after(
+        async {
+            let outcome = successful(&job_id, state.queue.outcome(&job_id).await?)?;
+            let body = outcome.results.unwrap_or_else(|| "{}".into()).into_bytes();
+            Ok(tagged(&headers, "application/json", body, HeaderMap::new()))
+        }
+        .await,
+    )
+}
+
+/// One time history
+///
+/// CSV (`time,<series...>`, full precision) or JSON, optionally restricted to
+/// `t_start <= time <= t_end` (s) and thinned to `max_points` rows with min/max buckets.
+#[utoipa::path(get, path = "/jobs/{jobId}/results/{output}", operation_id = "getResultOutput", tag = "Results",
+    params(
+        ("jobId" = String, Path, description = "Job id"),
+        ("output" = String, Path, description = "Output name, e.g. `tip_displacement`"),
+        HistoryQuery,
+    ),
+    responses(
+        (status = 200, description = "The history (time in s; values in the output's unit)",
+            content(
+                (HistoryDocument = "application/json"),
+                (String = "text/csv")
+            ),
+            headers(("ETag" = String))),
+        (status = 304, description = "Unchanged since the `If-None-Match` tag"),
+        (status = 400, description = "Invalid query parameter", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json"),
+        (status = 404, description = "No such job or output, or results not ready", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json")))]
+pub async fn output(
+    State(state): State<AppState>,
+    Path((job_id, output)): Path<(String, String)>,
+    ApiQuery(query): ApiQuery<HistoryQuery>,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let csv = match query.format.as_deref() {
+        Some("csv") => true,
+        Some("json") => false,
+        Some(other) => {
+            return Err(
+                Problem::invalid_query(format!("`format` must be `csv` or `json`, not `{other}`")).into(),
+            );
+        }
+        None => prefers_csv(&headers),
+    };
+    for (name, value) in [("t_start", query.t_start), ("t_end", query.t_end)] {
+        if value.is_some_and(|t| !t.is_finite()) {
+            return Err(Problem::invalid_query(format!("`{name}` must be a finite number (s)")).into());
+        }
+    }
+    if query.max_points.is_some_and(|n| n < 2) {
+        return Err(Problem::invalid_query("`max_points` must be at least 2").into());
+    }
+    with_retry_after(
+        async {
+            successful(&job_id, state.queue.outcome(&job_id).await?)?;
+            let stored = state
+                .queue
+                .history(&job_id, &output)
+                .await?
+                .ok_or_else(|| Problem::no_such_output(&job_id, &output))?;
+            // Decompressing and thinning a long history is CPU work: keep it off the runtime.
+            let rendered = tokio::task::spawn_blocking(move || render(&stored, &query, csv))
+                .await
+                .map_err(|e| ApiError::Internal(format!("rendering a history panicked: {e}")))??;
+            let content_type = if csv {
+                "text/csv; charset=utf-8"
+            } else {
+                "application/json"
+            };
+            Ok(tagged(&headers, content_type, rendered, HeaderMap::new()))
+        }
+        .await,
+    )
+}
+
+fn render(stored: &store::StoredHistory, query: &HistoryQuery, csv: bool) -> Result<Vec<u8>, ApiError> {
+    let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
+    let selected = thinning::select(&history, query.t_start, query.t_end, query.max_points);
+    if csv {
+        return Ok(selected.to_csv().into_bytes());
+    }
+    let in_window = {
+        let t0 = query.t_start.unwrap_or(f64::NEG_INFINITY);
+        let t1 = query.t_end.unwrap_or(f64::INFINITY);
+        history.time.iter().filter(|t| (t0..=t1).contains(*t)).count()
+    };
+    let document = HistoryDocument {
+        output: selected.name,
+        points: selected.time.len(),
+        total_points: history.time.len(),
+        thinned: selected.time.len() < in_window,
+        time: selected.time,
+        series: selected
+            .series
+            .into_iter()
+            .map(|(name, values)| Series { name, values })
+            .collect(),
+    };
+    serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
+}
+
+fn prefers_csv(headers: &HeaderMap) -> bool {
+    let accept = headers
+        .get(header::ACCEPT)
+        .and_then(|v| v.to_str().ok())
+        .unwrap_or_default();
+    match (accept.find("text/csv"), accept.find("application/json")) {
+        (Some(c), Some(j)) => c < j,
+        (Some(_), None) => true,
+        _ => false,
+    }
+}

@@ -1,0 +1,49 @@
+//! Claim: a worker atomically takes the oldest accepted job and a lease on it.
+//!
+//! One `UPDATE ... WHERE seq = (SELECT ...) RETURNING` statement: SQLite takes the write
+//! lock before it reads, so two workers can never claim the same row, and nothing is
+//! held once the statement returns.
+
+use std::time::Duration;
+
+use sqlx::Row;
+
+use super::{ClaimedJob, JobQueue, Lease};
+use crate::service::clock::duration_ms;
+
+impl JobQueue {
+    /// Takes the oldest accepted job for `owner`, leased for `lease`; `None` if the queue is empty.
+    pub async fn claim(&self, owner: &str, lease: Duration) -> Result<Option<ClaimedJob>, sqlx::Error> {
+        let now = self.now();
+        let row = sqlx::query(
+            "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = ?1, \
+                 lease_expires_at = ?2, started_at = ?3, updated_at = ?3, progress = 0, message = 'running' \
+             WHERE seq = (SELECT seq FROM jobs WHERE status = 'accepted' ORDER BY seq LIMIT 1) \
+             RETURNING id, process_id, inputs, attempt, created_at",
+        )
+        .bind(owner)
+        .bind(now.saturating_add(duration_ms(lease)))
+        .bind(now)
+        .fetch_optional(&self.pool)
+        .await?;
+        let Some(row) = row else {
+            return Ok(None);
+        };
+        let inputs: String = row.try_get("inputs")?;
+        let inputs = serde_json::from_str(&inputs).map_err(|e| sqlx::Error::ColumnDecode {
+            index: "inputs".into(),
+            source: Box::new(e),
+        })?;
+        Ok(Some(ClaimedJob {
+            lease: Lease {
+                job_id: row.try_get("id")?,
+                owner: owner.to_owned(),
+                attempt: row.try_get("attempt")?,
+            },
+            process_id: row.try_get("process_id")?,
+            inputs,
+            created_at: row.try_get("created_at")?,
+            started_at: now,
+        }))
+    }
+}

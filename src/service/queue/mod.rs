@@ -1,0 +1,179 @@
+//! The durable job queue, one table in SQLite (`migrations/0001_jobs.sql`).
+//!
+//! Life of a job: `accepted` (enqueued) → `running` (claimed by a worker, under a lease
+//! that its heartbeat renews) → `successful` | `failed` | `dismissed`. Every write a
+//! worker makes after its claim is guarded by its [`Lease`] (owner and attempt), so a
+//! worker that lost its lease (it stalled, the job was dismissed, recovery re-queued it)
+//! can never overwrite the row. No transaction is held while a job computes: each step
+//! is one short statement. One operation per file:
+//!
+//! - [`enqueue`]: insert an accepted job;
+//! - [`claim`]: atomically take the oldest accepted job;
+//! - [`heartbeat`]: renew the lease, record progress, notice cancellation;
+//! - [`finish`]: successful, failed, or handed back to the queue;
+//! - [`dismiss`]: cancel a queued or running job, or drop a finished job's results;
+//! - [`recovery`]: re-queue (or fail) jobs whose lease expired;
+//! - [`retention`]: delete old finished jobs;
+//! - [`read`]: status, listing with keyset paging, results and histories.
+
+pub mod claim;
+pub mod dismiss;
+pub mod enqueue;
+pub mod finish;
+pub mod heartbeat;
+pub mod read;
+pub mod recovery;
+pub mod retention;
+
+use sqlx::SqlitePool;
+
+use super::clock::SharedClock;
+
+/// Status of a job (OGC API – Processes `statusCode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize, utoipa::ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum JobStatus {
+    /// Queued, waiting for a worker.
+    Accepted,
+    /// A worker is computing it.
+    Running,
+    /// Finished with results.
+    Successful,
+    /// Finished without results; see the results problem document.
+    Failed,
+    /// Cancelled by `DELETE /jobs/{jobId}`.
+    Dismissed,
+}
+
+impl JobStatus {
+    pub const ALL: [JobStatus; 5] = [
+        JobStatus::Accepted,
+        JobStatus::Running,
+        JobStatus::Successful,
+        JobStatus::Failed,
+        JobStatus::Dismissed,
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            JobStatus::Accepted => "accepted",
+            JobStatus::Running => "running",
+            JobStatus::Successful => "successful",
+            JobStatus::Failed => "failed",
+            JobStatus::Dismissed => "dismissed",
+        }
+    }
+
+    pub fn parse(text: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|s| s.as_str() == text)
+    }
+
+    /// True once the job will not change any more (but for dismissing its results).
+    pub fn is_finished(self) -> bool {
+        matches!(
+            self,
+            JobStatus::Successful | JobStatus::Failed | JobStatus::Dismissed
+        )
+    }
+}
+
+/// What the API shows of a job: everything but its inputs and results.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JobRecord {
+    /// Insertion order (keyset of the job list).
+    pub seq: i64,
+    pub id: String,
+    pub process_id: String,
+    pub status: JobStatus,
+    /// Percent done, 0..=100.
+    pub progress: u8,
+    pub message: Option<String>,
+    /// Times in ms since the Unix epoch.
+    pub created_at: i64,
+    pub started_at: Option<i64>,
+    pub finished_at: Option<i64>,
+    pub updated_at: i64,
+    /// Number of claims so far.
+    pub attempt: i64,
+}
+
+/// Columns of [`JobRecord`] for `SELECT` and `RETURNING` clauses (a literal, for `concat!`:
+/// queries are static strings).
+macro_rules! record_columns {
+    () => {
+        "seq, id, process_id, status, progress, message, created_at, started_at, finished_at, \
+         updated_at, attempt"
+    };
+}
+pub(crate) use record_columns;
+
+impl<'r> sqlx::FromRow<'r, sqlx::sqlite::SqliteRow> for JobRecord {
+    fn from_row(row: &'r sqlx::sqlite::SqliteRow) -> Result<Self, sqlx::Error> {
+        use sqlx::Row;
+        let status: String = row.try_get("status")?;
+        let progress: i64 = row.try_get("progress")?;
+        Ok(Self {
+            seq: row.try_get("seq")?,
+            id: row.try_get("id")?,
+            process_id: row.try_get("process_id")?,
+            status: JobStatus::parse(&status).ok_or_else(|| sqlx::Error::ColumnDecode {
+                index: "status".into(),
+                source: format!("unknown job status `{status}`").into(),
+            })?,
+            progress: progress.clamp(0, 100) as u8,
+            message: row.try_get("message")?,
+            created_at: row.try_get("created_at")?,
+            started_at: row.try_get("started_at")?,
+            finished_at: row.try_get("finished_at")?,
+            updated_at: row.try_get("updated_at")?,
+            attempt: row.try_get("attempt")?,
+        })
+    }
+}
+
+/// A worker's hold on a running job: every write after the claim is guarded by it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Lease {
+    pub job_id: String,
+    /// Unique per worker (and per service instance).
+    pub owner: String,
+    /// The claim number this lease belongs to.
+    pub attempt: i64,
+}
+
+/// A job a worker has just claimed.
+#[derive(Debug, Clone)]
+pub struct ClaimedJob {
+    pub lease: Lease,
+    pub process_id: String,
+    /// The validated `inputs` object.
+    pub inputs: serde_json::Value,
+    /// When it was enqueued and claimed (ms since the Unix epoch).
+    pub created_at: i64,
+    pub started_at: i64,
+}
+
+/// The queue: a database pool and the clock that stamps every write.
+#[derive(Debug, Clone)]
+pub struct JobQueue {
+    pool: SqlitePool,
+    clock: SharedClock,
+}
+
+impl JobQueue {
+    pub fn new(pool: SqlitePool, clock: SharedClock) -> Self {
+        Self { pool, clock }
+    }
+
+    pub fn pool(&self) -> &SqlitePool {
+        &self.pool
+    }
+
+    pub fn clock(&self) -> &SharedClock {
+        &self.clock
+    }
+
+    fn now(&self) -> i64 {
+        self.clock.now_ms()
+    }
+}

@@ -1,0 +1,124 @@
+//! Reads for the API: one job, the job list (keyset paging), results, histories, counts.
+
+use sqlx::Row;
+
+use super::{JobQueue, JobRecord, JobStatus, record_columns};
+use crate::service::store::StoredHistory;
+
+/// Filters of `GET /jobs`; an empty list means "any".
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct JobFilter {
+    pub statuses: Vec<JobStatus>,
+    pub process_ids: Vec<String>,
+}
+
+/// A job with what it produced: results document (successful) or problem (failed).
+#[derive(Debug, Clone)]
+pub struct JobOutcome {
+    pub record: JobRecord,
+    /// Results document (JSON text) of a successful job.
+    pub results: Option<String>,
+    /// Problem document (JSON text) of a failed job.
+    pub error: Option<String>,
+}
+
+impl JobQueue {
+    pub async fn get(&self, id: &str) -> Result<Option<JobRecord>, sqlx::Error> {
+        sqlx::query_as(concat!("SELECT ", record_columns!(), " FROM jobs WHERE id = ?1"))
+            .bind(id)
+            .fetch_optional(&self.pool)
+            .await
+    }
+
+    /// Up to `limit` jobs matching `filter`, newest first, strictly older than the job
+    /// with sequence number `before` when given (keyset paging: stable under inserts).
+    pub async fn list(
+        &self,
+        filter: &JobFilter,
+        limit: u32,
+        before: Option<i64>,
+    ) -> Result<Vec<JobRecord>, sqlx::Error> {
+        let statuses = (!filter.statuses.is_empty()).then(|| {
+            serde_json::to_string(&filter.statuses.iter().map(|s| s.as_str()).collect::<Vec<_>>())
+                .unwrap_or_default()
+        });
+        let process_ids = (!filter.process_ids.is_empty())
+            .then(|| serde_json::to_string(&filter.process_ids).unwrap_or_default());
+        sqlx::query_as(concat!(
+            "SELECT ",
+            record_columns!(),
+            " FROM jobs \
+             WHERE (?1 IS NULL OR status IN (SELECT value FROM json_each(?1))) \
+               AND (?2 IS NULL OR process_id IN (SELECT value FROM json_each(?2))) \
+               AND (?3 IS NULL OR seq < ?3) \
+             ORDER BY seq DESC LIMIT ?4"
+        ))
+        .bind(statuses)
+        .bind(process_ids)
+        .bind(before)
+        .bind(i64::from(limit))
+        .fetch_all(&self.pool)
+        .await
+    }
+
+    pub async fn outcome(&self, id: &str) -> Result<Option<JobOutcome>, sqlx::Error> {
+        let row = sqlx::query(concat!(
+            "SELECT ",
+            record_columns!(),
+            ", results, error FROM jobs WHERE id = ?1"
+        ))
+        .bind(id)
+        .fetch_optional(&self.pool)
+        .await?;
+        row.map(|row| {
+            Ok(JobOutcome {
+                record: sqlx::FromRow::from_row(&row)?,
+                results: row.try_get("results")?,
+                error: row.try_get("error")?,
+            })
+        })
+        .transpose()
+    }
+
+    /// The stored history `name` of job `id`.
+    pub async fn history(&self, id: &str, name: &str) -> Result<Option<StoredHistory>, sqlx::Error> {
+        let row = sqlx::query(
+            "SELECT name, series, samples, data FROM job_histories WHERE job_id = ?1 AND name = ?2",
+        )
+        .bind(id)
+        .bind(name)
+        .fetch_optional(&self.pool)
+        .await?;
+        row.map(|row| {
+            let series: String = row.try_get("series")?;
+            let samples: i64 = row.try_get("samples")?;
+            Ok(StoredHistory {
+                name: row.try_get("name")?,
+                series: serde_json::from_str(&series).map_err(|e| sqlx::Error::ColumnDecode {
+                    index: "series".into(),
+                    source: Box::new(e),
+                })?,
+                samples: usize::try_from(samples).unwrap_or(0),
+                data: row.try_get("data")?,
+            })
+        })
+        .transpose()
+    }
+
+    /// Number of jobs in each status (every status present, zeros included).
+    pub async fn count_by_status(&self) -> Result<Vec<(JobStatus, i64)>, sqlx::Error> {
+        let rows: Vec<(String, i64)> = sqlx::query_as("SELECT status, COUNT(*) FROM jobs GROUP BY status")
+            .fetch_all(&self.pool)
+            .await?;
+        Ok(JobStatus::ALL
+            .into_iter()
+            .map(|status| {
+                let count = rows
+                    .iter()
+                    .find(|(s, _)| s == status.as_str())
+                    .map_or(0, |(_, n)| *n);
+                (status, count)
+            })
+            .collect())
+    }
+}

@@ -1,0 +1,129 @@
+//! Windows and peak-keeping thinning of time histories for `GET /jobs/{id}/results/{output}`.
+//!
+//! Thinning by taking every k-th sample would miss the short contact-force spikes that
+//! matter most. Instead the window is cut into equal buckets of consecutive samples and
+//! each bucket keeps, for every series, the samples holding its minimum and its maximum,
+//! in time order (the "min/max" decimation used by plotting tools). Every extreme of every
+//! series in the window therefore survives. With k series a bucket keeps at most 2k
+//! samples, so `max_points / (2k)` buckets (at least one) give at most `max_points` rows
+//! when `max_points >= 2k`.
+
+use crate::processes::History;
+
+/// The part of `history` with `t_start <= time <= t_end` (either bound optional),
+/// thinned to about `max_points` rows when it has more.
+pub fn select(
+    history: &History,
+    t_start: Option<f64>,
+    t_end: Option<f64>,
+    max_points: Option<usize>,
+) -> History {
+    let first = t_start.map_or(0, |t| history.time.partition_point(|&x| x < t));
+    let end = t_end.map_or(history.time.len(), |t| history.time.partition_point(|&x| x <= t));
+    let end = end.max(first);
+    let rows: Vec<usize> = match max_points {
+        Some(max) if end - first > max => peak_rows(history, first, end, max),
+        _ => (first..end).collect(),
+    };
+    History {
+        name: history.name.clone(),
+        time: rows.iter().map(|&i| history.time[i]).collect(),
+        series: history
+            .series
+            .iter()
+            .map(|(name, values)| (name.clone(), rows.iter().map(|&i| values[i]).collect()))
+            .collect(),
+    }
+}
+
+/// Row indices in `first..end` keeping each series' min and max per bucket, ascending.
+fn peak_rows(history: &History, first: usize, end: usize, max_points: usize) -> Vec<usize> {
+    let per_bucket = 2 * history.series.len().max(1);
+    let buckets = (max_points / per_bucket).max(1);
+    let len = end - first;
+    let mut rows = Vec::with_capacity(buckets * per_bucket);
+    for b in 0..buckets {
+        let lo = first + b * len / buckets;
+        let hi = first + (b + 1) * len / buckets;
+        if lo >= hi {
+            continue;
+        }
+        let start = rows.len();
+        if history.series.is_empty() {
+            rows.extend([lo, hi - 1]);
+        }
+        for (_, values) in &history.series {
+            let (mut min_at, mut max_at) = (lo, lo);
+            for i in lo..hi {
+                // NaN never wins a comparison, so it is never picked as an extreme.
+                if values[i] < values[min_at] || values[min_at].is_nan() {
+                    min_at = i;
+                }
+                if values[i] > values[max_at] || values[max_at].is_nan() {
+                    max_at = i;
+                }
+            }
+            rows.extend([min_at, max_at]);
+        }
+        rows[start..].sort_unstable();
+        let mut kept = start;
+        for i in start..rows.len() {
+            if i == start || rows[i] != rows[kept - 1] {
+                rows[kept] = rows[i];
+                kept += 1;
+            }
+        }
+        rows.truncate(kept);
+    }
+    rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spiky(samples: usize) -> History {
+        let time: Vec<f64> = (0..samples).map(|i| i as f64).collect();
+        let mut force: Vec<f64> = time.iter().map(|t| (t * 0.01).sin()).collect();
+        // One-sample impact spikes, off any bucket boundary.
+        force[samples * 43 / 100 + 1] = 50.0;
+        force[samples * 7 / 100 + 3] = -20.0;
+        History {
+            name: "contact_force".into(),
+            series: vec![("numerical".into(), force)],
+            time,
+        }
+    }
+
+    #[test]
+    fn thinning_keeps_every_extreme_and_the_time_order() {
+        let history = spiky(10_000);
+        let thin = select(&history, None, None, Some(100));
+        assert!(thin.time.len() <= 100, "{} rows", thin.time.len());
+        assert!(thin.time.windows(2).all(|w| w[0] < w[1]));
+        let values = &thin.series[0].1;
+        assert!(values.contains(&50.0) && values.contains(&-20.0));
+    }
+
+    #[test]
+    fn a_window_keeps_the_samples_between_its_bounds_inclusive() {
+        let history = spiky(100);
+        let window = select(&history, Some(10.0), Some(20.0), None);
+        assert_eq!(window.time.first(), Some(&10.0));
+        assert_eq!(window.time.last(), Some(&20.0));
+        assert_eq!(window.time.len(), 11);
+    }
+
+    #[test]
+    fn short_windows_are_not_thinned() {
+        let history = spiky(1_000);
+        let window = select(&history, Some(0.0), Some(49.0), Some(100));
+        assert_eq!(window.time.len(), 50);
+    }
+
+    #[test]
+    fn an_inverted_window_is_empty() {
+        let history = spiky(100);
+        assert!(select(&history, Some(50.0), Some(10.0), None).time.is_empty());
+    }
+}

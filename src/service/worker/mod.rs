@@ -1,0 +1,129 @@
+//! Workers: `N` slots that claim jobs from the queue and run them, plus the periodic
+//! maintenance (lease recovery, retention) of the queue.
+//!
+//! Each slot is a small async loop: claim the oldest accepted job, run it (see [`run`]),
+//! repeat; when the queue is empty, sleep until an enqueue wakes it or the poll interval
+//! passes. Shutdown happens in two steps: stop claiming, wait for the running jobs up to
+//! a grace period; then cancel what still runs and hand it back to the queue.
+
+pub mod control;
+mod maintenance;
+mod run;
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use tokio::sync::{Notify, watch};
+use tokio::task::JoinSet;
+
+pub use control::{RunControl, RunningJobs};
+pub use maintenance::Maintenance;
+
+use super::metrics::Metrics;
+use super::queue::JobQueue;
+use crate::processes::Registry;
+
+/// What every worker slot shares.
+#[derive(Debug)]
+pub struct WorkerContext {
+    pub queue: JobQueue,
+    pub registry: Registry,
+    pub running: RunningJobs,
+    pub metrics: Metrics,
+    /// Notified on every enqueue, so idle workers start at once.
+    pub wake: Arc<Notify>,
+    /// Lease of a running job.
+    pub lease: Duration,
+    /// Idle workers look for work at least this often.
+    pub poll_interval: Duration,
+    /// Period of progress and cancellation checks of a running job.
+    pub progress_interval: Duration,
+}
+
+/// The running worker slots.
+#[derive(Debug)]
+pub struct Workers {
+    tasks: JoinSet<()>,
+    stop_claiming: watch::Sender<bool>,
+    hand_back: watch::Sender<bool>,
+}
+
+impl Workers {
+    /// Starts `count` worker slots, each leasing jobs under its own owner id.
+    pub fn start(context: Arc<WorkerContext>, count: usize) -> Self {
+        let (stop_claiming, stop_rx) = watch::channel(false);
+        let (hand_back, hand_back_rx) = watch::channel(false);
+        let instance = uuid::Uuid::new_v4();
+        let mut tasks = JoinSet::new();
+        for slot in 0..count {
+            let owner = format!("{instance}/{slot}");
+            tasks.spawn(worker_loop(
+                context.clone(),
+                owner,
+                stop_rx.clone(),
+                hand_back_rx.clone(),
+            ));
+        }
+        Self {
+            tasks,
+            stop_claiming,
+            hand_back,
+        }
+    }
+
+    /// Stops claiming, lets running jobs finish within `grace`, then cancels the rest
+    /// and hands them back to the queue (waiting a few more seconds for them to stop).
+    pub async fn shutdown(mut self, grace: Duration) {
+        let _ = self.stop_claiming.send(true);
+        let finished = tokio::time::timeout(grace, drain(&mut self.tasks)).await.is_ok();
+        if finished {
+            return;
+        }
+        tracing::warn!("running jobs did not finish within the grace period; handing them back");
+        let _ = self.hand_back.send(true);
+        if tokio::time::timeout(Duration::from_secs(10), drain(&mut self.tasks))
+            .await
+            .is_err()
+        {
+            tracing::error!(
+                "some jobs ignore cancellation; their leases will expire and recovery will re-queue them"
+            );
+            self.tasks.abort_all();
+        }
+    }
+}
+
+async fn drain(tasks: &mut JoinSet<()>) {
+    while tasks.join_next().await.is_some() {}
+}
+
+async fn worker_loop(
+    ctx: Arc<WorkerContext>,
+    owner: String,
+    mut stop: watch::Receiver<bool>,
+    hand_back: watch::Receiver<bool>,
+) {
+    loop {
+        if *stop.borrow() {
+            break;
+        }
+        // Register for wake-ups before looking, so an enqueue right after an empty
+        // claim is not missed.
+        let wake = ctx.wake.notified();
+        tokio::pin!(wake);
+        wake.as_mut().enable();
+        match ctx.queue.claim(&owner, ctx.lease).await {
+            Ok(Some(job)) => {
+                run::run_job(&ctx, job, hand_back.clone()).await;
+                continue;
+            }
+            Ok(None) => {}
+            Err(error) => tracing::error!(%error, worker = %owner, "claiming a job failed"),
+        }
+        tokio::select! {
+            _ = &mut wake => {}
+            _ = tokio::time::sleep(ctx.poll_interval) => {}
+            changed = stop.changed() => if changed.is_err() { break },
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! Running one claimed job: compute on a dedicated thread, supervise from the runtime.
+//!
+//! The computation gets its own OS thread, never a runtime thread, so the API answers
+//! while every worker computes. The supervising task wakes every `progress_interval` to
+//! copy progress into the row (only when the percent changed), renew the lease (every
+//! third of it), and check that the job is still ours (twice a second: a dismissal or a
+//! lost lease sets the cancel flag, and the run stops at its next progress callback).
+//! The outcome is then written under the lease guard.
+
+use std::ops::ControlFlow;
+use std::panic::AssertUnwindSafe;
+use std::time::{Duration, Instant};
+
+use tokio::sync::{oneshot, watch};
+
+use super::WorkerContext;
+use crate::cli::document_with_outputs;
+use crate::problem::{CHOCMODAL_PROBLEMS, Problem};
+use crate::processes::{RunError, RunOutput};
+use crate::service::queue::{ClaimedJob, Lease};
+use crate::service::store;
+
+/// How often a running job checks, by a read, that its row still says it is ours (so a
+/// dismissal made through another API process stops it within about a second too).
+const OWNERSHIP_CHECK: Duration = Duration::from_millis(500);
+
+/// What the compute thread sends back: the run's result, or the panic message.
+type ThreadOutcome = Result<Result<RunOutput, RunError>, String>;
+
+pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back: watch::Receiver<bool>) {
+    let lease = job.lease.clone();
+    let process_id = job.process_id.clone();
+    let wait_ms = (job.started_at - job.created_at).max(0) as u64;
+    ctx.metrics
+        .observe_queue_wait(&process_id, Duration::from_millis(wait_ms));
+    let Some(process) = ctx.registry.get(&process_id) else {
+        let problem = Problem::job_failed(format!("this service no longer offers process `{process_id}`"));
+        record(&lease, "fail", ctx.queue.fail(&lease, &problem).await);
+        return;
+    };
+    tracing::info!(job = %lease.job_id, process = %process_id, attempt = lease.attempt, "job started");
+    let started = Instant::now();
+    let control = ctx.running.insert(&lease.job_id);
+
+    let (sender, mut receiver) = oneshot::channel::<ThreadOutcome>();
+    let thread_control = control.clone();
+    let inputs = job.inputs;
+    let spawned = std::thread::Builder::new()
+        .name(format!("job-{}", &lease.job_id[..8.min(lease.job_id.len())]))
+        .spawn(move || {
+            let mut progress = |fraction: f64| {
+                thread_control.set_fraction(fraction);
+                if thread_control.is_cancelled() {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            };
+            let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| process.run(&inputs, &mut progress)))
+                .map_err(|payload| panic_message(payload.as_ref()));
+            let _ = sender.send(outcome);
+        });
+    if let Err(error) = spawned {
+        tracing::error!(%error, "cannot start a compute thread; handing the job back");
+        ctx.running.remove(&lease.job_id);
+        record(&lease, "hand back", ctx.queue.hand_back(&lease).await);
+        return;
+    }
+
+    let mut ticker = tokio::time::interval(ctx.progress_interval);
+    ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    let renew_every = ctx.lease / 3;
+    let (mut reported, mut renewed, mut checked) = (0u8, Instant::now(), Instant::now());
+    let mut lost = false;
+    let mut handing_back = *hand_back.borrow();
+    if handing_back {
+        control.cancel();
+    }
+    let outcome = loop {
+        tokio::select! {
+            outcome = &mut receiver => break outcome.unwrap_or_else(|_| Err("the compute thread vanished".into())),
+            changed = hand_back.changed(), if !handing_back => {
+                if changed.is_err() || *hand_back.borrow() {
+                    handing_back = true;
+                    control.cancel();
+                }
+            }
+            _ = ticker.tick(), if !lost => {
+                let percent = control.percent();
+                let held = if percent != reported || renewed.elapsed() >= renew_every {
+                    let progress = (percent != reported).then_some(percent);
+                    let held = ctx.queue.heartbeat(&lease, progress, ctx.lease).await;
+                    if matches!(held, Ok(true)) {
+                        reported = percent;
+                        renewed = Instant::now();
+                    }
+                    held
+                } else if checked.elapsed() >= OWNERSHIP_CHECK {
+                    checked = Instant::now();
+                    ctx.queue.is_held(&lease).await
+                } else {
+                    Ok(true)
+                };
+                match held {
+                    Ok(true) => {}
+                    Ok(false) => {
+                        tracing::info!(job = %lease.job_id, "job dismissed or lease lost: stopping it");
+                        lost = true;
+                        control.cancel();
+                    }
+                    Err(error) => tracing::warn!(job = %lease.job_id, %error, "heartbeat failed"),
+                }
+            }
+        }
+    };
+    ctx.running.remove(&lease.job_id);
+    let outcome_label = finish(ctx, &lease, outcome, lost, handing_back).await;
+    ctx.metrics
+        .observe_job(&process_id, outcome_label, started.elapsed());
+    tracing::info!(job = %lease.job_id, outcome = outcome_label, seconds = started.elapsed().as_secs_f64(), "job ended");
+}
+
+/// Writes the outcome of a run under its lease; returns the outcome's metric label.
+async fn finish(
+    ctx: &WorkerContext,
+    lease: &Lease,
+    outcome: ThreadOutcome,
+    lost: bool,
+    handing_back: bool,
+) -> &'static str {
+    match outcome {
+        Ok(Ok(_)) | Ok(Err(_)) if lost => "lost",
+        Ok(Ok(output)) => {
+            let job_id = lease.job_id.clone();
+            // Compressing long histories is CPU work: keep it off the runtime threads.
+            let stored = tokio::task::spawn_blocking(move || {
+                let histories = output
+                    .histories
+                    .iter()
+                    .map(store::encode)
+                    .collect::<Result<Vec<_>, _>>()?;
+                let document = document_with_outputs(output, |name| format!("/jobs/{job_id}/results/{name}"));
+                Ok::<_, store::HistoryError>((document, histories))
+            })
+            .await;
+            match stored {
+                Ok(Ok((document, histories))) => {
+                    record(
+                        lease,
+                        "complete",
+                        ctx.queue.complete(lease, &document, &histories).await,
+                    );
+                    "successful"
+                }
+                Ok(Err(error)) => {
+                    tracing::error!(job = %lease.job_id, %error, "the process returned an unusable history");
+                    record(lease, "fail", ctx.queue.fail(lease, &crashed_problem()).await);
+                    "crashed"
+                }
+                Err(error) => {
+                    tracing::error!(job = %lease.job_id, %error, "storing the results panicked");
+                    record(lease, "fail", ctx.queue.fail(lease, &crashed_problem()).await);
+                    "crashed"
+                }
+            }
+        }
+        Ok(Err(RunError::Cancelled)) if handing_back => {
+            record(lease, "hand back", ctx.queue.hand_back(lease).await);
+            "handed_back"
+        }
+        // Stopped by a dismissal the supervisor has not noticed yet: the row says so already.
+        Ok(Err(RunError::Cancelled)) => "dismissed",
+        Ok(Err(RunError::Failed(reason))) => {
+            record(
+                lease,
+                "fail",
+                ctx.queue.fail(lease, &Problem::job_failed(reason)).await,
+            );
+            "failed"
+        }
+        Ok(Err(RunError::Invalid(invalid))) => {
+            let problem = Problem::invalid_inputs(&invalid);
+            record(lease, "fail", ctx.queue.fail(lease, &problem).await);
+            "failed"
+        }
+        Err(panic) => {
+            tracing::error!(job = %lease.job_id, panic = %panic, "the process panicked");
+            record(lease, "fail", ctx.queue.fail(lease, &crashed_problem()).await);
+            "crashed"
+        }
+    }
+}
+
+/// The problem stored for a job whose process crashed: no internals, they are logged.
+fn crashed_problem() -> Problem {
+    Problem::new(
+        format!("{CHOCMODAL_PROBLEMS}/job-crashed"),
+        "Job crashed",
+        500,
+        "the computation crashed (a bug in chocmodal); the incident is logged",
+    )
+}
+
+fn record(lease: &Lease, what: &str, result: Result<bool, sqlx::Error>) {
+    match result {
+        Ok(true) => {}
+        Ok(false) => tracing::info!(job = %lease.job_id, "{what}: the lease was lost; nothing written"),
+        Err(error) => tracing::error!(job = %lease.job_id, %error, "{what}: database error"),
+    }
+}
+
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "non-string panic payload".to_owned())
+}

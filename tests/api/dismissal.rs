@@ -1,0 +1,89 @@
+//! `DELETE /jobs/{id}`: a queued job never runs, a running job stops within a second,
+//! a finished job loses its results.
+
+use std::time::{Duration, Instant};
+
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use crate::helpers::{assert_problem, spawn_app, spawn_app_with};
+
+#[tokio::test]
+async fn a_dismissed_queued_job_never_runs() {
+    let app = spawn_app_with(|config| config.workers = 0).await;
+    let job = app.submit(json!({"steps": 3})).await;
+    let response = app.delete(&format!("/jobs/{job}")).await;
+    assert_eq!(response.status(), StatusCode::OK);
+    let status: Value = response.json().await.unwrap();
+    assert_eq!(status["status"], "dismissed");
+    assert!(status["finished"].is_string());
+    let claimed = app
+        .queue
+        .claim("a-worker", Duration::from_secs(30))
+        .await
+        .unwrap();
+    assert!(claimed.is_none(), "a dismissed job cannot be claimed");
+    assert_eq!(app.status(&job).await["status"], "dismissed");
+    assert_eq!(app.probe.started(), 0);
+}
+
+#[tokio::test]
+async fn a_dismissed_running_job_stops_within_a_second() {
+    let app = spawn_app().await;
+    // 100 000 steps of 1 ms: minutes of work unless cancelled.
+    let job = app.submit(json!({"steps": 100000, "step_ms": 1})).await;
+    app.wait_for(&job, &["running"], Duration::from_secs(5)).await;
+    tokio::time::sleep(Duration::from_millis(100)).await;
+    let dismissed_at = Instant::now();
+    let response = app.delete(&format!("/jobs/{job}")).await;
+    assert_eq!(response.status(), StatusCode::OK);
+    let status: Value = response.json().await.unwrap();
+    assert_eq!(status["status"], "dismissed");
+    loop {
+        if let Some(stopped_at) = *app.probe.cancelled_at.lock().unwrap() {
+            let took = stopped_at.saturating_duration_since(dismissed_at);
+            assert!(took < Duration::from_secs(1), "stopped after {took:?}");
+            break;
+        }
+        assert!(
+            dismissed_at.elapsed() < Duration::from_secs(1),
+            "the run did not stop within a second"
+        );
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    let status = app.status(&job).await;
+    assert_eq!(
+        status["status"], "dismissed",
+        "the stopped worker does not overwrite the dismissal"
+    );
+    assert_problem(
+        app.get(&format!("/jobs/{job}/results")).await,
+        StatusCode::NOT_FOUND,
+        "/job-dismissed",
+    )
+    .await;
+    let next = app.submit(json!({"steps": 2})).await;
+    assert_eq!(
+        app.wait_until_finished(&next).await["status"],
+        "successful",
+        "the worker is free again"
+    );
+}
+
+#[tokio::test]
+async fn dismissing_a_finished_job_deletes_its_results() {
+    let app = spawn_app().await;
+    let job = app.submit(json!({"steps": 10})).await;
+    app.wait_until_finished(&job).await;
+    assert_eq!(app.delete(&format!("/jobs/{job}")).await.status(), StatusCode::OK);
+    assert_problem(
+        app.get(&format!("/jobs/{job}/results/signal")).await,
+        StatusCode::NOT_FOUND,
+        "/job-dismissed",
+    )
+    .await;
+    assert!(app.queue.history(&job, "signal").await.unwrap().is_none());
+    let again = app.delete(&format!("/jobs/{job}")).await;
+    assert_eq!(again.status(), StatusCode::OK, "dismissing twice is harmless");
+}

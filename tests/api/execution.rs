@@ -1,0 +1,95 @@
+//! Submitting jobs: 201 + Location + statusInfo, progress, concurrency.
+
+use std::time::Duration;
+
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use crate::helpers::{spawn_app, spawn_app_with};
+
+#[tokio::test]
+async fn execution_returns_201_with_location_and_the_job_status() {
+    let app = spawn_app_with(|config| config.workers = 0).await;
+    let response = app
+        .post_execution("count-steps", &json!({"inputs": {"steps": 3}}))
+        .await;
+    assert_eq!(response.status(), StatusCode::CREATED);
+    let location = response.headers()["location"].to_str().unwrap().to_owned();
+    let status: Value = response.json().await.unwrap();
+    let job = status["jobID"].as_str().unwrap();
+    assert_eq!(location, format!("/jobs/{job}"));
+    assert_eq!(status["processID"], "count-steps");
+    assert_eq!(status["type"], "process");
+    assert_eq!(status["status"], "accepted");
+    assert_eq!(status["progress"], 0);
+    assert!(status["created"].as_str().unwrap().ends_with('Z'));
+    assert_eq!(status["links"][0]["href"], location);
+    assert_eq!(app.status(job).await["status"], "accepted");
+}
+
+#[tokio::test]
+async fn progress_is_reported_while_a_job_runs() {
+    let app = spawn_app().await;
+    let job = app.submit(json!({"steps": 100, "step_ms": 15})).await;
+    let mut seen = Vec::new();
+    loop {
+        let status = app.status(&job).await;
+        let progress = status["progress"].as_u64().unwrap();
+        if status["status"] == "successful" {
+            assert_eq!(progress, 100);
+            break;
+        }
+        seen.push(progress);
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    assert!(
+        seen.iter().any(|p| (1..100).contains(p)),
+        "no intermediate progress seen: {seen:?}"
+    );
+    assert!(
+        seen.windows(2).all(|w| w[0] <= w[1]),
+        "progress went backwards: {seen:?}"
+    );
+}
+
+#[tokio::test]
+async fn two_hundred_concurrent_submissions_all_land() {
+    let app = std::sync::Arc::new(spawn_app_with(|config| config.workers = 0).await);
+    let mut tasks = tokio::task::JoinSet::new();
+    for _ in 0..20 {
+        let app = app.clone();
+        tasks.spawn(async move {
+            let mut statuses = Vec::new();
+            for _ in 0..10 {
+                let response = app
+                    .post_execution("count-steps", &json!({"inputs": {"steps": 1}}))
+                    .await;
+                statuses.push(response.status());
+            }
+            statuses
+        });
+    }
+    let mut created = 0;
+    while let Some(statuses) = tasks.join_next().await {
+        for status in statuses.unwrap() {
+            assert_eq!(status, StatusCode::CREATED);
+            created += 1;
+        }
+    }
+    assert_eq!(created, 200);
+    let jobs = app.get_json("/jobs?limit=1000").await;
+    assert_eq!(jobs["jobs"].as_array().unwrap().len(), 200);
+}
+
+#[tokio::test]
+async fn queued_jobs_run_oldest_first() {
+    let app = spawn_app_with(|config| config.workers = 1).await;
+    let mut jobs = Vec::new();
+    for steps in [11, 12, 13, 14] {
+        jobs.push(app.submit(json!({"steps": steps, "step_ms": 2})).await);
+    }
+    for job in &jobs {
+        assert_eq!(app.wait_until_finished(job).await["status"], "successful");
+    }
+    assert_eq!(*app.probe.runs.lock().unwrap(), vec![11, 12, 13, 14]);
+}

@@ -1,0 +1,16 @@
+//! Service tests: each starts a real server on an ephemeral port with a fresh SQLite
+//! database and talks to it over HTTP, with a small test process (`counting`).
+
+mod counting;
+mod helpers;
+
+mod capabilities;
+mod database;
+mod dismissal;
+mod errors;
+mod execution;
+mod listing;
+mod load;
+mod recovery;
+mod responsiveness;
+mod results;
