@@ -9,7 +9,7 @@ use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
 use super::inputs::{self, at};
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput};
 use crate::physics::contact::Contact;
-use crate::physics::integrate::{Model, Settings, SimulationError, resolve_time_step, simulate};
+use crate::physics::integrate::{Model, Settings, SimulationError, resolve_time_step, simulate_resolved};
 use crate::physics::modal::ModalBasis;
 
 /// Most pins in one row.
@@ -23,6 +23,8 @@ pub const DEFAULT_OUTPUT_INTERVAL: f64 = 1e-4;
 
 #[derive(Debug)]
 struct Prepared {
+    /// (time step, critical step) (s), resolved once.
+    steps: (f64, f64),
     inputs: BundleInputs,
     pins: usize,
     contacts: Vec<Contact>,
@@ -203,20 +205,21 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
         output_interval: Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
         output_heights: heights,
     };
-    let prepared = Prepared {
+    let mut prepared = Prepared {
+        steps: (0.0, 0.0),
         inputs,
         pins,
         contacts,
         basis,
         settings,
     };
-    check_costs(&prepared)?;
+    prepared.steps = check_costs(&prepared)?;
     Ok(prepared)
 }
 
-fn check_costs(prepared: &Prepared) -> Result<(), InvalidInputs> {
+fn check_costs(prepared: &Prepared) -> Result<(f64, f64), InvalidInputs> {
     let model = prepared.model();
-    let (dt, _) = resolve_time_step(&model, &prepared.settings)
+    let (dt, critical) = resolve_time_step(&model, &prepared.settings)
         .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())]))?;
     let duration = prepared.settings.duration;
     let steps = duration / dt;
@@ -243,7 +246,7 @@ fn check_costs(prepared: &Prepared) -> Result<(), InvalidInputs> {
         ));
     }
     if errors.is_empty() {
-        Ok(())
+        Ok((dt, critical))
     } else {
         Err(InvalidInputs(errors))
     }
@@ -289,10 +292,11 @@ impl Process for BundleDynamics {
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
         let prepared = prepare(inputs)?;
         let model = prepared.model();
-        let simulation = simulate(&model, &prepared.settings, progress).map_err(|e| match e {
-            SimulationError::Cancelled => RunError::Cancelled,
-            other => RunError::Failed(other.to_string()),
-        })?;
+        let simulation =
+            simulate_resolved(&model, &prepared.settings, prepared.steps, progress).map_err(|e| match e {
+                SimulationError::Cancelled => RunError::Cancelled,
+                other => RunError::Failed(other.to_string()),
+            })?;
 
         let contacts: Vec<serde_json::Value> = prepared
             .contacts

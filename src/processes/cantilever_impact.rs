@@ -11,7 +11,7 @@ use super::inputs::{self, BeamInput, SchemeInput, SupportInput, TimeStepInput, a
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
-use crate::physics::integrate::{Model, Settings, SimulationError, resolve_time_step, simulate};
+use crate::physics::integrate::{Model, Settings, SimulationError, resolve_time_step, simulate_resolved};
 use crate::physics::modal::ModalBasis;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
@@ -137,6 +137,8 @@ pub struct OutputInput {
 /// Validated inputs, ready to run.
 #[derive(Debug)]
 struct Prepared {
+    /// (time step, critical step) (s), resolved once.
+    steps: (f64, f64),
     inputs: CantileverInputs,
     basis: ModalBasis,
     contact_stiffness: f64,
@@ -259,21 +261,22 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
         modes: inputs.reference.modes,
         max_events: 100_000,
     };
-    let prepared = Prepared {
+    let mut prepared = Prepared {
+        steps: (0.0, 0.0),
         inputs,
         basis,
         contact_stiffness,
         settings,
         reference,
     };
-    check_costs(&prepared)?;
+    prepared.steps = check_costs(&prepared)?;
     Ok(prepared)
 }
 
 /// Refuses steps above the critical one, histories too long, references too costly.
-fn check_costs(prepared: &Prepared) -> Result<(), InvalidInputs> {
+fn check_costs(prepared: &Prepared) -> Result<(f64, f64), InvalidInputs> {
     let model = prepared.model();
-    let (dt, _) = resolve_time_step(&model, &prepared.settings).map_err(|e| match e {
+    let (dt, critical) = resolve_time_step(&model, &prepared.settings).map_err(|e| match e {
         SimulationError::TimeStepAboveCritical { .. } => {
             InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())])
         }
@@ -314,7 +317,7 @@ fn check_costs(prepared: &Prepared) -> Result<(), InvalidInputs> {
         ));
     }
     if errors.is_empty() {
-        Ok(())
+        Ok((dt, critical))
     } else {
         Err(InvalidInputs(errors))
     }
@@ -363,11 +366,16 @@ impl Process for CantileverImpact {
         let prepared = prepare(inputs)?;
         let model = prepared.model();
         let mut numerical_progress = |fraction: f64| progress(0.9 * fraction);
-        let simulation =
-            simulate(&model, &prepared.settings, &mut numerical_progress).map_err(|e| match e {
-                SimulationError::Cancelled => RunError::Cancelled,
-                other => RunError::Failed(other.to_string()),
-            })?;
+        let simulation = simulate_resolved(
+            &model,
+            &prepared.settings,
+            prepared.steps,
+            &mut numerical_progress,
+        )
+        .map_err(|e| match e {
+            SimulationError::Cancelled => RunError::Cancelled,
+            other => RunError::Failed(other.to_string()),
+        })?;
         let solution = prepared
             .reference
             .solve(&mut |fraction| progress(0.9 + 0.1 * fraction))

@@ -162,6 +162,23 @@ fn simulate_unchecked(
     integrate_with_step(model, settings, dt, f64::NAN, &mut |_| ControlFlow::Continue(()))
 }
 
+/// Integrates with a step already resolved by [`resolve_time_step`] (`dt`, `critical`):
+/// callers that validated the step first need not solve the stability eigenproblem twice.
+pub fn simulate_resolved(
+    model: &Model<'_>,
+    settings: &Settings,
+    (dt, critical): (f64, f64),
+    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+) -> Result<Simulation, SimulationError> {
+    if dt > critical * (1.0 + 1e-12) {
+        return Err(SimulationError::TimeStepAboveCritical {
+            time_step: dt,
+            critical_time_step: critical,
+        });
+    }
+    integrate_with_step(model, settings, dt, critical, progress)
+}
+
 fn integrate_with_step(
     model: &Model<'_>,
     settings: &Settings,

@@ -122,6 +122,26 @@ fn sweep(shapes: &[f64], modes: usize, coordinates: &[f64], stride: usize, out: 
     }
 }
 
+/// Σᵢ shape[i] · values[i·stride + offset] with four partial sums (one running sum
+/// chains every addition's latency and defeats vectorization).
+#[inline(always)]
+fn strided_dot(shape: &[f64], values: &[f64], stride: usize, offset: usize) -> f64 {
+    let mut acc = [0.0; 4];
+    let mut blocks = shape.chunks_exact(4);
+    let mut row = offset;
+    for block in &mut blocks {
+        for (partial, s) in acc.iter_mut().zip(block) {
+            *partial += s * values[row];
+            row += stride;
+        }
+    }
+    for (partial, s) in acc.iter_mut().zip(blocks.remainder()) {
+        *partial += s * values[row];
+        row += stride;
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3])
+}
+
 impl<'m> Integrator<'m> {
     pub(super) fn new(model: &'m Model<'m>, settings: &Settings, dt: f64, critical: f64) -> Self {
         let basis = model.basis;
@@ -304,11 +324,7 @@ impl<'m> Integrator<'m> {
                     if pin == WALL {
                         return 0.0;
                     }
-                    shape
-                        .iter()
-                        .zip(self.predicted_velocity[pin..].iter().step_by(stride))
-                        .map(|(s, v)| s * v)
-                        .sum()
+                    strided_dot(shape, &self.predicted_velocity, stride, pin)
                 };
                 velocity(left) - velocity(right)
             } else {
@@ -333,12 +349,14 @@ impl<'m> Integrator<'m> {
                 }
             }
             if force != 0.0 {
-                for (i, s) in shape.iter().enumerate() {
-                    if left != WALL {
-                        self.force[i * stride + left] -= force * s;
-                    }
-                    if right != WALL {
-                        self.force[i * stride + right] += force * s;
+                // Row by row on a hoisted slice: indexing `self.force` per mode reloads the
+                // vector through `self` at every store.
+                let loads = self.force.as_mut_slice();
+                for (pin, sign) in [(left, -force), (right, force)] {
+                    if pin != WALL {
+                        for (row, s) in loads.chunks_exact_mut(stride).zip(shape) {
+                            row[pin] += sign * s;
+                        }
                     }
                 }
             }
@@ -398,26 +416,31 @@ impl<'m> Integrator<'m> {
                 &mut self.a[rows.clone()],
                 &self.force[rows],
             );
-            let (mut sum_v, mut sum_v2) = (0.0, 0.0);
             match self.scheme {
                 Scheme::CentralDifference => {
                     let factor = self.implicit_damping_factor[i];
-                    for k in 0..stride {
-                        let acceleration = (f[k] - stiffness * q[k] - damping * v[k]) * factor;
-                        a[k] = acceleration;
-                        v[k] += half * acceleration;
-                        sum_v += v[k];
-                        sum_v2 += v[k] * v[k];
+                    for (((a, v), q), f) in a.iter_mut().zip(v.iter_mut()).zip(q).zip(f) {
+                        *a = (f - stiffness * q - damping * *v) * factor;
+                        *v += half * *a;
                     }
                 }
                 Scheme::Tchamwa { .. } => {
-                    for k in 0..stride {
-                        a[k] = f[k] - stiffness * q[k] - damping * v[k];
-                        sum_v += v[k];
-                        sum_v2 += v[k] * v[k];
+                    for (((a, v), q), f) in a.iter_mut().zip(v.iter()).zip(q).zip(f) {
+                        *a = f - stiffness * q - damping * v;
                     }
                 }
             }
+            // Power sums in a separate pass with one accumulator per lane: a running
+            // scalar sum inside the update would keep it from vectorizing.
+            let (mut lanes_v, mut lanes_v2) = ([0.0; LANES], [0.0; LANES]);
+            for block in v.chunks_exact(LANES) {
+                for lane in 0..LANES {
+                    lanes_v[lane] += block[lane];
+                    lanes_v2[lane] += block[lane] * block[lane];
+                }
+            }
+            let sum_v: f64 = lanes_v.iter().sum();
+            let sum_v2: f64 = lanes_v2.iter().sum();
             modal_damping += damping * sum_v2;
             base_power -= self.participation[i] * base * sum_v;
         }
