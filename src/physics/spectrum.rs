@@ -65,7 +65,7 @@ fn one_sided_power(signal: &[f64], scale: f64) -> Vec<f64> {
         .iter()
         .enumerate()
         .map(|(k, z)| {
-            let doubled = k != 0 && !(n % 2 == 0 && k == half);
+            let doubled = k != 0 && !(n.is_multiple_of(2) && k == half);
             z.norm_sqr() * if doubled { 2.0 } else { 1.0 }
         })
         .collect()

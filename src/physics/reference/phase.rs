@@ -136,7 +136,7 @@ impl<'a> TipWalker<'a> {
     /// w(L) (m) at the current sample, then moves to the next one.
     pub fn next_tip(&mut self) -> f64 {
         let tau = self.tau();
-        if self.index % RESEED_INTERVAL == 0 {
+        if self.index.is_multiple_of(RESEED_INTERVAL) {
             self.reseed(tau);
         }
         let mut sum = self.phase.tip_offset + self.current_re.iter().sum::<f64>();

@@ -300,10 +300,10 @@ impl LowestMinima {
     fn offer(&mut self, value: f64, index: usize) {
         if self.entries.len() < REFINED_MINIMA {
             self.entries.push((value, index));
-        } else if let Some(worst) = self.entries.iter_mut().max_by(|x, y| x.0.total_cmp(&y.0)) {
-            if value < worst.0 {
-                *worst = (value, index);
-            }
+        } else if let Some(worst) = self.entries.iter_mut().max_by(|x, y| x.0.total_cmp(&y.0))
+            && value < worst.0
+        {
+            *worst = (value, index);
         }
     }
 
