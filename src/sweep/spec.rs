@@ -316,6 +316,13 @@ pub fn parse(body: &Value, max_runs: usize) -> Result<SweepSpec, SweepError> {
     Ok(spec)
 }
 
+/// `value` rounded to 15 significant digits: inner `linspace`/`logspace` values read
+/// as written (10, not 9.999999999999998; 0.3, not 0.30000000000000004), and are the
+/// same on every platform whatever the last bit of its `powf`.
+fn significant(value: f64) -> f64 {
+    format!("{value:.14e}").parse().unwrap_or(value)
+}
+
 fn parse_axis(axis: &Value, index: usize, inputs: &Value, errors: &mut Vec<FieldError>) -> Option<Axis> {
     let at = |member: &str| format!("/axes/{index}{member}");
     let Some(object) = axis.as_object() else {
@@ -418,8 +425,8 @@ fn parse_axis(axis: &Value, index: usize, inputs: &Value, errors: &mut Vec<Field
                     let value = match (i, logarithmic) {
                         (0, _) => start,
                         (i, _) if i == count - 1 => stop,
-                        (_, false) => start + (stop - start) * fraction,
-                        (_, true) => start * (stop / start).powf(fraction),
+                        (_, false) => significant(start + (stop - start) * fraction),
+                        (_, true) => significant(start * (stop / start).powf(fraction)),
                     };
                     axis.number(value)
                 })

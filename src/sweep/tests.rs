@@ -44,9 +44,10 @@ fn logspace_spaces_values_geometrically_with_exact_ends() {
         .collect();
     assert_eq!(values[0], 0.1);
     assert_eq!(values[3], 100.0);
-    assert!(
-        (values[1] - 1.0).abs() < 1e-12 && (values[2] - 10.0).abs() < 1e-12,
-        "{values:?}"
+    assert_eq!(
+        values,
+        [0.1, 1.0, 10.0, 100.0],
+        "inner values rounded to 15 significant digits"
     );
 }
 

@@ -489,3 +489,72 @@ async fn a_calibration_grid_maps_validity_shrinking_as_rk_and_time_step_grow() {
     let problem = assert_problem(problem, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
     assert_eq!(problem["errors"][0]["pointer"], "/inputs/solver/time_step");
 }
+
+#[tokio::test]
+async fn sweeps_are_listed_newest_first_with_paging_and_unknown_ones_are_404() {
+    let app = spawn_app().await;
+    let mut ids = Vec::new();
+    for steps in [1, 2, 3] {
+        ids.push(
+            app.create_sweep(sweep(
+                json!({"steps": 1}),
+                json!([{"pointer": "/steps", "values": [steps]}]),
+            ))
+            .await,
+        );
+    }
+    let first = app.get_json("/sweeps?limit=2").await;
+    let listed: Vec<&str> = first["sweeps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["sweepID"].as_str().unwrap())
+        .collect();
+    assert_eq!(listed, [ids[2].as_str(), ids[1].as_str()]);
+    let next = first["links"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|l| l["rel"] == "next")
+        .expect("a next link");
+    let second = app.get_json(next["href"].as_str().unwrap()).await;
+    assert_eq!(second["sweeps"][0]["sweepID"], ids[0].as_str());
+    assert!(
+        second["links"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|l| l["rel"] != "next")
+    );
+
+    assert_problem(
+        app.get("/sweeps/nope").await,
+        StatusCode::NOT_FOUND,
+        "/no-such-sweep",
+    )
+    .await;
+    assert_problem(
+        app.get("/sweeps/nope/results").await,
+        StatusCode::NOT_FOUND,
+        "/no-such-sweep",
+    )
+    .await;
+    assert_problem(
+        app.delete("/sweeps/nope").await,
+        StatusCode::NOT_FOUND,
+        "/no-such-sweep",
+    )
+    .await;
+    assert_problem(
+        app.get("/sweeps?limit=0").await,
+        StatusCode::BAD_REQUEST,
+        "/invalid-query",
+    )
+    .await;
+    assert_problem(
+        app.get(&format!("/sweeps/{}/results?format=xml", ids[0])).await,
+        StatusCode::BAD_REQUEST,
+        "/invalid-query",
+    )
+    .await;
+}
