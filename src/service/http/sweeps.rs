@@ -123,9 +123,11 @@ fn expand_and_validate(spec: &SweepSpec, process: &dyn Process) -> Result<Vec<Ne
             .collect();
         handles
             .into_iter()
-            .flat_map(|h| h.join().unwrap_or_default())
-            .collect()
-    });
+            .map(|h| h.join())
+            .collect::<Result<Vec<_>, _>>()
+            .map(|chunks| chunks.into_iter().flatten().collect())
+    })
+    .map_err(|_| ApiError::Internal("a process's validation panicked".into()))?;
     if failures.is_empty() || spec.invalid_runs == InvalidRuns::Record {
         let mut failures = failures.into_iter().collect::<std::collections::HashMap<_, _>>();
         return Ok(runs
