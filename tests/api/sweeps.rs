@@ -5,6 +5,7 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use chocmodal::processes::bundle_dynamics::BundleDynamics;
 use chocmodal::processes::cantilever_impact::CantileverImpact;
 use reqwest::StatusCode;
 use serde_json::{Value, json};
@@ -557,4 +558,51 @@ async fn sweeps_are_listed_newest_first_with_paging_and_unknown_ones_are_404() {
         "/invalid-query",
     )
     .await;
+}
+
+/// Random gap states on a small real bundle: the seed of the gap generator is the
+/// random axis (integers, since the base holds one), and every run's table row carries
+/// the peak force overall and per contact, with statistics over the campaign.
+#[tokio::test]
+async fn a_random_gap_campaign_tabulates_peak_forces_per_contact() {
+    let app = spawn_app_with_processes(vec![Arc::new(BundleDynamics)], |_| {}).await;
+    let mut body: Value = serde_json::from_str(include_str!("../../examples/sweep-gaps.json")).unwrap();
+    body["samples"] = json!(3);
+    body["inputs"]["solver"]["duration"] = json!(0.02);
+    let id = app.create_sweep(body).await;
+    app.wait_for_sweep(&id, &["successful"], Duration::from_secs(120))
+        .await;
+    let results = app.sweep_results(&id).await;
+    let columns: Vec<&str> = results["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap())
+        .collect();
+    for expected in [
+        "/bundle/gaps/seed",
+        "max_contact_force.force",
+        "impacts",
+        "contacts.0.max_force",
+        "contacts.7.max_force",
+    ] {
+        assert!(columns.contains(&expected), "{expected} missing from {columns:?}");
+    }
+    let rows = results["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3);
+    for row in rows {
+        assert!(row["/bundle/gaps/seed"].is_u64(), "seeds are integers: {row}");
+        let peak = row["max_contact_force.force"].as_f64().unwrap();
+        let largest = (0..8)
+            .map(|k| row[format!("contacts.{k}.max_force")].as_f64().unwrap())
+            .fold(0.0, f64::max);
+        assert_eq!(
+            peak, largest,
+            "the overall peak is the largest contact peak: {row}"
+        );
+    }
+    let force = &results["aggregates"]["statistics"][0]["metrics"]["max_contact_force.force"];
+    assert_eq!(force["count"], 3, "{force}");
+    assert!(force["min"].as_f64().unwrap() <= force["q50"].as_f64().unwrap());
+    assert!(force["q50"].as_f64().unwrap() <= force["max"].as_f64().unwrap());
 }
