@@ -8,6 +8,9 @@ use crate::service::clock::rfc3339;
 use crate::service::queue::SweepRecord;
 use crate::service::queue::sweep_read::SweepCounts;
 
+/// Link relation of results (OGC API – Processes).
+const RESULTS_REL: &str = "http://www.opengis.net/def/rel/ogc/1.0/results";
+
 /// Status of a sweep.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
@@ -87,12 +90,16 @@ impl SweepStatus {
         let href = format!("/sweeps/{}", record.id);
         let links = vec![
             Link::new(&href, "self", "application/json").titled("Sweep status"),
-            Link::new(format!("{href}/results"), "results", "application/json")
+            Link::new(format!("{href}/results"), RESULTS_REL, "application/json")
                 .titled("Results table and aggregates"),
-            Link::new(format!("{href}/results?format=csv"), "results", "text/csv")
+            Link::new(format!("{href}/results?format=csv"), RESULTS_REL, "text/csv")
                 .titled("Results table as CSV"),
-            Link::new(format!("/jobs?sweepID={}", record.id), "jobs", "application/json")
-                .titled("The runs, as jobs"),
+            Link::new(
+                format!("/jobs?sweepID={}", record.id),
+                "http://www.opengis.net/def/rel/ogc/1.0/job-list",
+                "application/json",
+            )
+            .titled("The runs, as jobs"),
             Link::new(
                 format!("/processes/{}", record.process_id),
                 "up",
