@@ -13,3 +13,5 @@ pub mod problem;
 pub mod processes;
 /// The HTTP service: OGC API – Processes, SQLite job queue, workers, results store.
 pub mod service;
+/// Sweeps: expansion of axes into runs, results tables and aggregates (pure).
+pub mod sweep;

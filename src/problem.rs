@@ -134,6 +134,34 @@ impl Problem {
         )
     }
 
+    /// 404: no sweep with this id.
+    pub fn no_such_sweep(id: &str) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/no-such-sweep"),
+            "No such sweep",
+            404,
+            format!("there is no sweep `{id}`"),
+        )
+    }
+
+    /// 422: the sweep would expand into more runs than this service accepts at once.
+    pub fn sweep_too_large(runs: u128, limit: usize) -> Self {
+        Self {
+            errors: vec![FieldError::new(
+                "/axes",
+                format!(
+                    "the axes and samples make {runs} runs; this service accepts at most {limit} per sweep"
+                ),
+            )],
+            ..Self::new(
+                format!("{CHOCMODAL_PROBLEMS}/sweep-too-large"),
+                "Sweep too large",
+                422,
+                format!("the sweep has {runs} runs, more than the limit of {limit} (`--max-sweep-runs`)"),
+            )
+        }
+    }
+
     /// 400: a query parameter is missing, unknown or out of range.
     pub fn invalid_query(detail: impl Into<String>) -> Self {
         Self::new(

@@ -289,6 +289,10 @@ impl Process for BundleDynamics {
         prepare(inputs).map(|_| ())
     }
 
+    fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
+        bundle_metrics(document)
+    }
+
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
         let prepared = prepare(inputs)?;
         let model = prepared.model();
@@ -357,6 +361,28 @@ impl Process for BundleDynamics {
             histories: histories(&prepared, simulation),
         })
     }
+}
+
+/// Sweep columns: the scalars of the document, plus the peak force of each contact
+/// (`contacts.<k>.max_force`, N) and the largest deflection of each pin
+/// (`pins.<p>.max_abs_deflection`, m).
+fn bundle_metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
+    let mut metrics = crate::sweep::table::flatten_scalars(document);
+    let entries = |list: &str, field: &str| {
+        document[list]
+            .as_array()
+            .map(|items| {
+                items
+                    .iter()
+                    .enumerate()
+                    .map(|(k, item)| (format!("{list}.{k}.{field}"), item[field].clone()))
+                    .collect::<Vec<_>>()
+            })
+            .unwrap_or_default()
+    };
+    metrics.extend(entries("contacts", "max_force"));
+    metrics.extend(entries("pins", "max_abs_deflection"));
+    metrics
 }
 
 fn histories(prepared: &Prepared, simulation: crate::physics::integrate::Simulation) -> Vec<History> {

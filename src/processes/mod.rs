@@ -120,6 +120,13 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     fn validate(&self, inputs: &serde_json::Value) -> Result<(), InvalidInputs>;
     /// Runs the computation on inputs that passed [`Process::validate`].
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError>;
+    /// The scalar results of a results document as `(dotted.name, value)` pairs: the
+    /// metric columns of a sweep's results table. Default: the numbers and booleans of
+    /// nested objects ([`crate::sweep::table::flatten_scalars`]); a process adds entries
+    /// of its arrays worth a column.
+    fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
+        crate::sweep::table::flatten_scalars(document)
+    }
 }
 
 /// The processes this build offers, looked up by id.

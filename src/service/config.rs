@@ -44,6 +44,9 @@ pub struct ServeArgs {
     /// On SIGTERM/ctrl-c, how long running jobs may take to finish (s) before they are handed back to the queue.
     #[arg(long, env = "CHOCMODAL_SHUTDOWN_GRACE_SECONDS", default_value_t = 30)]
     pub shutdown_grace_seconds: u64,
+    /// Most runs one sweep may expand into; larger sweeps are refused (422).
+    #[arg(long, env = "CHOCMODAL_MAX_SWEEP_RUNS", default_value_t = DEFAULT_MAX_SWEEP_RUNS)]
+    pub max_sweep_runs: usize,
     /// Log format on stderr.
     #[arg(long, env = "CHOCMODAL_LOG_FORMAT", value_enum, default_value = "human")]
     pub log_format: LogFormat,
@@ -74,9 +77,14 @@ pub struct ServiceConfig {
     pub poll_interval: Duration,
     /// Period at which a running job's progress and cancel flag are synchronised with its row.
     pub progress_interval: Duration,
+    /// Most runs one sweep may expand into.
+    pub max_sweep_runs: usize,
     /// The queue's clock.
     pub clock: SharedClock,
 }
+
+/// Default limit of runs per sweep.
+pub const DEFAULT_MAX_SWEEP_RUNS: usize = 10_000;
 
 /// Default number of workers: the cores available to this process.
 pub fn default_workers() -> usize {
@@ -98,6 +106,7 @@ impl ServiceConfig {
             maintenance_interval: Duration::from_secs(15),
             poll_interval: Duration::from_millis(500),
             progress_interval: Duration::from_millis(250),
+            max_sweep_runs: DEFAULT_MAX_SWEEP_RUNS,
             clock: Arc::new(SystemClock),
         }
     }
@@ -119,6 +128,7 @@ impl From<&ServeArgs> for ServiceConfig {
             lease: Duration::from_secs(args.lease_seconds.max(1)),
             max_attempts: args.max_attempts.max(1),
             shutdown_grace: Duration::from_secs(args.shutdown_grace_seconds),
+            max_sweep_runs: args.max_sweep_runs,
             ..Self::new(args.data_dir.clone())
         }
     }

@@ -100,6 +100,7 @@ impl Application {
             running,
             metrics,
             wake,
+            max_sweep_runs: config.max_sweep_runs,
         };
         let router = http::router(state, config.max_body_bytes);
         tracing::info!(%address, workers = config.workers, database = %config.database_path().display(), "chocmodal is ready");

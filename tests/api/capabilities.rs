@@ -17,7 +17,7 @@ async fn the_landing_page_links_to_processes_jobs_and_the_api_definition() {
         .iter()
         .map(|l| l["href"].as_str().unwrap())
         .collect();
-    for href in ["/processes", "/jobs", "/conformance", "/openapi.json"] {
+    for href in ["/processes", "/jobs", "/sweeps", "/conformance", "/openapi.json"] {
         assert!(hrefs.contains(&href), "{href} missing from {hrefs:?}");
     }
 }

@@ -3,7 +3,7 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use chocmodal::processes::Registry;
+use chocmodal::processes::{Process, Registry};
 use chocmodal::service::queue::JobQueue;
 use chocmodal::service::{Application, ServiceConfig};
 use reqwest::{Response, StatusCode};
@@ -55,11 +55,29 @@ pub async fn spawn_app_with(configure: impl FnOnce(&mut ServiceConfig)) -> TestA
 
 /// Starts a service on `data_dir` (a restart when it already holds a database).
 pub async fn spawn_app_in(data_dir: TempDir, configure: impl FnOnce(&mut ServiceConfig)) -> TestApp {
+    spawn_app_serving(data_dir, Vec::new(), configure).await
+}
+
+/// Starts a service that also offers the `extra` processes (e.g. the real ones).
+pub async fn spawn_app_with_processes(
+    extra: Vec<Arc<dyn Process>>,
+    configure: impl FnOnce(&mut ServiceConfig),
+) -> TestApp {
+    spawn_app_serving(TempDir::new().unwrap(), extra, configure).await
+}
+
+async fn spawn_app_serving(
+    data_dir: TempDir,
+    extra: Vec<Arc<dyn Process>>,
+    configure: impl FnOnce(&mut ServiceConfig),
+) -> TestApp {
     init_logs();
     let mut config = test_config(&data_dir);
     configure(&mut config);
     let probe = Arc::new(Probe::default());
-    let registry = Registry::new(vec![Arc::new(CountSteps { probe: probe.clone() })]);
+    let mut processes: Vec<Arc<dyn Process>> = vec![Arc::new(CountSteps { probe: probe.clone() })];
+    processes.extend(extra);
+    let registry = Registry::new(processes);
     let application = Application::build(config, registry)
         .await
         .expect("the service starts");

@@ -14,3 +14,4 @@ mod load;
 mod recovery;
 mod responsiveness;
 mod results;
+mod sweeps;

@@ -22,21 +22,43 @@ impl<S: Send + Sync> FromRequest<S> for ExecutionInputs {
     type Rejection = ApiError;
 
     async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
-        if let Some(content_type) = req.headers().get(header::CONTENT_TYPE) {
-            let content_type = content_type.to_str().unwrap_or_default().to_ascii_lowercase();
-            let essence = content_type.split(';').next().unwrap_or_default().trim();
-            if !(essence == "application/json" || essence.ends_with("+json")) {
-                return Err(Problem::unsupported_media_type(format!(
-                    "the execution request must be `application/json`, not `{essence}`"
-                ))
-                .into());
-            }
-        }
-        let bytes = Bytes::from_request(req, state).await.map_err(body_rejection)?;
-        let text = std::str::from_utf8(&bytes)
-            .map_err(|_| Problem::malformed_body("the body is not valid UTF-8"))?;
-        Ok(Self(parse_envelope(text)?))
+        let text = json_text(req, state, "the execution request").await?;
+        Ok(Self(parse_envelope(&text)?))
     }
+}
+
+/// Any JSON body (a sweep request), with the same rejections as [`ExecutionInputs`] but
+/// for the envelope: 413, 415, 400 when it is not JSON.
+#[derive(Debug)]
+pub struct JsonBody(pub serde_json::Value);
+
+impl<S: Send + Sync> FromRequest<S> for JsonBody {
+    type Rejection = ApiError;
+
+    async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
+        let text = json_text(req, state, "the request").await?;
+        serde_json::from_str(&text)
+            .map(Self)
+            .map_err(|e| Problem::malformed_body(format!("the body is not valid JSON: {e}")).into())
+    }
+}
+
+/// The body as text, refusing bodies declared as something else than JSON.
+async fn json_text<S: Send + Sync>(req: Request, state: &S, what: &str) -> Result<String, ApiError> {
+    if let Some(content_type) = req.headers().get(header::CONTENT_TYPE) {
+        let content_type = content_type.to_str().unwrap_or_default().to_ascii_lowercase();
+        let essence = content_type.split(';').next().unwrap_or_default().trim();
+        if !(essence == "application/json" || essence.ends_with("+json")) {
+            return Err(Problem::unsupported_media_type(format!(
+                "{what} must be `application/json`, not `{essence}`"
+            ))
+            .into());
+        }
+    }
+    let bytes = Bytes::from_request(req, state).await.map_err(body_rejection)?;
+    let text =
+        std::str::from_utf8(&bytes).map_err(|_| Problem::malformed_body("the body is not valid UTF-8"))?;
+    Ok(text.to_owned())
 }
 
 fn body_rejection(rejection: BytesRejection) -> ApiError {

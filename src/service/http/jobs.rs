@@ -51,6 +51,10 @@ fn parse_list_query(pairs: &[(String, String)]) -> Result<ListQuery, Problem> {
                 .filter
                 .process_ids
                 .extend(value.split(',').filter(|s| !s.is_empty()).map(str::to_owned)),
+            "sweepID" => query
+                .filter
+                .sweep_ids
+                .extend(value.split(',').filter(|s| !s.is_empty()).map(str::to_owned)),
             "limit" => {
                 query.limit = value
                     .parse()
@@ -68,7 +72,7 @@ fn parse_list_query(pairs: &[(String, String)]) -> Result<ListQuery, Problem> {
             "f" => {}
             other => {
                 return Err(Problem::invalid_query(format!(
-                    "unknown query parameter `{other}` (expected status, processID, limit, cursor)"
+                    "unknown query parameter `{other}` (expected status, processID, sweepID, limit, cursor)"
                 )));
             }
         }
@@ -86,6 +90,12 @@ fn list_href(query: &ListQuery, cursor: Option<i64>) -> String {
         href.push_str(&format!(
             "&processID={}",
             encode_component(&query.filter.process_ids.join(","))
+        ));
+    }
+    if !query.filter.sweep_ids.is_empty() {
+        href.push_str(&format!(
+            "&sweepID={}",
+            encode_component(&query.filter.sweep_ids.join(","))
         ));
     }
     if let Some(cursor) = cursor {
@@ -115,6 +125,7 @@ fn encode_component(text: &str) -> String {
     params(
         ("status" = Option<String>, Query, description = "Only jobs in these statuses, e.g. `running,accepted`"),
         ("processID" = Option<String>, Query, description = "Only jobs of these processes"),
+        ("sweepID" = Option<String>, Query, description = "Only runs of these sweeps"),
         ("limit" = Option<u32>, Query, description = "Jobs per page, 1 to 1000 (default 10)"),
         ("cursor" = Option<i64>, Query, description = "Opaque position from a `next` link"),
     ),

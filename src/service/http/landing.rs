@@ -47,6 +47,8 @@ fn landing_links() -> Vec<Link> {
             "application/json",
         )
         .titled("Jobs"),
+        Link::new("/sweeps", "https://chocmodal.dev/rel/sweeps", "application/json")
+            .titled("Sweeps: many runs of a process with aggregated results"),
         Link::new("/healthz", "status", "application/json").titled("Liveness"),
         Link::new("/metrics", "monitor", "text/plain").titled("Prometheus metrics"),
     ]

@@ -11,6 +11,8 @@ pub mod models;
 pub mod openapi;
 pub mod processes;
 pub mod results;
+pub mod sweep_models;
+pub mod sweeps;
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -44,6 +46,8 @@ pub struct AppState {
     pub metrics: Metrics,
     /// Wakes an idle worker when a job is queued.
     pub wake: Arc<Notify>,
+    /// Most runs one sweep may expand into.
+    pub max_sweep_runs: usize,
 }
 
 /// Longest time a request may take before a 408 problem.
@@ -64,6 +68,9 @@ pub fn router(state: AppState, max_body_bytes: usize) -> Router {
         .route("/jobs/{jobId}", get(jobs::status).delete(jobs::dismiss))
         .route("/jobs/{jobId}/results", get(results::results))
         .route("/jobs/{jobId}/results/{output}", get(results::output))
+        .route("/sweeps", get(sweeps::list).post(sweeps::create))
+        .route("/sweeps/{sweepId}", get(sweeps::status).delete(sweeps::dismiss))
+        .route("/sweeps/{sweepId}/results", get(sweeps::results))
         .fallback(not_found)
         // Layers run outside-in from the last one added: trace and count every request,
         // then turn any bare error below (timeout, panic, 405, 413) into a problem.

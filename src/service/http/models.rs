@@ -47,6 +47,9 @@ pub struct StatusInfo {
     #[serde(rename = "type")]
     pub kind: &'static str,
     pub status: JobStatus,
+    /// The sweep this job is a run of (absent for single jobs).
+    #[serde(rename = "sweepID", skip_serializing_if = "Option::is_none")]
+    pub sweep_id: Option<String>,
     /// Human-readable state, e.g. `queued`, `running`, `failed: <reason>`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub message: Option<String>,
@@ -85,11 +88,18 @@ impl StatusInfo {
             "up",
             "application/json",
         ));
+        if let Some(sweep_id) = &job.sweep_id {
+            links.push(
+                Link::new(format!("/sweeps/{sweep_id}"), "up", "application/json")
+                    .titled("The sweep this job is a run of"),
+            );
+        }
         Self {
             job_id: job.id.clone(),
             process_id: job.process_id.clone(),
             kind: "process",
             status: job.status,
+            sweep_id: job.sweep_id.clone(),
             message: job.message.clone(),
             progress: job.progress,
             created: rfc3339(job.created_at),

@@ -6,7 +6,7 @@
 
 use utoipa::OpenApi;
 
-use super::{jobs, landing, models, processes, results};
+use super::{jobs, landing, models, processes, results, sweep_models, sweeps};
 use crate::service::queue::JobStatus;
 
 /// A field at fault in an execution request.
@@ -64,6 +64,11 @@ pub struct ProblemSchema {
         jobs::dismiss,
         results::results,
         results::output,
+        sweeps::create,
+        sweeps::list,
+        sweeps::status,
+        sweeps::dismiss,
+        sweeps::results,
     ),
     components(schemas(
         ProblemSchema,
@@ -82,12 +87,20 @@ pub struct ProblemSchema {
         models::LandingPage,
         models::Conformance,
         models::Health,
+        sweep_models::SweepState,
+        sweep_models::RunCounts,
+        sweep_models::SweepStatus,
+        sweep_models::SweepList,
+        sweep_models::SweepAxisSchema,
+        sweep_models::SweepRequestSchema,
+        sweep_models::SweepResults,
     )),
     tags(
         (name = "Capabilities", description = "What this service is and offers"),
         (name = "Processes", description = "The computations, and their execution as jobs"),
         (name = "Jobs", description = "Queued, running and finished jobs"),
         (name = "Results", description = "Results documents and time histories"),
+        (name = "Sweeps", description = "Many runs of a process over axes of its inputs, as one resource with aggregated results"),
         (name = "Operations", description = "Health and metrics"),
     )
 )]

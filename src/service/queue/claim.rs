@@ -1,8 +1,12 @@
-//! Claim: a worker atomically takes the oldest accepted job and a lease on it.
+//! Claim: a worker atomically takes the next accepted job and a lease on it.
 //!
 //! One `UPDATE ... WHERE seq = (SELECT ...) RETURNING` statement: SQLite takes the write
 //! lock before it reads, so two workers can never claim the same row, and nothing is
 //! held once the statement returns.
+//!
+//! Order: single jobs first (oldest first), then sweep runs (oldest first). A sweep of
+//! thousands of runs queued before a single job never makes it wait for more than the
+//! runs already computing: it only gets the workers no single job wants.
 
 use std::time::Duration;
 
@@ -12,14 +16,16 @@ use super::{ClaimedJob, JobQueue, Lease};
 use crate::service::clock::duration_ms;
 
 impl JobQueue {
-    /// Takes the oldest accepted job for `owner`, leased for `lease`; `None` if the queue is empty.
+    /// Takes the next accepted job for `owner`, leased for `lease`; `None` if the queue is empty.
     pub async fn claim(&self, owner: &str, lease: Duration) -> Result<Option<ClaimedJob>, sqlx::Error> {
         let now = self.now();
         let row = sqlx::query(
             "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = ?1, \
                  lease_expires_at = ?2, started_at = ?3, updated_at = ?3, progress = 0, message = 'running' \
-             WHERE seq = (SELECT seq FROM jobs WHERE status = 'accepted' ORDER BY seq LIMIT 1) \
-             RETURNING id, process_id, inputs, attempt, created_at",
+             WHERE seq = COALESCE( \
+                 (SELECT seq FROM jobs WHERE status = 'accepted' AND sweep_id IS NULL ORDER BY seq LIMIT 1), \
+                 (SELECT seq FROM jobs WHERE status = 'accepted' ORDER BY seq LIMIT 1)) \
+             RETURNING id, process_id, inputs, attempt, created_at, content_hash",
         )
         .bind(owner)
         .bind(now.saturating_add(duration_ms(lease)))
@@ -42,6 +48,7 @@ impl JobQueue {
             },
             process_id: row.try_get("process_id")?,
             inputs,
+            content_hash: row.try_get("content_hash")?,
             created_at: row.try_get("created_at")?,
             started_at: now,
         }))

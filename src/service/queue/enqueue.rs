@@ -1,5 +1,6 @@
-//! Enqueue: one execution request becomes one `accepted` job row.
+//! Enqueue: one execution request becomes one `accepted` job row, with its content hash.
 
+use super::content_hash::content_hash;
 use super::{JobQueue, JobRecord, record_columns};
 
 impl JobQueue {
@@ -11,14 +12,16 @@ impl JobQueue {
     ) -> Result<JobRecord, sqlx::Error> {
         let id = uuid::Uuid::new_v4().to_string();
         sqlx::query_as(concat!(
-            "INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at) \
-             VALUES (?1, ?2, ?3, 'accepted', 0, 'queued', ?4, ?4) RETURNING ",
+            "INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
+                 content_hash) \
+             VALUES (?1, ?2, ?3, 'accepted', 0, 'queued', ?4, ?4, ?5) RETURNING ",
             record_columns!()
         ))
         .bind(&id)
         .bind(process_id)
         .bind(inputs.to_string())
         .bind(self.now())
+        .bind(content_hash(process_id, inputs))
         .fetch_one(&self.pool)
         .await
     }

@@ -61,8 +61,11 @@ impl JobQueue {
     }
 
     /// Marks the job failed with `problem` as its error (served by `/jobs/{id}/results`).
+    /// A run of a `fail_fast` sweep also dismisses the sweep's runs that have not ended
+    /// (their workers notice within a second), in the same transaction.
     pub async fn fail(&self, lease: &Lease, problem: &Problem) -> Result<bool, sqlx::Error> {
         let now = self.now();
+        let mut tx = self.pool.begin().await?;
         let updated = sqlx::query(concat!(
             "UPDATE jobs SET status = 'failed', message = ?5, error = ?6, finished_at = ?4, \
                  updated_at = ?4, lease_owner = NULL, lease_expires_at = NULL",
@@ -74,9 +77,27 @@ impl JobQueue {
         .bind(now)
         .bind(format!("failed: {}", problem.detail))
         .bind(serde_json::to_string(problem).unwrap_or_default())
-        .execute(&self.pool)
+        .execute(&mut *tx)
         .await?;
-        Ok(updated.rows_affected() == 1)
+        if updated.rows_affected() != 1 {
+            tx.rollback().await?;
+            return Ok(false);
+        }
+        sqlx::query(
+            "UPDATE jobs SET status = 'dismissed', cancel_requested = 1, finished_at = ?2, updated_at = ?2, \
+                 lease_owner = NULL, lease_expires_at = NULL, \
+                 message = 'dismissed: job ' || ?3 || ' of its fail-fast sweep failed' \
+             WHERE sweep_id = (SELECT sweep_id FROM jobs WHERE id = ?1) \
+               AND status IN ('accepted', 'running') \
+               AND EXISTS (SELECT 1 FROM sweeps s WHERE s.id = jobs.sweep_id AND s.policy = 'fail_fast')",
+        )
+        .bind(&lease.job_id)
+        .bind(now)
+        .bind(&lease.job_id)
+        .execute(&mut *tx)
+        .await?;
+        tx.commit().await?;
+        Ok(true)
     }
 
     /// Returns the job to the queue without counting the attempt (graceful shutdown ran

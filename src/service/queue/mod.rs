@@ -14,9 +14,13 @@
 //! - [`dismiss`]: cancel a queued or running job, or drop a finished job's results;
 //! - [`recovery`]: re-queue (or fail) jobs whose lease expired;
 //! - [`retention`]: delete old finished jobs;
-//! - [`read`]: status, listing with keyset paging, results and histories.
+//! - [`read`]: status, listing with keyset paging, results and histories;
+//! - [`reuse`]: complete a claimed job with the results of an identical one
+//!   ([`content_hash`]);
+//! - [`sweep_create`], [`sweep_read`], [`sweep_dismiss`]: sweeps, whose runs are jobs.
 
 pub mod claim;
+pub mod content_hash;
 pub mod dismiss;
 pub mod enqueue;
 pub mod finish;
@@ -24,6 +28,10 @@ pub mod heartbeat;
 pub mod read;
 pub mod recovery;
 pub mod retention;
+pub mod reuse;
+pub mod sweep_create;
+pub mod sweep_dismiss;
+pub mod sweep_read;
 
 use sqlx::SqlitePool;
 
@@ -95,6 +103,8 @@ pub struct JobRecord {
     pub updated_at: i64,
     /// Number of claims so far.
     pub attempt: i64,
+    /// The sweep this job is a run of, if any.
+    pub sweep_id: Option<String>,
 }
 
 /// Columns of [`JobRecord`] for `SELECT` and `RETURNING` clauses (a literal, for `concat!`:
@@ -102,7 +112,7 @@ pub struct JobRecord {
 macro_rules! record_columns {
     () => {
         "seq, id, process_id, status, progress, message, created_at, started_at, finished_at, \
-         updated_at, attempt"
+         updated_at, attempt, sweep_id"
     };
 }
 pub(crate) use record_columns;
@@ -127,6 +137,7 @@ impl<'r> sqlx::FromRow<'r, sqlx::sqlite::SqliteRow> for JobRecord {
             finished_at: row.try_get("finished_at")?,
             updated_at: row.try_get("updated_at")?,
             attempt: row.try_get("attempt")?,
+            sweep_id: row.try_get("sweep_id")?,
         })
     }
 }
@@ -148,6 +159,8 @@ pub struct ClaimedJob {
     pub process_id: String,
     /// The validated `inputs` object.
     pub inputs: serde_json::Value,
+    /// Content hash of process and inputs (jobs queued before hashes existed have none).
+    pub content_hash: Option<String>,
     /// When it was enqueued and claimed (ms since the Unix epoch).
     pub created_at: i64,
     pub started_at: i64,
@@ -177,3 +190,31 @@ impl JobQueue {
         self.clock.now_ms()
     }
 }
+
+/// A sweep as stored: its definition and bookkeeping (its runs are jobs).
+#[derive(Debug, Clone, PartialEq, sqlx::FromRow)]
+pub struct SweepRecord {
+    /// Insertion order (keyset of the sweep list).
+    pub seq: i64,
+    pub id: String,
+    pub process_id: String,
+    /// The normalized definition (JSON text).
+    pub definition: String,
+    pub design: String,
+    pub policy: String,
+    /// Number of runs.
+    pub runs: i64,
+    /// Dismissed by `DELETE /sweeps/{id}`.
+    pub dismissed: bool,
+    /// Times in ms since the Unix epoch.
+    pub created_at: i64,
+    pub updated_at: i64,
+}
+
+/// Columns of [`SweepRecord`] (a literal, for `concat!`).
+macro_rules! sweep_columns {
+    () => {
+        "seq, id, process_id, definition, design, policy, runs, dismissed, created_at, updated_at"
+    };
+}
+pub(crate) use sweep_columns;

@@ -10,6 +10,8 @@ use crate::service::store::StoredHistory;
 pub struct JobFilter {
     pub statuses: Vec<JobStatus>,
     pub process_ids: Vec<String>,
+    /// Only runs of these sweeps.
+    pub sweep_ids: Vec<String>,
 }
 
 /// A job with what it produced: results document (successful) or problem (failed).
@@ -44,6 +46,8 @@ impl JobQueue {
         });
         let process_ids = (!filter.process_ids.is_empty())
             .then(|| serde_json::to_string(&filter.process_ids).unwrap_or_default());
+        let sweep_ids = (!filter.sweep_ids.is_empty())
+            .then(|| serde_json::to_string(&filter.sweep_ids).unwrap_or_default());
         sqlx::query_as(concat!(
             "SELECT ",
             record_columns!(),
@@ -51,12 +55,14 @@ impl JobQueue {
              WHERE (?1 IS NULL OR status IN (SELECT value FROM json_each(?1))) \
                AND (?2 IS NULL OR process_id IN (SELECT value FROM json_each(?2))) \
                AND (?3 IS NULL OR seq < ?3) \
+               AND (?5 IS NULL OR sweep_id IN (SELECT value FROM json_each(?5))) \
              ORDER BY seq DESC LIMIT ?4"
         ))
         .bind(statuses)
         .bind(process_ids)
         .bind(before)
         .bind(i64::from(limit))
+        .bind(sweep_ids)
         .fetch_all(&self.pool)
         .await
     }

@@ -38,8 +38,22 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
         record(&lease, "fail", ctx.queue.fail(&lease, &problem).await);
         return;
     };
-    tracing::info!(job = %lease.job_id, process = %process_id, attempt = lease.attempt, "job started");
     let started = Instant::now();
+    // An identical run already succeeded: take its results instead of computing again.
+    if let Some(hash) = &job.content_hash {
+        match ctx.queue.reuse(&lease, hash).await {
+            Ok(Some(source)) => {
+                ctx.metrics.observe_job(&process_id, "reused", started.elapsed());
+                tracing::info!(job = %lease.job_id, source = %source, "job reused the results of an identical job");
+                return;
+            }
+            Ok(None) => {}
+            Err(error) => {
+                tracing::warn!(job = %lease.job_id, %error, "looking for reusable results failed; computing")
+            }
+        }
+    }
+    tracing::info!(job = %lease.job_id, process = %process_id, attempt = lease.attempt, "job started");
     let control = ctx.running.insert(&lease.job_id);
 
     let (sender, mut receiver) = oneshot::channel::<ThreadOutcome>();

@@ -1,0 +1,226 @@
+//! The JSON documents of `/sweeps`, with their OpenAPI schemas.
+
+use serde::Serialize;
+use utoipa::ToSchema;
+
+use super::models::Link;
+use crate::service::clock::rfc3339;
+use crate::service::queue::SweepRecord;
+use crate::service::queue::sweep_read::SweepCounts;
+
+/// Link relation of results (OGC API – Processes).
+const RESULTS_REL: &str = "http://www.opengis.net/def/rel/ogc/1.0/results";
+
+/// Status of a sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum SweepState {
+    /// No run has started yet.
+    Accepted,
+    /// Some runs have started or ended, some have not.
+    Running,
+    /// Every run ended (under the `continue` policy, some may have failed: see `counts`).
+    Successful,
+    /// A run failed under the `fail_fast` policy; the runs not finished were dismissed.
+    Failed,
+    /// Dismissed by `DELETE /sweeps/{sweepId}`.
+    Dismissed,
+}
+
+/// Number of runs in each job status.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct RunCounts {
+    pub accepted: i64,
+    pub running: i64,
+    pub successful: i64,
+    pub failed: i64,
+    pub dismissed: i64,
+}
+
+/// The state of one sweep.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct SweepStatus {
+    #[serde(rename = "sweepID")]
+    pub sweep_id: String,
+    #[serde(rename = "processID")]
+    pub process_id: String,
+    pub status: SweepState,
+    /// `grid`, `monte_carlo` or `latin_hypercube`.
+    pub design: String,
+    /// `continue` or `fail_fast`.
+    pub policy: String,
+    /// Number of runs (jobs).
+    pub runs: i64,
+    pub counts: RunCounts,
+    /// Percent done over all runs (ended runs count 100, running ones their progress).
+    #[schema(minimum = 0, maximum = 100)]
+    pub progress: u8,
+    /// When the sweep was submitted (RFC 3339, UTC).
+    pub created: String,
+    /// When its last run ended (RFC 3339, UTC), once every run ended.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finished: Option<String>,
+    /// Last change of the sweep or any of its runs (RFC 3339, UTC).
+    pub updated: String,
+    /// The sweep request as normalized: process, base inputs, axes, design, samples, seed, policy.
+    #[schema(value_type = Object)]
+    pub definition: serde_json::Value,
+    pub links: Vec<Link>,
+}
+
+impl SweepStatus {
+    pub fn new(record: &SweepRecord, counts: &SweepCounts) -> Self {
+        let ended = counts.successful + counts.failed + counts.dismissed;
+        let status = if record.dismissed {
+            SweepState::Dismissed
+        } else if record.policy == "fail_fast" && counts.failed > 0 {
+            SweepState::Failed
+        } else if counts.pending() == 0 {
+            SweepState::Successful
+        } else if counts.running > 0 || ended > 0 {
+            SweepState::Running
+        } else {
+            SweepState::Accepted
+        };
+        let progress = if record.runs > 0 {
+            ((ended * 100 + counts.running_progress) / record.runs).clamp(0, 100) as u8
+        } else {
+            100
+        };
+        let href = format!("/sweeps/{}", record.id);
+        let links = vec![
+            Link::new(&href, "self", "application/json").titled("Sweep status"),
+            Link::new(format!("{href}/results"), RESULTS_REL, "application/json")
+                .titled("Results table and aggregates"),
+            Link::new(format!("{href}/results?format=csv"), RESULTS_REL, "text/csv")
+                .titled("Results table as CSV"),
+            Link::new(
+                format!("/jobs?sweepID={}", record.id),
+                "http://www.opengis.net/def/rel/ogc/1.0/job-list",
+                "application/json",
+            )
+            .titled("The runs, as jobs"),
+            Link::new(
+                format!("/processes/{}", record.process_id),
+                "up",
+                "application/json",
+            ),
+        ];
+        Self {
+            sweep_id: record.id.clone(),
+            process_id: record.process_id.clone(),
+            status,
+            design: record.design.clone(),
+            policy: record.policy.clone(),
+            runs: record.runs,
+            counts: RunCounts {
+                accepted: counts.accepted,
+                running: counts.running,
+                successful: counts.successful,
+                failed: counts.failed,
+                dismissed: counts.dismissed,
+            },
+            progress,
+            created: rfc3339(record.created_at),
+            finished: (counts.pending() == 0).then(|| {
+                rfc3339(
+                    counts
+                        .finished_at
+                        .unwrap_or(record.updated_at)
+                        .max(record.created_at),
+                )
+            }),
+            updated: rfc3339(counts.updated_at.unwrap_or(0).max(record.updated_at)),
+            definition: serde_json::from_str(&record.definition).unwrap_or(serde_json::Value::Null),
+            links,
+        }
+    }
+
+    /// True once nothing will change any more.
+    pub fn is_finished(&self) -> bool {
+        self.counts.accepted + self.counts.running == 0
+    }
+}
+
+/// A page of sweeps, newest first; follow the `next` link for older ones.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct SweepList {
+    pub sweeps: Vec<SweepStatus>,
+    pub links: Vec<Link>,
+}
+
+/// One axis of a sweep: a JSON pointer into the inputs and exactly one of `values`,
+/// `linspace`, `logspace` (list axes) or `uniform`, `normal`, `lognormal` (random axes).
+#[derive(Debug, ToSchema)]
+#[schema(as = SweepAxis)]
+#[allow(dead_code)]
+pub struct SweepAxisSchema {
+    /// JSON pointer into the process inputs, e.g. `/contact/rk`; it must exist in the
+    /// base inputs or be creatable there (missing object members are created).
+    pointer: String,
+    /// Explicit values, any JSON.
+    #[schema(value_type = Option<Vec<Object>>)]
+    values: Option<Vec<serde_json::Value>>,
+    /// `[start, stop, count]`: count evenly spaced values, both ends included.
+    linspace: Option<Vec<f64>>,
+    /// `[start, stop, count]`: count geometrically spaced values (not exponents), start and stop > 0.
+    logspace: Option<Vec<f64>>,
+    /// `[low, high]`: uniform draws on [low, high).
+    uniform: Option<Vec<f64>>,
+    /// `{"mean", "std"}`: normal draws.
+    #[schema(value_type = Option<Object>)]
+    normal: Option<serde_json::Value>,
+    /// `{"mean", "std"}` of the natural logarithm of the value: lognormal draws.
+    #[schema(value_type = Option<Object>)]
+    lognormal: Option<serde_json::Value>,
+}
+
+/// A sweep request. Integer targets (an integer in the base inputs, or integer bounds)
+/// receive generated numbers rounded to integers.
+#[derive(Debug, ToSchema)]
+#[schema(as = SweepRequest)]
+#[allow(dead_code)]
+pub struct SweepRequestSchema {
+    /// Process id, e.g. `cantilever-impact`.
+    process: String,
+    /// Base inputs of every run (see the process description).
+    #[schema(value_type = Object)]
+    inputs: serde_json::Value,
+    axes: Vec<SweepAxisSchema>,
+    /// `grid` (default with list axes only), `monte_carlo` (default with a random axis)
+    /// or `latin_hypercube`.
+    design: Option<String>,
+    /// Draws per grid cell of the list axes; required with random axes.
+    samples: Option<u64>,
+    /// Seed of the random draws (default 0): the same seed gives the same runs on every machine.
+    seed: Option<u64>,
+    /// `continue` (default) or `fail_fast`: the first failed run dismisses the others.
+    policy: Option<String>,
+    /// `refuse` (default): any invalid generated run refuses the whole sweep (422);
+    /// `record`: invalid runs are recorded as failed jobs with their `invalid-inputs`
+    /// problem, never queued, and the valid ones run (maps across a stability limit).
+    invalid_runs: Option<String>,
+}
+
+/// The results of a sweep: one row per ended run, and aggregates.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct SweepResults {
+    #[serde(rename = "sweepID")]
+    pub sweep_id: String,
+    pub status: SweepState,
+    /// Number of runs.
+    pub runs: i64,
+    /// `run`, `job`, `status`, one column per axis (its pointer), then the metrics
+    /// flattened with dots (`comparison.f_err`, `contacts.3.max_force`), in SI units.
+    pub columns: Vec<String>,
+    /// One object per ended run (successful, failed or dismissed), in run order, keyed by column.
+    #[schema(value_type = Vec<Object>)]
+    pub rows: Vec<serde_json::Map<String, serde_json::Value>>,
+    /// `statistics` (random designs: per grid cell of the list axes, count, mean, std,
+    /// min, max, q05, q50, q95 of every numeric column over the successful runs) or
+    /// `calibration` (grids with `comparison.f_err`: validity map, cheapest valid
+    /// `/solver/time_step`, `/beam/modes`, `/beam/elements`).
+    #[schema(value_type = Object)]
+    pub aggregates: serde_json::Value,
+    pub links: Vec<Link>,
+}

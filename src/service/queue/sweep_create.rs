@@ -1,0 +1,91 @@
+//! Create a sweep: the sweep row and all its runs, as `accepted` jobs, in one
+//! transaction (a sweep is queued whole or not at all).
+//!
+//! The runs go in with one `INSERT ... SELECT FROM json_each(?)` statement: ten
+//! thousand runs are one round trip to the database, not ten thousand.
+
+use serde_json::{Value, json};
+
+use super::content_hash::content_hash;
+use super::{JobQueue, SweepRecord, sweep_columns};
+use crate::problem::Problem;
+
+/// What the queue stores of a new sweep.
+#[derive(Debug, Clone)]
+pub struct NewSweep<'a> {
+    pub process_id: &'a str,
+    /// The normalized definition (JSON), served back by `GET /sweeps/{id}`.
+    pub definition: &'a Value,
+    /// `grid`, `monte_carlo` or `latin_hypercube`.
+    pub design: &'a str,
+    /// `continue` or `fail_fast`.
+    pub policy: &'a str,
+    /// Every run, in run order.
+    pub runs: &'a [NewRun],
+}
+
+/// One run of a new sweep.
+#[derive(Debug, Clone)]
+pub struct NewRun {
+    pub inputs: Value,
+    /// Why the process refuses these inputs: the run is recorded as `failed` with this
+    /// problem and never queued.
+    pub invalid: Option<Problem>,
+}
+
+impl JobQueue {
+    /// Inserts the sweep and its runs (invalid runs directly as `failed`); returns the sweep.
+    pub async fn create_sweep(&self, sweep: &NewSweep<'_>) -> Result<SweepRecord, sqlx::Error> {
+        let id = uuid::Uuid::new_v4().to_string();
+        let now = self.now();
+        let children: Vec<Value> = sweep
+            .runs
+            .iter()
+            .enumerate()
+            .map(|(run, new)| {
+                json!({
+                    "id": uuid::Uuid::new_v4().to_string(),
+                    "run": run,
+                    "inputs": new.inputs.to_string(),
+                    "hash": content_hash(sweep.process_id, &new.inputs),
+                    "error": new.invalid.as_ref().map(|p| serde_json::to_string(p).unwrap_or_default()),
+                    "message": new.invalid.as_ref().map(|p| format!("failed: invalid inputs: {}", p.detail)),
+                })
+            })
+            .collect();
+        let mut tx = self.pool.begin().await?;
+        let record: SweepRecord = sqlx::query_as(concat!(
+            "INSERT INTO sweeps (id, process_id, definition, design, policy, runs, created_at, updated_at) \
+             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?7) RETURNING ",
+            sweep_columns!()
+        ))
+        .bind(&id)
+        .bind(sweep.process_id)
+        .bind(sweep.definition.to_string())
+        .bind(sweep.design)
+        .bind(sweep.policy)
+        .bind(sweep.runs.len() as i64)
+        .bind(now)
+        .fetch_one(&mut *tx)
+        .await?;
+        sqlx::query(
+            "INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
+                 finished_at, error, sweep_id, sweep_run, content_hash) \
+             SELECT json_extract(value, '$.id'), ?1, json_extract(value, '$.inputs'), \
+                 CASE WHEN json_extract(value, '$.error') IS NULL THEN 'accepted' ELSE 'failed' END, 0, \
+                 COALESCE(json_extract(value, '$.message'), \
+                     'queued (sweep run ' || json_extract(value, '$.run') || ')'), ?2, ?2, \
+                 CASE WHEN json_extract(value, '$.error') IS NULL THEN NULL ELSE ?2 END, \
+                 json_extract(value, '$.error'), ?3, json_extract(value, '$.run'), json_extract(value, '$.hash') \
+             FROM json_each(?4) ORDER BY key",
+        )
+        .bind(sweep.process_id)
+        .bind(now)
+        .bind(&id)
+        .bind(Value::Array(children).to_string())
+        .execute(&mut *tx)
+        .await?;
+        tx.commit().await?;
+        Ok(record)
+    }
+}

@@ -1,0 +1,139 @@
+//! Reads of sweeps: one sweep, the sweep list (keyset paging), the counts of its runs
+//! per status, and its ended runs with their results.
+
+use std::collections::HashMap;
+
+use sqlx::Row;
+
+use super::{JobQueue, JobStatus, SweepRecord, sweep_columns};
+
+/// How a sweep's runs stand.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SweepCounts {
+    pub accepted: i64,
+    pub running: i64,
+    pub successful: i64,
+    pub failed: i64,
+    pub dismissed: i64,
+    /// Sum of the progress (percent) of the running runs.
+    pub running_progress: i64,
+    /// Latest change of any run (ms since the Unix epoch).
+    pub updated_at: Option<i64>,
+    /// Latest end of any run.
+    pub finished_at: Option<i64>,
+}
+
+impl SweepCounts {
+    /// Runs that have not ended.
+    pub fn pending(&self) -> i64 {
+        self.accepted + self.running
+    }
+
+    fn add(&mut self, status: &str, count: i64, progress: i64, updated: Option<i64>, finished: Option<i64>) {
+        match JobStatus::parse(status) {
+            Some(JobStatus::Accepted) => self.accepted += count,
+            Some(JobStatus::Running) => {
+                self.running += count;
+                self.running_progress += progress;
+            }
+            Some(JobStatus::Successful) => self.successful += count,
+            Some(JobStatus::Failed) => self.failed += count,
+            Some(JobStatus::Dismissed) => self.dismissed += count,
+            None => {}
+        }
+        self.updated_at = self.updated_at.max(updated);
+        self.finished_at = self.finished_at.max(finished);
+    }
+}
+
+/// An ended run of a sweep with what it produced.
+#[derive(Debug, Clone)]
+pub struct SweepRun {
+    pub run: i64,
+    pub job_id: String,
+    pub status: JobStatus,
+    /// The run's inputs (JSON text).
+    pub inputs: String,
+    /// Results document (JSON text) of a successful run.
+    pub results: Option<String>,
+}
+
+impl JobQueue {
+    pub async fn get_sweep(&self, id: &str) -> Result<Option<SweepRecord>, sqlx::Error> {
+        sqlx::query_as(concat!("SELECT ", sweep_columns!(), " FROM sweeps WHERE id = ?1"))
+            .bind(id)
+            .fetch_optional(&self.pool)
+            .await
+    }
+
+    /// Up to `limit` sweeps, newest first, strictly older than sequence `before` when given.
+    pub async fn list_sweeps(
+        &self,
+        limit: u32,
+        before: Option<i64>,
+    ) -> Result<Vec<SweepRecord>, sqlx::Error> {
+        sqlx::query_as(concat!(
+            "SELECT ",
+            sweep_columns!(),
+            " FROM sweeps WHERE (?1 IS NULL OR seq < ?1) ORDER BY seq DESC LIMIT ?2"
+        ))
+        .bind(before)
+        .bind(i64::from(limit))
+        .fetch_all(&self.pool)
+        .await
+    }
+
+    /// Counts of the runs of each of `sweep_ids` (every id present, zeros included).
+    pub async fn sweep_counts(
+        &self,
+        sweep_ids: &[String],
+    ) -> Result<HashMap<String, SweepCounts>, sqlx::Error> {
+        let rows = sqlx::query(
+            "SELECT sweep_id, status, COUNT(*) AS n, SUM(progress) AS progress, MAX(updated_at) AS updated, \
+                 MAX(finished_at) AS finished \
+             FROM jobs WHERE sweep_id IN (SELECT value FROM json_each(?1)) GROUP BY sweep_id, status",
+        )
+        .bind(serde_json::to_string(sweep_ids).unwrap_or_default())
+        .fetch_all(&self.pool)
+        .await?;
+        let mut counts: HashMap<String, SweepCounts> = sweep_ids
+            .iter()
+            .map(|id| (id.clone(), SweepCounts::default()))
+            .collect();
+        for row in rows {
+            let id: String = row.try_get("sweep_id")?;
+            let status: String = row.try_get("status")?;
+            counts.entry(id).or_default().add(
+                &status,
+                row.try_get("n")?,
+                row.try_get::<Option<i64>, _>("progress")?.unwrap_or(0),
+                row.try_get("updated")?,
+                row.try_get("finished")?,
+            );
+        }
+        Ok(counts)
+    }
+
+    /// The runs of sweep `id` that ended (successful, failed, dismissed), in run order.
+    pub async fn ended_sweep_runs(&self, id: &str) -> Result<Vec<SweepRun>, sqlx::Error> {
+        let rows = sqlx::query(
+            "SELECT id, sweep_run, status, inputs, results FROM jobs \
+             WHERE sweep_id = ?1 AND status IN ('successful', 'failed', 'dismissed') ORDER BY sweep_run",
+        )
+        .bind(id)
+        .fetch_all(&self.pool)
+        .await?;
+        rows.into_iter()
+            .map(|row| {
+                let status: String = row.try_get("status")?;
+                Ok(SweepRun {
+                    run: row.try_get::<Option<i64>, _>("sweep_run")?.unwrap_or(0),
+                    job_id: row.try_get("id")?,
+                    status: JobStatus::parse(&status).unwrap_or(JobStatus::Failed),
+                    inputs: row.try_get("inputs")?,
+                    results: row.try_get("results")?,
+                })
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,191 @@
+//! The results table of a sweep: one row per run that ended, with its run number, job id,
+//! status, the value of every axis (a column named by its pointer, `/contact/rk`), then
+//! the run's scalar results flattened with dots (`comparison.f_err`,
+//! `contacts.3.max_force`).
+
+use serde_json::{Map, Value};
+
+/// What the table needs of one run.
+#[derive(Debug, Clone)]
+pub struct RunRecord {
+    pub run: usize,
+    pub job: String,
+    /// Job status (`successful`, `failed`, `dismissed`, ...).
+    pub status: String,
+    /// The run's inputs (the axis values are read from them).
+    pub inputs: Value,
+    /// Scalar results, flattened (empty unless successful).
+    pub metrics: Vec<(String, Value)>,
+}
+
+/// Columns and rows (each row an object keyed by column).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    pub columns: Vec<String>,
+    /// Names of the metric columns (after `run`, `job`, `status` and the axes).
+    pub metrics: Vec<String>,
+    pub rows: Vec<Map<String, Value>>,
+}
+
+/// Fixed leading columns.
+pub const LEADING: [&str; 3] = ["run", "job", "status"];
+
+/// Flattens a results document into `(dotted.name, scalar)` pairs: numbers and booleans
+/// of nested objects, in the document's key order. Arrays are left out (spectra, event
+/// lists), and so is `outputs` (links); processes add array entries they want as columns.
+pub fn flatten_scalars(document: &Value) -> Vec<(String, Value)> {
+    fn walk(prefix: &str, value: &Value, out: &mut Vec<(String, Value)>) {
+        match value {
+            Value::Object(map) => {
+                for (key, value) in map {
+                    if prefix.is_empty() && key == "outputs" {
+                        continue;
+                    }
+                    let name = if prefix.is_empty() {
+                        key.clone()
+                    } else {
+                        format!("{prefix}.{key}")
+                    };
+                    walk(&name, value, out);
+                }
+            }
+            Value::Number(_) | Value::Bool(_) => out.push((prefix.to_owned(), value.clone())),
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk("", document, &mut out);
+    out
+}
+
+/// Builds the table of `records` for axes at `pointers`; metric columns in order of
+/// first appearance.
+pub fn build(pointers: &[String], records: &[RunRecord]) -> Table {
+    let mut metrics: Vec<String> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for record in records {
+        for (name, _) in &record.metrics {
+            if seen.insert(name.as_str()) {
+                metrics.push(name.clone());
+            }
+        }
+    }
+    let rows = records
+        .iter()
+        .map(|record| {
+            let mut row = Map::new();
+            row.insert("run".into(), Value::from(record.run));
+            row.insert("job".into(), Value::from(record.job.clone()));
+            row.insert("status".into(), Value::from(record.status.clone()));
+            for pointer in pointers {
+                row.insert(
+                    pointer.clone(),
+                    record.inputs.pointer(pointer).cloned().unwrap_or(Value::Null),
+                );
+            }
+            for (name, value) in &record.metrics {
+                row.insert(name.clone(), value.clone());
+            }
+            row
+        })
+        .collect();
+    let columns = LEADING
+        .iter()
+        .map(|c| (*c).to_owned())
+        .chain(pointers.iter().cloned())
+        .chain(metrics.iter().cloned())
+        .collect();
+    Table {
+        columns,
+        metrics,
+        rows,
+    }
+}
+
+impl Table {
+    /// CSV with a header of the column names; absent values are empty cells, strings are
+    /// quoted when they need it, numbers keep full precision.
+    pub fn to_csv(&self) -> String {
+        let mut out = String::new();
+        out.push_str(
+            &self
+                .columns
+                .iter()
+                .map(|c| quote(c))
+                .collect::<Vec<_>>()
+                .join(","),
+        );
+        out.push('\n');
+        for row in &self.rows {
+            let cells: Vec<String> = self
+                .columns
+                .iter()
+                .map(|column| match row.get(column) {
+                    None | Some(Value::Null) => String::new(),
+                    Some(Value::String(text)) => quote(text),
+                    Some(Value::Number(n)) => n.to_string(),
+                    Some(Value::Bool(b)) => b.to_string(),
+                    Some(other) => quote(&other.to_string()),
+                })
+                .collect();
+            out.push_str(&cells.join(","));
+            out.push('\n');
+        }
+        out
+    }
+}
+
+fn quote(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_owned()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn documents_flatten_to_dotted_scalars_without_arrays_or_links() {
+        let doc = json!({"comparison": {"f_err": 0.1, "agrees": true}, "numerical": {"frequencies_hz": [1.0], "impacts": 3},
+                         "outputs": {"x": {"href": "/jobs/a/results/x"}}, "label": "text"});
+        let flat = flatten_scalars(&doc);
+        assert_eq!(
+            flat,
+            vec![
+                ("comparison.agrees".to_owned(), json!(true)),
+                ("comparison.f_err".to_owned(), json!(0.1)),
+                ("numerical.impacts".to_owned(), json!(3)),
+            ]
+        );
+    }
+
+    #[test]
+    fn tables_have_axis_columns_then_metrics_and_render_as_csv() {
+        let records = vec![
+            RunRecord {
+                run: 0,
+                job: "a".into(),
+                status: "successful".into(),
+                inputs: json!({"contact": {"rk": 1.0}}),
+                metrics: vec![("sum".into(), json!(3))],
+            },
+            RunRecord {
+                run: 1,
+                job: "b".into(),
+                status: "failed".into(),
+                inputs: json!({"contact": {"rk": 10.0}}),
+                metrics: vec![],
+            },
+        ];
+        let table = build(&["/contact/rk".to_owned()], &records);
+        assert_eq!(table.columns, vec!["run", "job", "status", "/contact/rk", "sum"]);
+        assert_eq!(
+            table.to_csv(),
+            "run,job,status,/contact/rk,sum\n0,a,successful,1.0,3\n1,b,failed,10.0,\n"
+        );
+    }
+}
