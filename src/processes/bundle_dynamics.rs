@@ -9,7 +9,7 @@ use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
 use super::inputs::{self, at};
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput};
 use crate::physics::contact::Contact;
-use crate::physics::integrate::{Model, Settings, SimulationError, resolve_time_step, simulate_resolved};
+use crate::physics::integrate::{Model, Settings, SimulationError, simulate_resolved};
 use crate::physics::modal::ModalBasis;
 
 /// Most pins in one row.
@@ -219,8 +219,7 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
 
 fn check_costs(prepared: &Prepared) -> Result<(f64, f64), InvalidInputs> {
     let model = prepared.model();
-    let (dt, critical) = resolve_time_step(&model, &prepared.settings)
-        .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())]))?;
+    let (dt, critical) = inputs::resolve_step(&model, &prepared.settings)?;
     let duration = prepared.settings.duration;
     let steps = duration / dt;
     let mut errors = Vec::new();

@@ -11,7 +11,7 @@ use super::inputs::{self, BeamInput, SchemeInput, SupportInput, TimeStepInput, a
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
-use crate::physics::integrate::{Model, Settings, SimulationError, resolve_time_step, simulate_resolved};
+use crate::physics::integrate::{Model, Settings, SimulationError, simulate_resolved};
 use crate::physics::modal::ModalBasis;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
@@ -276,12 +276,7 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
 /// Refuses steps above the critical one, histories too long, references too costly.
 fn check_costs(prepared: &Prepared) -> Result<(f64, f64), InvalidInputs> {
     let model = prepared.model();
-    let (dt, critical) = resolve_time_step(&model, &prepared.settings).map_err(|e| match e {
-        SimulationError::TimeStepAboveCritical { .. } => {
-            InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())])
-        }
-        other => InvalidInputs(vec![FieldError::new("/inputs/solver", other.to_string())]),
-    })?;
+    let (dt, critical) = inputs::resolve_step(&model, &prepared.settings)?;
     let duration = prepared.settings.duration;
     let mut errors = Vec::new();
     if duration / dt > inputs::MAX_STEPS {

@@ -265,6 +265,16 @@ pub fn time_step(step: TimeStepInput, duration: f64, issues: &mut Vec<InputIssue
     }
 }
 
+/// The (time step, critical step) a run will use (s), or a 422 on `/inputs/solver/time_step`
+/// naming both values when a given step exceeds the critical one.
+pub fn resolve_step(
+    model: &crate::physics::integrate::Model<'_>,
+    settings: &crate::physics::integrate::Settings,
+) -> Result<(f64, f64), InvalidInputs> {
+    crate::physics::integrate::resolve_time_step(model, settings)
+        .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())]))
+}
+
 /// Turns physics issues into field errors under `prefix` (a JSON pointer).
 pub fn at(prefix: &str, issues: Vec<InputIssue>) -> Vec<FieldError> {
     issues

@@ -11,6 +11,7 @@ mod errors;
 mod execution;
 mod listing;
 mod load;
+mod physics;
 mod recovery;
 mod responsiveness;
 mod results;

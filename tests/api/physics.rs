@@ -1,0 +1,119 @@
+//! The shipped processes end to end over HTTP: the public cantilever case runs as a
+//! job and serves the same physics as the CLI (results blocks, CSV histories with
+//! numerical and reference columns), and bad physics inputs come back as 422 with the
+//! pointer of the field at fault.
+
+use std::sync::Arc;
+
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use chocmodal::processes::bundle_dynamics::BundleDynamics;
+use chocmodal::processes::cantilever_impact::CantileverImpact;
+
+use crate::helpers::{TestApp, spawn_app_with_processes};
+
+async fn spawn_with_real_processes() -> TestApp {
+    spawn_app_with_processes(vec![Arc::new(CantileverImpact), Arc::new(BundleDynamics)], |_| {}).await
+}
+
+fn cantilever_body(duration: f64) -> Value {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/cantilever-impact.json"
+    ))
+    .unwrap();
+    let mut body: Value = serde_json::from_str(&text).unwrap();
+    body["inputs"]["solver"]["duration"] = json!(duration);
+    body
+}
+
+#[tokio::test]
+async fn the_public_cantilever_case_runs_as_a_job_and_serves_its_histories() {
+    let app = spawn_with_real_processes().await;
+    let response = app
+        .post_execution("cantilever-impact", &cantilever_body(0.1))
+        .await;
+    assert_eq!(response.status(), StatusCode::CREATED);
+    let job: Value = response.json().await.unwrap();
+    let id = job["jobID"].as_str().unwrap().to_owned();
+    let status = app.wait_until_finished(&id).await;
+    assert_eq!(status["status"], "successful", "{status}");
+
+    let results = app.get_json(&format!("/jobs/{id}/results")).await;
+    // First impact of the public case (BRIEF §7) on both sides.
+    for block in ["numerical", "reference"] {
+        let first = results[block]["first_impact_time"].as_f64().unwrap();
+        assert!((first - 0.0253717).abs() < 1e-6, "{block} first impact {first}");
+    }
+    assert_eq!(results["comparison"]["agrees"], true);
+    let href = results["outputs"]["tip_displacement"]["href"].as_str().unwrap();
+    assert_eq!(href, format!("/jobs/{id}/results/tip_displacement"));
+
+    let csv = app.get(&format!("{href}?format=csv")).await.text().await.unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("time,numerical,reference"));
+    assert_eq!(lines.count(), 10_001, "one row per 1e-5 s step over 0.1 s");
+    let forces = app
+        .get_json(&format!("/jobs/{id}/results/contact_force?max_points=200"))
+        .await;
+    let numerical = forces["series"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == "numerical")
+        .unwrap();
+    let peak = numerical["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(Value::as_f64)
+        .fold(0.0, f64::max);
+    let expected = results["numerical"]["max_contact_force"].as_f64().unwrap();
+    assert_eq!(peak, expected, "thinning keeps the force peak");
+}
+
+#[tokio::test]
+async fn a_time_step_above_the_critical_one_is_a_422_naming_the_field() {
+    let app = spawn_with_real_processes().await;
+    let mut body = cantilever_body(0.1);
+    body["inputs"]["solver"]["time_step"] = json!(1e-3);
+    let response = app.post_execution("cantilever-impact", &body).await;
+    assert_eq!(response.status(), StatusCode::UNPROCESSABLE_ENTITY);
+    let problem: Value = response.json().await.unwrap();
+    assert_eq!(problem["errors"][0]["pointer"], "/inputs/solver/time_step");
+    assert!(
+        problem["errors"][0]["detail"]
+            .as_str()
+            .unwrap()
+            .contains("critical")
+    );
+}
+
+#[tokio::test]
+async fn a_bundle_job_serves_contact_forces_by_contact_column() {
+    let app = spawn_with_real_processes().await;
+    let body = json!({"inputs": {
+        "pin": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
+                "section": {"type": "tube", "outer_diameter": 0.010, "inner_diameter": 0.009},
+                "elements": 10, "modes": 4},
+        "bundle": {"pins": 2, "levels": [1.0], "stiffness": 1e4, "wall_gap": 1e-4, "pin_gap": 1e-4},
+        "excitation": {"base_acceleration": {"type": "half_sine", "amplitude": 30.0, "duration": 0.01}},
+        "solver": {"duration": 0.05}}});
+    let response = app.post_execution("bundle-dynamics", &body).await;
+    assert_eq!(response.status(), StatusCode::CREATED);
+    let id = response.json::<Value>().await.unwrap()["jobID"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    assert_eq!(app.wait_until_finished(&id).await["status"], "successful");
+    let csv = app
+        .get(&format!("/jobs/{id}/results/contact_forces?format=csv"))
+        .await
+        .text()
+        .await
+        .unwrap();
+    assert_eq!(csv.lines().next(), Some("time,c0,c1,c2"));
+    let results = app.get_json(&format!("/jobs/{id}/results")).await;
+    assert_eq!(results["expansion"]["contacts"].as_array().unwrap().len(), 3);
+}
