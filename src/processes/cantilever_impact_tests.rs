@@ -161,7 +161,13 @@ fn defaults_fill_everything_but_geometry_and_material() {
     let inputs = json!({"beam": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
         "section": {"type": "explicit", "area": 1.4923e-5, "inertia": 1.6198e-10}}});
     assert!(CantileverImpact.validate(&inputs).is_ok());
-    assert_eq!(pointers(&json!({})), ["/inputs"], "beam is required");
+    assert_eq!(pointers(&json!({})), ["/inputs/beam"], "beam is required");
+    let errors = CantileverImpact
+        .validate(&json!({"beam": {"length": 1.0}}))
+        .unwrap_err()
+        .0;
+    assert_eq!(errors[0].pointer, "/inputs/beam/young_modulus");
+    assert_eq!(errors[0].detail, "is required");
 }
 
 #[test]

@@ -305,7 +305,17 @@ pub fn parse<T: DeserializeOwned>(inputs: &serde_json::Value) -> Result<T, Inval
                 serde_path_to_error::Segment::Enum { .. } | serde_path_to_error::Segment::Unknown => {}
             }
         }
-        InvalidInputs(vec![FieldError::new(pointer, error.into_inner().to_string())])
+        let detail = error.into_inner().to_string();
+        // serde reports a missing member at its parent: point at the member itself.
+        if let Some(field) = detail
+            .strip_prefix("missing field `")
+            .and_then(|rest| rest.strip_suffix('`'))
+        {
+            pointer.push('/');
+            pointer.push_str(field);
+            return InvalidInputs(vec![FieldError::new(pointer, "is required")]);
+        }
+        InvalidInputs(vec![FieldError::new(pointer, detail)])
     })
 }
 
