@@ -155,7 +155,8 @@ pub struct ProcessDescription {
 /// An execution request.
 #[derive(Debug, Serialize, ToSchema)]
 pub struct ExecuteRequest {
-    /// The process inputs (see the process description).
+    /// The process inputs (see the process description): `CantileverInputs` for
+    /// `cantilever-impact`, `BundleInputs` for `bundle-dynamics`.
     #[schema(value_type = Object)]
     pub inputs: serde_json::Value,
 }

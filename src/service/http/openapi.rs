@@ -94,6 +94,9 @@ pub struct ProblemSchema {
         sweep_models::SweepAxisSchema,
         sweep_models::SweepRequestSchema,
         sweep_models::SweepResults,
+        // The `inputs` of each shipped process (also served by `/processes/{id}`).
+        crate::processes::cantilever_impact::CantileverInputs,
+        crate::processes::bundle_inputs::BundleInputs,
     )),
     tags(
         (name = "Capabilities", description = "What this service is and offers"),
