@@ -264,9 +264,10 @@ impl<'m> Integrator<'m> {
         integrator
     }
 
-    /// External loads at time t into `force`; returns a(t) of the base.
+    /// External loads at time t into `force`; keeps the base acceleration a(t) in
+    /// `base_now` for the power of the step.
     #[inline(always)]
-    fn external_forces(&mut self, t: f64) -> f64 {
+    fn external_forces(&mut self, t: f64) {
         let (pins, stride) = (self.pins, self.stride);
         let base = self.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
         self.base_now = base;
@@ -279,7 +280,6 @@ impl<'m> Integrator<'m> {
                 row[point.pin] += value * s;
             }
         }
-        base
     }
 
     /// Loads at time t (`force`), contact forces from the current positions and the
