@@ -3,7 +3,8 @@
 //! `chocmodal run <processId> <body.json | ->` runs one execution request in-process,
 //! with no server: the results document goes to stdout, invalid inputs give the same
 //! problem document as the HTTP API on stderr and exit status 2, a failed run exits 1.
-//! `chocmodal serve` runs the HTTP API and its workers (see [`crate::service`]).
+//! `chocmodal serve` runs the HTTP API and its workers, `chocmodal worker` workers alone
+//! (see [`crate::service`]).
 
 use std::io::Read;
 use std::ops::ControlFlow;
@@ -30,8 +31,10 @@ pub struct Cli {
 pub enum Command {
     /// Run one execution request in-process and print its results document.
     Run(RunArgs),
-    /// Serve the HTTP API and run jobs on an embedded SQLite database.
+    /// Serve the HTTP API and run jobs (SQLite by default, or PostgreSQL).
     Serve(crate::service::ServeArgs),
+    /// Run jobs from the queue without serving the API (scale-out on PostgreSQL).
+    Worker(crate::service::WorkerArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -54,6 +57,7 @@ pub fn main() -> ExitCode {
     match cli.command {
         Command::Run(args) => run_command(&args, &Registry::builtin()),
         Command::Serve(args) => crate::service::serve(&args, Registry::builtin()),
+        Command::Worker(args) => crate::service::worker(&args, Registry::builtin()),
     }
 }
 

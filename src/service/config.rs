@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::clock::{SharedClock, SystemClock};
+use super::db::DatabaseUrl;
 
 /// Log output format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -17,24 +18,26 @@ pub enum LogFormat {
     Json,
 }
 
-/// `chocmodal serve`: the HTTP API and the workers on an embedded SQLite database.
+/// Flags of every process that opens the queue (`serve` and `worker`).
 #[derive(Debug, Clone, clap::Args)]
-pub struct ServeArgs {
-    /// Address to listen on.
-    #[arg(long, env = "CHOCMODAL_BIND", default_value = "127.0.0.1:8080")]
-    pub bind: SocketAddr,
-    /// Directory of the database (`chocmodal.sqlite`); created if missing.
+pub struct QueueArgs {
+    /// Database: `sqlite://<path>` (one machine) or
+    /// `postgres://<user>:<password>@<host>:<port>/<database>` (shared by API and worker
+    /// processes on any number of machines). Default: `sqlite://<data-dir>/chocmodal.sqlite`.
+    #[arg(long, env = "CHOCMODAL_DATABASE_URL", value_name = "URL")]
+    pub database: Option<DatabaseUrl>,
+    /// Directory of the default SQLite database (`chocmodal.sqlite`); created if missing.
     #[arg(long, env = "CHOCMODAL_DATA_DIR", default_value = "./data")]
     pub data_dir: PathBuf,
-    /// Jobs computed at once (default: number of cores). 0 runs the API alone.
+    /// Jobs computed at once by this process (default: number of cores). 0: none.
     #[arg(long, env = "CHOCMODAL_WORKERS")]
     pub workers: Option<usize>,
+    /// Largest number of connections this process opens to a PostgreSQL database.
+    #[arg(long, env = "CHOCMODAL_DATABASE_CONNECTIONS", default_value_t = 10)]
+    pub database_connections: u32,
     /// Delete finished jobs (and their results) this many days after they finished; 0 keeps them forever.
     #[arg(long, env = "CHOCMODAL_RETENTION_DAYS", default_value_t = 30)]
     pub retention_days: u32,
-    /// Largest accepted request body (bytes).
-    #[arg(long, env = "CHOCMODAL_MAX_BODY_BYTES", default_value_t = 1 << 20)]
-    pub max_body_bytes: usize,
     /// Lease of a running job (s): a worker that stops heartbeating loses its job after this long.
     #[arg(long, env = "CHOCMODAL_LEASE_SECONDS", default_value_t = 30)]
     pub lease_seconds: u64,
@@ -44,21 +47,49 @@ pub struct ServeArgs {
     /// On SIGTERM/ctrl-c, how long running jobs may take to finish (s) before they are handed back to the queue.
     #[arg(long, env = "CHOCMODAL_SHUTDOWN_GRACE_SECONDS", default_value_t = 30)]
     pub shutdown_grace_seconds: u64,
-    /// Most runs one sweep may expand into; larger sweeps are refused (422).
-    #[arg(long, env = "CHOCMODAL_MAX_SWEEP_RUNS", default_value_t = DEFAULT_MAX_SWEEP_RUNS)]
-    pub max_sweep_runs: usize,
     /// Log format on stderr.
     #[arg(long, env = "CHOCMODAL_LOG_FORMAT", value_enum, default_value = "human")]
     pub log_format: LogFormat,
 }
 
+/// `chocmodal serve`: the HTTP API, and workers unless `--workers 0`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ServeArgs {
+    /// Address to listen on.
+    #[arg(long, env = "CHOCMODAL_BIND", default_value = "127.0.0.1:8080")]
+    pub bind: SocketAddr,
+    #[command(flatten)]
+    pub queue: QueueArgs,
+    /// Largest accepted request body (bytes).
+    #[arg(long, env = "CHOCMODAL_MAX_BODY_BYTES", default_value_t = 1 << 20)]
+    pub max_body_bytes: usize,
+    /// Most runs one sweep may expand into; larger sweeps are refused (422).
+    #[arg(long, env = "CHOCMODAL_MAX_SWEEP_RUNS", default_value_t = DEFAULT_MAX_SWEEP_RUNS)]
+    pub max_sweep_runs: usize,
+}
+
+/// `chocmodal worker`: workers alone, no API (any number of such processes, on any
+/// machines, sharing one PostgreSQL database with the API processes).
+#[derive(Debug, Clone, clap::Args)]
+pub struct WorkerArgs {
+    #[command(flatten)]
+    pub queue: QueueArgs,
+    /// Also serve `/healthz` and `/metrics` on this address (e.g. `0.0.0.0:9090`).
+    #[arg(long, env = "CHOCMODAL_HEALTH_BIND", value_name = "ADDR")]
+    pub health_bind: Option<SocketAddr>,
+}
+
 /// Everything the service needs to start, with defaults for the knobs the CLI does not expose.
 #[derive(Debug, Clone)]
 pub struct ServiceConfig {
-    /// Address to listen on; port 0 picks a free port (tests).
+    /// Address the API listens on; port 0 picks a free port (tests).
     pub bind: SocketAddr,
-    /// Directory holding `chocmodal.sqlite`.
-    pub data_dir: PathBuf,
+    /// Worker role only: address of `/healthz` and `/metrics`, if any.
+    pub health_bind: Option<SocketAddr>,
+    /// The queue's database.
+    pub database: DatabaseUrl,
+    /// Largest number of connections to a PostgreSQL database.
+    pub database_connections: u32,
     /// Number of worker slots (jobs computed at once).
     pub workers: usize,
     /// Age after which finished jobs are deleted; `None` keeps them.
@@ -71,7 +102,7 @@ pub struct ServiceConfig {
     pub max_attempts: u32,
     /// Time running jobs get to finish on shutdown before they are handed back.
     pub shutdown_grace: Duration,
-    /// Period of lease recovery and retention.
+    /// Period of lease recovery and retention (every process runs them).
     pub maintenance_interval: Duration,
     /// Idle workers look for work at least this often (enqueues also wake them).
     pub poll_interval: Duration,
@@ -92,11 +123,19 @@ pub fn default_workers() -> usize {
 }
 
 impl ServiceConfig {
-    /// Defaults for a data directory (bind `127.0.0.1:8080`, one worker per core).
+    /// Defaults with the SQLite database `chocmodal.sqlite` in `data_dir` (bind
+    /// `127.0.0.1:8080`, one worker per core).
     pub fn new(data_dir: impl Into<PathBuf>) -> Self {
+        Self::with_database(DatabaseUrl::Sqlite(data_dir.into().join(SQLITE_FILE)))
+    }
+
+    /// Defaults with this database.
+    pub fn with_database(database: DatabaseUrl) -> Self {
         Self {
             bind: SocketAddr::from(([127, 0, 0, 1], 8080)),
-            data_dir: data_dir.into(),
+            health_bind: None,
+            database,
+            database_connections: 10,
             workers: default_workers(),
             retention: Some(Duration::from_secs(30 * 86_400)),
             max_body_bytes: 1 << 20,
@@ -111,25 +150,47 @@ impl ServiceConfig {
         }
     }
 
-    /// Path of the SQLite database file.
-    pub fn database_path(&self) -> PathBuf {
-        self.data_dir.join("chocmodal.sqlite")
+    /// Settings shared by both roles, from their flags.
+    fn from_queue_args(args: &QueueArgs) -> Self {
+        let lease = Duration::from_secs(args.lease_seconds.max(1));
+        let database = args
+            .database
+            .clone()
+            .unwrap_or_else(|| DatabaseUrl::Sqlite(args.data_dir.join(SQLITE_FILE)));
+        Self {
+            database_connections: args.database_connections.max(2),
+            workers: args.workers.unwrap_or_else(default_workers),
+            retention: (args.retention_days > 0)
+                .then(|| Duration::from_secs(u64::from(args.retention_days) * 86_400)),
+            lease,
+            // A lost worker's job is back in the queue within 1.5 leases.
+            maintenance_interval: (lease / 2).clamp(Duration::from_secs(1), Duration::from_secs(15)),
+            max_attempts: args.max_attempts.max(1),
+            shutdown_grace: Duration::from_secs(args.shutdown_grace_seconds),
+            ..Self::with_database(database)
+        }
     }
 }
+
+/// File name of the default SQLite database in the data directory.
+pub const SQLITE_FILE: &str = "chocmodal.sqlite";
 
 impl From<&ServeArgs> for ServiceConfig {
     fn from(args: &ServeArgs) -> Self {
         Self {
             bind: args.bind,
-            workers: args.workers.unwrap_or_else(default_workers),
-            retention: (args.retention_days > 0)
-                .then(|| Duration::from_secs(u64::from(args.retention_days) * 86_400)),
             max_body_bytes: args.max_body_bytes,
-            lease: Duration::from_secs(args.lease_seconds.max(1)),
-            max_attempts: args.max_attempts.max(1),
-            shutdown_grace: Duration::from_secs(args.shutdown_grace_seconds),
             max_sweep_runs: args.max_sweep_runs,
-            ..Self::new(args.data_dir.clone())
+            ..Self::from_queue_args(&args.queue)
+        }
+    }
+}
+
+impl From<&WorkerArgs> for ServiceConfig {
+    fn from(args: &WorkerArgs) -> Self {
+        Self {
+            health_bind: args.health_bind,
+            ..Self::from_queue_args(&args.queue)
         }
     }
 }

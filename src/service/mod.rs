@@ -1,5 +1,6 @@
-//! The service behind `chocmodal serve`: OGC API – Processes over HTTP, a durable job
-//! queue in SQLite, and workers that run the processes on their own threads.
+//! The service behind `chocmodal serve` and `chocmodal worker`: OGC API – Processes
+//! over HTTP, a durable job queue in SQLite or PostgreSQL ([`db`]), and workers that run
+//! the processes on their own threads, in the API process or in worker processes.
 //!
 //! Data flows one way: [`http`] validates an execution request with the process and
 //! [`queue`]s a job; a [`worker`] claims it, runs the process, and stores the results
@@ -18,12 +19,31 @@ pub mod telemetry;
 pub mod thinning;
 pub mod worker;
 
-pub use config::{ServeArgs, ServiceConfig};
-pub use startup::{Application, StartupError, shutdown_signal};
+pub use config::{ServeArgs, ServiceConfig, WorkerArgs};
+pub use startup::{Application, StartupError, WorkerService, shutdown_signal};
 
 /// `chocmodal serve`: logs, builds the service and serves until SIGTERM or ctrl-c.
 pub fn serve(args: &ServeArgs, registry: crate::processes::Registry) -> std::process::ExitCode {
-    telemetry::init(args.log_format);
+    telemetry::init(args.queue.log_format);
+    block_on(async {
+        let application = Application::build(ServiceConfig::from(args), registry).await?;
+        Ok(application.run_until_stopped().await?)
+    })
+}
+
+/// `chocmodal worker`: logs, starts the workers and works until SIGTERM or ctrl-c.
+pub fn worker(args: &WorkerArgs, registry: crate::processes::Registry) -> std::process::ExitCode {
+    telemetry::init(args.queue.log_format);
+    block_on(async {
+        let service = WorkerService::build(ServiceConfig::from(args), registry).await?;
+        Ok(service.run_until_stopped().await?)
+    })
+}
+
+/// Runs a role on a new runtime; any error is logged and fails the process.
+fn block_on(
+    role: impl std::future::Future<Output = Result<(), Box<dyn std::error::Error>>>,
+) -> std::process::ExitCode {
     let runtime = match tokio::runtime::Runtime::new() {
         Ok(runtime) => runtime,
         Err(error) => {
@@ -31,20 +51,11 @@ pub fn serve(args: &ServeArgs, registry: crate::processes::Registry) -> std::pro
             return std::process::ExitCode::FAILURE;
         }
     };
-    runtime.block_on(async {
-        let application = match Application::build(ServiceConfig::from(args), registry).await {
-            Ok(application) => application,
-            Err(error) => {
-                tracing::error!(%error, "cannot start");
-                return std::process::ExitCode::FAILURE;
-            }
-        };
-        match application.run_until_stopped().await {
-            Ok(()) => std::process::ExitCode::SUCCESS,
-            Err(error) => {
-                tracing::error!(%error, "server error");
-                std::process::ExitCode::FAILURE
-            }
+    match runtime.block_on(role) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(error) => {
+            tracing::error!(%error, "stopped on an error");
+            std::process::ExitCode::FAILURE
         }
-    })
+    }
 }

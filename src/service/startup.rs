@@ -1,8 +1,12 @@
-//! Assembling the service: database, queue, workers, maintenance and HTTP server.
+//! Assembling the service in either role: the API ([`Application`]: HTTP, and workers
+//! unless there are none) or workers alone ([`WorkerService`]: no API, an optional
+//! health and metrics port). Both open the database, recover jobs whose worker was lost,
+//! and run the queue maintenance periodically, so that lease recovery and retention
+//! happen whichever processes are up (they are safe to run in several at once).
 //!
-//! [`Application::build`] does everything that can fail (open and migrate the database,
-//! recover jobs left behind by a previous run, bind the port) and returns the bound
-//! address, so tests build it on port 0 and talk to it over real HTTP.
+//! `build` does everything that can fail (open and migrate the database, recover jobs
+//! left behind by a previous run, bind the ports) and returns the bound address, so
+//! tests build it on port 0 and talk to it over real HTTP.
 
 use std::future::Future;
 use std::net::SocketAddr;
@@ -11,9 +15,10 @@ use std::time::Duration;
 
 use tokio::net::TcpListener;
 use tokio::sync::Notify;
+use tokio::task::JoinHandle;
 
 use super::config::ServiceConfig;
-use super::db;
+use super::db::{self, Database};
 use super::http::{self, AppState};
 use super::metrics::Metrics;
 use super::queue::JobQueue;
@@ -23,10 +28,10 @@ use crate::processes::Registry;
 /// Why the service could not start.
 #[derive(Debug, thiserror::Error)]
 pub enum StartupError {
-    #[error("cannot create the data directory {path}: {source}")]
-    DataDir { path: String, source: std::io::Error },
-    #[error("cannot open the database: {0}")]
-    Database(#[from] sqlx::Error),
+    #[error("cannot open the database {database}: {source}")]
+    Database { database: String, source: sqlx::Error },
+    #[error("cannot recover the jobs of lost workers: {0}")]
+    Recovery(#[from] sqlx::Error),
     #[error("cannot listen on {address}: {source}")]
     Bind {
         address: SocketAddr,
@@ -34,32 +39,31 @@ pub enum StartupError {
     },
 }
 
-/// A built service, bound to its address, workers started, ready to serve.
+/// What both roles run: the queue, its maintenance, the worker slots and their wake-ups.
 #[derive(Debug)]
-pub struct Application {
-    address: SocketAddr,
-    listener: TcpListener,
-    router: axum::Router,
+struct Engine {
     queue: JobQueue,
-    workers: Workers,
-    maintenance: tokio::task::JoinHandle<()>,
-    shutdown_grace: Duration,
+    metrics: Metrics,
+    wake: Arc<Notify>,
+    running: RunningJobs,
+    maintenance: Maintenance,
+    workers: Option<Workers>,
+    background: Vec<JoinHandle<()>>,
 }
 
-impl Application {
-    /// Opens the database under `config.data_dir`, recovers jobs whose worker was lost,
-    /// binds `config.bind` and starts `config.workers` workers running `registry`'s processes.
-    pub async fn build(config: ServiceConfig, registry: Registry) -> Result<Self, StartupError> {
-        std::fs::create_dir_all(&config.data_dir).map_err(|source| StartupError::DataDir {
-            path: config.data_dir.display().to_string(),
-            source,
-        })?;
-        let pool = db::open(&config.database_path()).await?;
-        let queue = JobQueue::new(pool, config.clock.clone());
+impl Engine {
+    /// Opens the database and recovers the jobs whose lease expired (a previous run of
+    /// this or another process died).
+    async fn open(config: &ServiceConfig) -> Result<Self, StartupError> {
+        let database = Database::open(&config.database, config.database_connections)
+            .await
+            .map_err(|source| StartupError::Database {
+                database: config.database.to_string(),
+                source,
+            })?;
+        let queue = JobQueue::new(database, config.clock.clone());
         let metrics = Metrics::new();
         let wake = Arc::new(Notify::new());
-        let running = RunningJobs::default();
-
         let maintenance = Maintenance {
             queue: queue.clone(),
             metrics: metrics.clone(),
@@ -67,50 +71,108 @@ impl Application {
             max_attempts: config.max_attempts,
             retention: config.retention,
         };
-        // Jobs a previous run left `running` with an expired lease go back to the queue now.
         maintenance.run_once().await?;
+        Ok(Self {
+            queue,
+            metrics,
+            wake,
+            running: RunningJobs::default(),
+            maintenance,
+            workers: None,
+            background: Vec::new(),
+        })
+    }
 
-        let listener = TcpListener::bind(config.bind)
-            .await
-            .map_err(|source| StartupError::Bind {
-                address: config.bind,
-                source,
-            })?;
-        let address = listener.local_addr().map_err(|source| StartupError::Bind {
-            address: config.bind,
-            source,
-        })?;
-
+    /// Starts the worker slots, the periodic maintenance and, on PostgreSQL with
+    /// workers, the listener that wakes them when another process queues jobs.
+    fn start(&mut self, config: &ServiceConfig, registry: Registry) {
         let context = Arc::new(WorkerContext {
-            queue: queue.clone(),
-            registry: registry.clone(),
-            running: running.clone(),
-            metrics: metrics.clone(),
-            wake: wake.clone(),
+            queue: self.queue.clone(),
+            registry,
+            running: self.running.clone(),
+            metrics: self.metrics.clone(),
+            wake: self.wake.clone(),
             lease: config.lease,
             poll_interval: config.poll_interval,
             progress_interval: config.progress_interval,
         });
-        let workers = Workers::start(context, config.workers);
-        let maintenance = tokio::spawn(maintenance.run_every(config.maintenance_interval));
+        self.workers = Some(Workers::start(context, config.workers));
+        self.background.push(tokio::spawn(
+            self.maintenance.clone().run_every(config.maintenance_interval),
+        ));
+        if let Some(pool) = self.queue.database().as_postgres()
+            && config.workers > 0
+        {
+            self.background.push(tokio::spawn(db::postgres::wake_on_notify(
+                pool.clone(),
+                self.wake.clone(),
+            )));
+        }
+    }
 
-        let state = AppState {
-            queue: queue.clone(),
+    fn state(&self, registry: Registry, max_sweep_runs: usize) -> AppState {
+        AppState {
+            queue: self.queue.clone(),
             registry,
-            running,
-            metrics,
-            wake,
-            max_sweep_runs: config.max_sweep_runs,
-        };
-        let router = http::router(state, config.max_body_bytes);
-        tracing::info!(%address, workers = config.workers, database = %config.database_path().display(), "chocmodal is ready");
+            running: self.running.clone(),
+            metrics: self.metrics.clone(),
+            wake: self.wake.clone(),
+            max_sweep_runs,
+        }
+    }
+
+    /// Stops claiming, lets running jobs finish within `grace` (then hands them back),
+    /// stops the background tasks and closes the database.
+    async fn stop(self, grace: Duration) {
+        tracing::info!("shutting down: no new jobs are claimed");
+        if let Some(workers) = self.workers {
+            workers.shutdown(grace).await;
+        }
+        for task in &self.background {
+            task.abort();
+        }
+        self.queue.database().close().await;
+        tracing::info!("shut down");
+    }
+}
+
+async fn bind(address: SocketAddr) -> Result<(TcpListener, SocketAddr), StartupError> {
+    let listener = TcpListener::bind(address)
+        .await
+        .map_err(|source| StartupError::Bind { address, source })?;
+    let bound = listener
+        .local_addr()
+        .map_err(|source| StartupError::Bind { address, source })?;
+    Ok((listener, bound))
+}
+
+/// The API role, bound to its address, workers started, ready to serve.
+#[derive(Debug)]
+pub struct Application {
+    address: SocketAddr,
+    listener: TcpListener,
+    router: axum::Router,
+    engine: Engine,
+    shutdown_grace: Duration,
+}
+
+impl Application {
+    /// Opens `config.database`, recovers jobs whose worker was lost, binds
+    /// `config.bind` and starts `config.workers` workers running `registry`'s processes.
+    pub async fn build(config: ServiceConfig, registry: Registry) -> Result<Self, StartupError> {
+        let mut engine = Engine::open(&config).await?;
+        let (listener, address) = bind(config.bind).await?;
+        engine.start(&config, registry.clone());
+        let router = http::router(
+            engine.state(registry, config.max_sweep_runs),
+            config.max_body_bytes,
+        );
+        tracing::info!(%address, workers = config.workers, database = %config.database, "chocmodal is ready");
         Ok(Self {
             address,
             listener,
             router,
-            queue,
-            workers,
-            maintenance,
+            engine,
             shutdown_grace: config.shutdown_grace,
         })
     }
@@ -122,7 +184,7 @@ impl Application {
 
     /// The job queue (tests inspect and stage jobs through it).
     pub fn queue(&self) -> &JobQueue {
-        &self.queue
+        &self.engine.queue
     }
 
     /// Serves until SIGTERM or ctrl-c, then shuts down gracefully.
@@ -137,11 +199,79 @@ impl Application {
         let served = axum::serve(self.listener, self.router)
             .with_graceful_shutdown(stop)
             .await;
-        tracing::info!("shutting down: no new jobs are claimed");
-        self.workers.shutdown(self.shutdown_grace).await;
-        self.maintenance.abort();
-        self.queue.pool().close().await;
-        tracing::info!("shut down");
+        self.engine.stop(self.shutdown_grace).await;
+        served
+    }
+}
+
+/// The worker role: worker slots and queue maintenance, no API; `/healthz` and
+/// `/metrics` on `config.health_bind` when set.
+#[derive(Debug)]
+pub struct WorkerService {
+    health: Option<(SocketAddr, TcpListener, axum::Router)>,
+    engine: Engine,
+    workers: usize,
+    shutdown_grace: Duration,
+}
+
+impl WorkerService {
+    /// Opens `config.database`, recovers jobs whose worker was lost, binds the health
+    /// port if any and starts `config.workers` workers running `registry`'s processes.
+    pub async fn build(config: ServiceConfig, registry: Registry) -> Result<Self, StartupError> {
+        let mut engine = Engine::open(&config).await?;
+        let health = match config.health_bind {
+            Some(address) => {
+                let (listener, address) = bind(address).await?;
+                let router = http::health_router(engine.state(registry.clone(), config.max_sweep_runs));
+                Some((address, listener, router))
+            }
+            None => None,
+        };
+        engine.start(&config, registry);
+        tracing::info!(
+            workers = config.workers,
+            health = %health.as_ref().map_or_else(|| "none".to_owned(), |(address, _, _)| address.to_string()),
+            database = %config.database,
+            "chocmodal worker is ready"
+        );
+        Ok(Self {
+            health,
+            engine,
+            workers: config.workers,
+            shutdown_grace: config.shutdown_grace,
+        })
+    }
+
+    /// The bound health address, if any.
+    pub fn health_address(&self) -> Option<SocketAddr> {
+        self.health.as_ref().map(|(address, _, _)| *address)
+    }
+
+    /// The job queue.
+    pub fn queue(&self) -> &JobQueue {
+        &self.engine.queue
+    }
+
+    /// Number of worker slots.
+    pub fn workers(&self) -> usize {
+        self.workers
+    }
+
+    /// Works until SIGTERM or ctrl-c, then shuts down gracefully.
+    pub async fn run_until_stopped(self) -> std::io::Result<()> {
+        self.run_until(shutdown_signal()).await
+    }
+
+    /// Works until `stop` completes, then shuts down like [`Application::run_until`].
+    pub async fn run_until(self, stop: impl Future<Output = ()> + Send + 'static) -> std::io::Result<()> {
+        let served = match self.health {
+            Some((_, listener, router)) => axum::serve(listener, router).with_graceful_shutdown(stop).await,
+            None => {
+                stop.await;
+                Ok(())
+            }
+        };
+        self.engine.stop(self.shutdown_grace).await;
         served
     }
 }

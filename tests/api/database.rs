@@ -1,4 +1,4 @@
-//! The SQLite settings really apply, and retention deletes old finished jobs.
+//! The SQLite settings really apply, and retention deletes old finished jobs (both backends).
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -7,15 +7,16 @@ use chocmodal::service::clock::ManualClock;
 use reqwest::StatusCode;
 use serde_json::json;
 
-use crate::helpers::{assert_problem, spawn_app, spawn_app_with};
+use crate::helpers::{Backend, assert_problem, on_both_backends, spawn_app, spawn_app_on};
 
 #[tokio::test]
 async fn every_connection_uses_wal_a_busy_timeout_and_foreign_keys() {
     let app = spawn_app().await;
+    let sqlite = app.queue.database().as_sqlite().unwrap();
     // Hold several connections at once so that the pool has to open more than one.
     let mut connections = Vec::new();
     for _ in 0..3 {
-        connections.push(app.queue.pool().acquire().await.unwrap());
+        connections.push(sqlite.acquire().await.unwrap());
     }
     for connection in &mut connections {
         let journal_mode: String = sqlx::query_scalar("PRAGMA journal_mode")
@@ -41,16 +42,18 @@ async fn every_connection_uses_wal_a_busy_timeout_and_foreign_keys() {
     }
 }
 
-#[tokio::test]
-async fn retention_deletes_finished_jobs_and_their_histories() {
+on_both_backends!(retention_deletes_finished_jobs_and_their_histories);
+
+async fn retention_deletes_finished_jobs_and_their_histories(backend: Backend) {
     let clock = Arc::new(ManualClock::starting_now());
-    let app = spawn_app_with(|config| {
+    let app = spawn_app_on(backend, |config| {
         config.clock = clock.clone();
         config.retention = Some(Duration::from_secs(30 * 86_400));
     })
     .await;
     let old = app.submit(json!({"steps": 10})).await;
     app.wait_until_finished(&old).await;
+    assert!(app.queue.history(&old, "signal").await.unwrap().is_some());
     clock.advance(Duration::from_secs(20 * 86_400));
     let recent = app.submit(json!({"steps": 10})).await;
     app.wait_until_finished(&recent).await;
@@ -63,11 +66,9 @@ async fn retention_deletes_finished_jobs_and_their_histories() {
         "/no-such-job",
     )
     .await;
-    let histories: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM job_histories WHERE job_id = ?1")
-        .bind(&old)
-        .fetch_one(app.queue.pool())
-        .await
-        .unwrap();
-    assert_eq!(histories, 0, "histories go with their job");
+    assert!(
+        app.queue.history(&old, "signal").await.unwrap().is_none(),
+        "histories go with their job"
+    );
     assert_eq!(app.status(&recent).await["status"], "successful");
 }

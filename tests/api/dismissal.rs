@@ -6,11 +6,16 @@ use std::time::{Duration, Instant};
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use crate::helpers::{assert_problem, spawn_app, spawn_app_with};
+use crate::helpers::{Backend, assert_problem, on_both_backends, spawn_app_on};
 
-#[tokio::test]
-async fn a_dismissed_queued_job_never_runs() {
-    let app = spawn_app_with(|config| config.workers = 0).await;
+on_both_backends!(
+    a_dismissed_queued_job_never_runs,
+    a_dismissed_running_job_stops_within_a_second,
+    dismissing_a_finished_job_deletes_its_results
+);
+
+async fn a_dismissed_queued_job_never_runs(backend: Backend) {
+    let app = spawn_app_on(backend, |config| config.workers = 0).await;
     let job = app.submit(json!({"steps": 3})).await;
     let response = app.delete(&format!("/jobs/{job}")).await;
     assert_eq!(response.status(), StatusCode::OK);
@@ -27,9 +32,8 @@ async fn a_dismissed_queued_job_never_runs() {
     assert_eq!(app.probe.started(), 0);
 }
 
-#[tokio::test]
-async fn a_dismissed_running_job_stops_within_a_second() {
-    let app = spawn_app().await;
+async fn a_dismissed_running_job_stops_within_a_second(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
     // 100 000 steps of 1 ms: minutes of work unless cancelled.
     let job = app.submit(json!({"steps": 100000, "step_ms": 1})).await;
     app.wait_for(&job, &["running"], Duration::from_secs(5)).await;
@@ -71,9 +75,8 @@ async fn a_dismissed_running_job_stops_within_a_second() {
     );
 }
 
-#[tokio::test]
-async fn dismissing_a_finished_job_deletes_its_results() {
-    let app = spawn_app().await;
+async fn dismissing_a_finished_job_deletes_its_results(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
     let job = app.submit(json!({"steps": 10})).await;
     app.wait_until_finished(&job).await;
     assert_eq!(app.delete(&format!("/jobs/{job}")).await.status(), StatusCode::OK);

@@ -137,7 +137,7 @@ async fn bad_query_parameters_are_400_problems() {
 async fn a_server_fault_is_a_500_problem_that_reveals_no_internals() {
     let app = spawn_app().await;
     // Make every database access fail.
-    app.queue.pool().close().await;
+    app.queue.database().close().await;
     let problem = assert_problem(
         app.get("/jobs").await,
         StatusCode::INTERNAL_SERVER_ERROR,

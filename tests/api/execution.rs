@@ -5,11 +5,17 @@ use std::time::Duration;
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use crate::helpers::{spawn_app, spawn_app_with};
+use crate::helpers::{Backend, on_both_backends, spawn_app_on};
 
-#[tokio::test]
-async fn execution_returns_201_with_location_and_the_job_status() {
-    let app = spawn_app_with(|config| config.workers = 0).await;
+on_both_backends!(
+    execution_returns_201_with_location_and_the_job_status,
+    progress_is_reported_while_a_job_runs,
+    two_hundred_concurrent_submissions_all_land,
+    queued_jobs_run_oldest_first
+);
+
+async fn execution_returns_201_with_location_and_the_job_status(backend: Backend) {
+    let app = spawn_app_on(backend, |config| config.workers = 0).await;
     let response = app
         .post_execution("count-steps", &json!({"inputs": {"steps": 3}}))
         .await;
@@ -27,9 +33,8 @@ async fn execution_returns_201_with_location_and_the_job_status() {
     assert_eq!(app.status(job).await["status"], "accepted");
 }
 
-#[tokio::test]
-async fn progress_is_reported_while_a_job_runs() {
-    let app = spawn_app().await;
+async fn progress_is_reported_while_a_job_runs(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
     let job = app.submit(json!({"steps": 100, "step_ms": 15})).await;
     let mut seen = Vec::new();
     loop {
@@ -52,9 +57,8 @@ async fn progress_is_reported_while_a_job_runs() {
     );
 }
 
-#[tokio::test]
-async fn two_hundred_concurrent_submissions_all_land() {
-    let app = std::sync::Arc::new(spawn_app_with(|config| config.workers = 0).await);
+async fn two_hundred_concurrent_submissions_all_land(backend: Backend) {
+    let app = std::sync::Arc::new(spawn_app_on(backend, |config| config.workers = 0).await);
     let mut tasks = tokio::task::JoinSet::new();
     for _ in 0..20 {
         let app = app.clone();
@@ -81,9 +85,8 @@ async fn two_hundred_concurrent_submissions_all_land() {
     assert_eq!(jobs["jobs"].as_array().unwrap().len(), 200);
 }
 
-#[tokio::test]
-async fn queued_jobs_run_oldest_first() {
-    let app = spawn_app_with(|config| config.workers = 1).await;
+async fn queued_jobs_run_oldest_first(backend: Backend) {
+    let app = spawn_app_on(backend, |config| config.workers = 1).await;
     let mut jobs = Vec::new();
     for steps in [11, 12, 13, 14] {
         jobs.push(app.submit(json!({"steps": steps, "step_ms": 2})).await);

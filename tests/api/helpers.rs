@@ -1,9 +1,11 @@
-//! A real service on an ephemeral port with a fresh data directory, and typed requests.
+//! A real service on an ephemeral port with a fresh database (SQLite in a temporary
+//! directory, or a new PostgreSQL database), and typed requests.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use chocmodal::processes::{Process, Registry};
+use chocmodal::service::db::DatabaseUrl;
 use chocmodal::service::queue::JobQueue;
 use chocmodal::service::{Application, ServiceConfig};
 use reqwest::{Response, StatusCode};
@@ -14,6 +16,60 @@ use tokio::task::JoinHandle;
 
 use crate::counting::{self, CountSteps, Probe};
 
+/// The queue's database backend a test runs on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Backend {
+    Sqlite,
+    Postgres,
+}
+
+/// Defines each listed test, an `async fn(Backend)` of the calling module, once per
+/// backend: `<module>::sqlite::<name>` and `<module>::postgres::<name>`.
+macro_rules! on_both_backends {
+    ($($test:ident),+ $(,)?) => {
+        mod sqlite {
+            $(
+                #[tokio::test]
+                async fn $test() {
+                    super::$test($crate::helpers::Backend::Sqlite).await
+                }
+            )+
+        }
+        mod postgres {
+            $(
+                #[tokio::test]
+                async fn $test() {
+                    if $crate::postgres::skipped() {
+                        return;
+                    }
+                    super::$test($crate::helpers::Backend::Postgres).await
+                }
+            )+
+        }
+    };
+}
+pub(crate) use on_both_backends;
+
+/// Where a test service keeps its jobs: kept across a restart of the service.
+#[derive(Debug)]
+pub struct TestStore {
+    pub database: DatabaseUrl,
+    /// The SQLite file's directory (unused with PostgreSQL), deleted with the store.
+    _dir: TempDir,
+}
+
+impl TestStore {
+    /// A new empty database of `backend`.
+    pub async fn new(backend: Backend) -> Self {
+        let dir = TempDir::new().unwrap();
+        let database = match backend {
+            Backend::Sqlite => DatabaseUrl::Sqlite(dir.path().join("chocmodal.sqlite")),
+            Backend::Postgres => DatabaseUrl::Postgres(crate::postgres::fresh_database().await),
+        };
+        Self { database, _dir: dir }
+    }
+}
+
 /// A running test service.
 pub struct TestApp {
     /// `http://127.0.0.1:<port>`
@@ -21,14 +77,14 @@ pub struct TestApp {
     pub client: reqwest::Client,
     pub probe: Arc<Probe>,
     pub queue: JobQueue,
-    pub data_dir: TempDir,
+    pub store: Option<TestStore>,
     stop: Option<oneshot::Sender<()>>,
     served: Option<JoinHandle<std::io::Result<()>>>,
 }
 
-/// Test settings: 2 workers, quick polling and maintenance, SQLite under a fresh tempdir.
-pub fn test_config(data_dir: &TempDir) -> ServiceConfig {
-    let mut config = ServiceConfig::new(data_dir.path());
+/// Test settings: 2 workers, quick polling and maintenance, on `store`'s database.
+pub fn test_config(store: &TestStore) -> ServiceConfig {
+    let mut config = ServiceConfig::with_database(store.database.clone());
     config.bind = "127.0.0.1:0".parse().unwrap();
     config.workers = 2;
     config.poll_interval = Duration::from_millis(50);
@@ -39,7 +95,7 @@ pub fn test_config(data_dir: &TempDir) -> ServiceConfig {
 }
 
 /// Logs when `TEST_LOG` is set (`TEST_LOG=1 cargo test --test api -- --nocapture`).
-fn init_logs() {
+pub fn init_logs() {
     if std::env::var_os("TEST_LOG").is_some() {
         chocmodal::service::telemetry::init(chocmodal::service::config::LogFormat::Human);
     }
@@ -50,12 +106,17 @@ pub async fn spawn_app() -> TestApp {
 }
 
 pub async fn spawn_app_with(configure: impl FnOnce(&mut ServiceConfig)) -> TestApp {
-    spawn_app_in(TempDir::new().unwrap(), configure).await
+    spawn_app_on(Backend::Sqlite, configure).await
 }
 
-/// Starts a service on `data_dir` (a restart when it already holds a database).
-pub async fn spawn_app_in(data_dir: TempDir, configure: impl FnOnce(&mut ServiceConfig)) -> TestApp {
-    spawn_app_serving(data_dir, Vec::new(), configure).await
+/// Starts a service on a fresh database of `backend`.
+pub async fn spawn_app_on(backend: Backend, configure: impl FnOnce(&mut ServiceConfig)) -> TestApp {
+    spawn_app_in(TestStore::new(backend).await, configure).await
+}
+
+/// Starts a service on `store` (a restart when it already holds jobs).
+pub async fn spawn_app_in(store: TestStore, configure: impl FnOnce(&mut ServiceConfig)) -> TestApp {
+    spawn_app_serving(store, Vec::new(), configure).await
 }
 
 /// Starts a service that also offers the `extra` processes (e.g. the real ones).
@@ -63,16 +124,16 @@ pub async fn spawn_app_with_processes(
     extra: Vec<Arc<dyn Process>>,
     configure: impl FnOnce(&mut ServiceConfig),
 ) -> TestApp {
-    spawn_app_serving(TempDir::new().unwrap(), extra, configure).await
+    spawn_app_serving(TestStore::new(Backend::Sqlite).await, extra, configure).await
 }
 
 async fn spawn_app_serving(
-    data_dir: TempDir,
+    store: TestStore,
     extra: Vec<Arc<dyn Process>>,
     configure: impl FnOnce(&mut ServiceConfig),
 ) -> TestApp {
     init_logs();
-    let mut config = test_config(&data_dir);
+    let mut config = test_config(&store);
     configure(&mut config);
     let probe = Arc::new(Probe::default());
     let mut processes: Vec<Arc<dyn Process>> = vec![Arc::new(CountSteps { probe: probe.clone() })];
@@ -95,7 +156,7 @@ async fn spawn_app_serving(
             .unwrap(),
         probe,
         queue,
-        data_dir,
+        store: Some(store),
         stop: Some(stop),
         served: Some(served),
     }
@@ -174,15 +235,15 @@ impl TestApp {
         .await
     }
 
-    /// Stops the service gracefully and returns its data directory (to restart on it).
-    pub async fn stop(mut self) -> TempDir {
+    /// Stops the service gracefully and returns its database (to restart on it).
+    pub async fn stop(mut self) -> TestStore {
         if let Some(stop) = self.stop.take() {
             let _ = stop.send(());
         }
         if let Some(served) = self.served.take() {
             served.await.unwrap().unwrap();
         }
-        std::mem::replace(&mut self.data_dir, TempDir::new().unwrap())
+        self.store.take().expect("a running app has its store")
     }
 }
 

@@ -4,7 +4,14 @@ use std::collections::HashSet;
 
 use serde_json::{Value, json};
 
-use crate::helpers::{TestApp, spawn_app_with};
+use crate::helpers::{Backend, TestApp, on_both_backends, spawn_app_on};
+
+on_both_backends!(
+    jobs_are_listed_newest_first,
+    jobs_can_be_filtered_by_status_and_process,
+    paging_follows_next_links_through_every_job_once_even_while_jobs_arrive,
+    next_links_keep_the_filters
+);
 
 fn ids(page: &Value) -> Vec<String> {
     page["jobs"]
@@ -24,13 +31,12 @@ fn next_link(page: &Value) -> Option<String> {
         .map(|l| l["href"].as_str().unwrap().to_owned())
 }
 
-async fn queue_only() -> TestApp {
-    spawn_app_with(|config| config.workers = 0).await
+async fn queue_only(backend: Backend) -> TestApp {
+    spawn_app_on(backend, |config| config.workers = 0).await
 }
 
-#[tokio::test]
-async fn jobs_are_listed_newest_first() {
-    let app = queue_only().await;
+async fn jobs_are_listed_newest_first(backend: Backend) {
+    let app = queue_only(backend).await;
     let mut submitted = Vec::new();
     for _ in 0..4 {
         submitted.push(app.submit(json!({"steps": 1})).await);
@@ -39,9 +45,8 @@ async fn jobs_are_listed_newest_first() {
     assert_eq!(ids(&app.get_json("/jobs").await), submitted);
 }
 
-#[tokio::test]
-async fn jobs_can_be_filtered_by_status_and_process() {
-    let app = queue_only().await;
+async fn jobs_can_be_filtered_by_status_and_process(backend: Backend) {
+    let app = queue_only(backend).await;
     let first = app.submit(json!({"steps": 1})).await;
     let second = app.submit(json!({"steps": 1})).await;
     app.delete(&format!("/jobs/{first}")).await;
@@ -66,9 +71,8 @@ async fn jobs_can_be_filtered_by_status_and_process() {
     assert!(ids(&app.get_json("/jobs?status=running").await).is_empty());
 }
 
-#[tokio::test]
-async fn paging_follows_next_links_through_every_job_once_even_while_jobs_arrive() {
-    let app = queue_only().await;
+async fn paging_follows_next_links_through_every_job_once_even_while_jobs_arrive(backend: Backend) {
+    let app = queue_only(backend).await;
     let mut submitted = Vec::new();
     for _ in 0..7 {
         submitted.push(app.submit(json!({"steps": 1})).await);
@@ -97,9 +101,8 @@ async fn paging_follows_next_links_through_every_job_once_even_while_jobs_arrive
     assert_eq!(seen.iter().collect::<HashSet<_>>().len(), 7);
 }
 
-#[tokio::test]
-async fn next_links_keep_the_filters() {
-    let app = queue_only().await;
+async fn next_links_keep_the_filters(backend: Backend) {
+    let app = queue_only(backend).await;
     let mut dismissed = Vec::new();
     for i in 0..5 {
         let job = app.submit(json!({"steps": 1})).await;

@@ -1,8 +1,10 @@
-//! Service tests: each starts a real server on an ephemeral port with a fresh SQLite
-//! database and talks to it over HTTP, with a small test process (`counting`).
+//! Service tests: each starts a real server on an ephemeral port with a fresh database
+//! (SQLite, and for the queue's core flows PostgreSQL too: `<module>::postgres::<test>`)
+//! and talks to it over HTTP, with a small test process (`counting`).
 
 mod counting;
 mod helpers;
+mod postgres;
 
 mod capabilities;
 mod database;
@@ -15,4 +17,5 @@ mod physics;
 mod recovery;
 mod responsiveness;
 mod results;
+mod scale_out;
 mod sweeps;

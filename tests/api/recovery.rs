@@ -9,14 +9,22 @@ use chocmodal::service::clock::ManualClock;
 use reqwest::StatusCode;
 use serde_json::json;
 
-use crate::helpers::{assert_problem, spawn_app_in, spawn_app_with};
+use crate::helpers::{Backend, assert_problem, on_both_backends, spawn_app_in, spawn_app_on};
+
+on_both_backends!(
+    a_job_left_running_by_a_dead_worker_is_requeued_at_startup_and_completes,
+    a_job_whose_worker_keeps_dying_fails_with_a_clear_message,
+    expired_leases_are_recovered_periodically_once_the_clock_passes_them,
+    a_worker_that_lost_its_lease_can_neither_heartbeat_nor_write_results,
+    a_job_survives_a_server_restart,
+    a_graceful_shutdown_lets_a_running_job_finish_within_the_grace_period
+);
 
 /// Long enough that the periodic pass never runs during a test.
 const NO_MAINTENANCE: Duration = Duration::from_secs(3600);
 
-#[tokio::test]
-async fn a_job_left_running_by_a_dead_worker_is_requeued_at_startup_and_completes() {
-    let before = spawn_app_with(|config| {
+async fn a_job_left_running_by_a_dead_worker_is_requeued_at_startup_and_completes(backend: Backend) {
+    let before = spawn_app_on(backend, |config| {
         config.workers = 0;
         config.maintenance_interval = NO_MAINTENANCE;
     })
@@ -26,10 +34,10 @@ async fn a_job_left_running_by_a_dead_worker_is_requeued_at_startup_and_complete
     let claimed = before.queue.claim("dead-worker", Duration::ZERO).await.unwrap();
     assert_eq!(claimed.unwrap().lease.job_id, job);
     assert_eq!(before.status(&job).await["status"], "running");
-    let data_dir = before.stop().await;
+    let store = before.stop().await;
     tokio::time::sleep(Duration::from_millis(5)).await;
 
-    let after = spawn_app_in(data_dir, |config| config.workers = 1).await;
+    let after = spawn_app_in(store, |config| config.workers = 1).await;
     let status = after.wait_until_finished(&job).await;
     assert_eq!(status["status"], "successful", "{status}");
     assert_eq!(after.queue.get(&job).await.unwrap().unwrap().attempt, 2);
@@ -37,9 +45,8 @@ async fn a_job_left_running_by_a_dead_worker_is_requeued_at_startup_and_complete
     assert!(metrics.contains("chocmodal_jobs_rescued_total 1"), "{metrics}");
 }
 
-#[tokio::test]
-async fn a_job_whose_worker_keeps_dying_fails_with_a_clear_message() {
-    let app = spawn_app_with(|config| {
+async fn a_job_whose_worker_keeps_dying_fails_with_a_clear_message(backend: Backend) {
+    let app = spawn_app_on(backend, |config| {
         config.workers = 0;
         config.max_attempts = 2;
         config.maintenance_interval = NO_MAINTENANCE;
@@ -77,10 +84,9 @@ async fn a_job_whose_worker_keeps_dying_fails_with_a_clear_message() {
     assert_eq!(app.probe.started(), 0);
 }
 
-#[tokio::test]
-async fn expired_leases_are_recovered_periodically_once_the_clock_passes_them() {
+async fn expired_leases_are_recovered_periodically_once_the_clock_passes_them(backend: Backend) {
     let clock = Arc::new(ManualClock::starting_now());
-    let before = spawn_app_with(|config| {
+    let before = spawn_app_on(backend, |config| {
         config.workers = 0;
         config.clock = clock.clone();
     })
@@ -91,9 +97,9 @@ async fn expired_leases_are_recovered_periodically_once_the_clock_passes_them() 
         .claim("stalled-worker", Duration::from_secs(30))
         .await
         .unwrap();
-    let data_dir = before.stop().await;
+    let store = before.stop().await;
 
-    let app = spawn_app_in(data_dir, |config| {
+    let app = spawn_app_in(store, |config| {
         config.workers = 1;
         config.clock = clock.clone();
     })
@@ -112,10 +118,9 @@ async fn expired_leases_are_recovered_periodically_once_the_clock_passes_them() 
     assert_eq!(app.probe.started(), 1);
 }
 
-#[tokio::test]
-async fn a_worker_that_lost_its_lease_can_neither_heartbeat_nor_write_results() {
+async fn a_worker_that_lost_its_lease_can_neither_heartbeat_nor_write_results(backend: Backend) {
     let clock = Arc::new(ManualClock::starting_now());
-    let app = spawn_app_with(|config| {
+    let app = spawn_app_on(backend, |config| {
         config.workers = 0;
         config.clock = clock.clone();
         config.maintenance_interval = NO_MAINTENANCE;
@@ -155,41 +160,39 @@ async fn a_worker_that_lost_its_lease_can_neither_heartbeat_nor_write_results() 
     assert_eq!(results, json!({"fresh": true}));
 }
 
-#[tokio::test]
-async fn a_job_survives_a_server_restart() {
-    let before = spawn_app_with(|config| {
+async fn a_job_survives_a_server_restart(backend: Backend) {
+    let before = spawn_app_on(backend, |config| {
         config.workers = 1;
         config.shutdown_grace = Duration::from_millis(200);
     })
     .await;
     let job = before.submit(json!({"steps": 1500, "step_ms": 1})).await;
     before.wait_for(&job, &["running"], Duration::from_secs(5)).await;
-    let data_dir = before.stop().await;
+    let store = before.stop().await;
 
-    let after = spawn_app_in(data_dir, |config| config.workers = 0).await;
+    let after = spawn_app_in(store, |config| config.workers = 0).await;
     let record = after.queue.get(&job).await.unwrap().unwrap();
     assert_eq!(record.status.as_str(), "accepted", "handed back to the queue");
     assert_eq!(record.attempt, 0, "a hand-back does not count as a lost worker");
-    let data_dir = after.stop().await;
+    let store = after.stop().await;
 
-    let restarted = spawn_app_in(data_dir, |config| config.workers = 1).await;
+    let restarted = spawn_app_in(store, |config| config.workers = 1).await;
     let status = restarted.wait_until_finished(&job).await;
     assert_eq!(status["status"], "successful", "{status}");
     let results = restarted.get_json(&format!("/jobs/{job}/results")).await;
     assert_eq!(results["sum"], 1500 * 1501 / 2);
 }
 
-#[tokio::test]
-async fn a_graceful_shutdown_lets_a_running_job_finish_within_the_grace_period() {
-    let before = spawn_app_with(|config| {
+async fn a_graceful_shutdown_lets_a_running_job_finish_within_the_grace_period(backend: Backend) {
+    let before = spawn_app_on(backend, |config| {
         config.workers = 1;
         config.shutdown_grace = Duration::from_secs(10);
     })
     .await;
     let job = before.submit(json!({"steps": 300, "step_ms": 1})).await;
     before.wait_for(&job, &["running"], Duration::from_secs(5)).await;
-    let data_dir = before.stop().await;
+    let store = before.stop().await;
 
-    let after = spawn_app_in(data_dir, |config| config.workers = 0).await;
+    let after = spawn_app_in(store, |config| config.workers = 0).await;
     assert_eq!(after.status(&job).await["status"], "successful");
 }

@@ -6,11 +6,16 @@ use std::time::Duration;
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use crate::helpers::{assert_problem, spawn_app};
+use crate::helpers::{Backend, assert_problem, on_both_backends, spawn_app, spawn_app_on};
 
-#[tokio::test]
-async fn a_job_runs_to_success_and_serves_its_results_and_histories() {
-    let app = spawn_app().await;
+on_both_backends!(
+    a_job_runs_to_success_and_serves_its_results_and_histories,
+    a_deterministic_failure_fails_at_once_without_retry,
+    a_panicking_process_fails_only_its_own_job
+);
+
+async fn a_job_runs_to_success_and_serves_its_results_and_histories(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
     let job = app.submit(json!({"steps": 50})).await;
     let status = app.wait_until_finished(&job).await;
     assert_eq!(status["status"], "successful", "{status}");
@@ -125,9 +130,8 @@ async fn an_unknown_output_is_a_404_problem() {
     assert_problem(response, StatusCode::NOT_FOUND, "/no-such-output").await;
 }
 
-#[tokio::test]
-async fn a_deterministic_failure_fails_at_once_without_retry() {
-    let app = spawn_app().await;
+async fn a_deterministic_failure_fails_at_once_without_retry(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
     let job = app.submit(json!({"steps": 10, "fail_at": 5})).await;
     let status = app.wait_until_finished(&job).await;
     assert_eq!(status["status"], "failed");
@@ -147,9 +151,8 @@ async fn a_deterministic_failure_fails_at_once_without_retry() {
     assert_eq!(app.queue.get(&job).await.unwrap().unwrap().attempt, 1);
 }
 
-#[tokio::test]
-async fn a_panicking_process_fails_only_its_own_job() {
-    let app = spawn_app().await;
+async fn a_panicking_process_fails_only_its_own_job(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
     let crashing = app.submit(json!({"steps": 10, "panic_at": 3})).await;
     let healthy = app.submit(json!({"steps": 10})).await;
     assert_eq!(app.wait_until_finished(&crashing).await["status"], "failed");

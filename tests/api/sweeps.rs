@@ -11,7 +11,18 @@ use reqwest::StatusCode;
 use serde_json::{Value, json};
 
 use crate::counting;
-use crate::helpers::{TestApp, assert_problem, spawn_app, spawn_app_with, spawn_app_with_processes};
+use crate::helpers::{
+    Backend, TestApp, assert_problem, on_both_backends, spawn_app, spawn_app_on, spawn_app_with_processes,
+};
+
+on_both_backends!(
+    a_grid_runs_every_cell_once_and_tabulates_axes_then_metrics,
+    dismissing_a_sweep_dismisses_its_queued_and_running_runs,
+    a_failed_run_of_a_fail_fast_sweep_dismisses_the_rest_and_fails_the_sweep,
+    identical_runs_are_computed_once_across_single_jobs_and_sweeps,
+    single_jobs_submitted_after_a_big_sweep_do_not_wait_for_it,
+    sweeps_are_listed_newest_first_with_paging_and_unknown_ones_are_404
+);
 
 impl TestApp {
     pub async fn post_sweep(&self, body: &Value) -> reqwest::Response {
@@ -74,9 +85,8 @@ fn column(results: &Value, name: &str) -> Vec<f64> {
         .collect()
 }
 
-#[tokio::test]
-async fn a_grid_runs_every_cell_once_and_tabulates_axes_then_metrics() {
-    let app = spawn_app().await;
+async fn a_grid_runs_every_cell_once_and_tabulates_axes_then_metrics(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
     let id = app
         .create_sweep(sweep(
             json!({"steps": 1, "step_ms": 0.0}),
@@ -231,9 +241,8 @@ async fn an_invalid_run_is_named_by_run_and_pointer_and_nothing_is_queued() {
     assert_eq!(app.get_json("/sweeps").await["sweeps"], json!([]));
 }
 
-#[tokio::test]
-async fn dismissing_a_sweep_dismisses_its_queued_and_running_runs() {
-    let app = spawn_app().await;
+async fn dismissing_a_sweep_dismisses_its_queued_and_running_runs(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
     let id = app
         .create_sweep(sweep(
             json!({"steps": 400, "step_ms": 10.0}),
@@ -260,9 +269,8 @@ async fn dismissing_a_sweep_dismisses_its_queued_and_running_runs() {
     assert_eq!(app.probe.started(), 2, "no dismissed run may start");
 }
 
-#[tokio::test]
-async fn a_failed_run_of_a_fail_fast_sweep_dismisses_the_rest_and_fails_the_sweep() {
-    let app = spawn_app_with(|config| config.workers = 1).await;
+async fn a_failed_run_of_a_fail_fast_sweep_dismisses_the_rest_and_fails_the_sweep(backend: Backend) {
+    let app = spawn_app_on(backend, |config| config.workers = 1).await;
     let mut body = sweep(
         json!({"steps": 1, "fail_at": 4}),
         json!([{"pointer": "/steps", "values": [3, 4, 5, 6]}]),
@@ -348,9 +356,8 @@ async fn monte_carlo_aggregates_match_the_law_and_the_rows() {
     );
 }
 
-#[tokio::test]
-async fn identical_runs_are_computed_once_across_single_jobs_and_sweeps() {
-    let app = spawn_app_with(|config| config.workers = 1).await;
+async fn identical_runs_are_computed_once_across_single_jobs_and_sweeps(backend: Backend) {
+    let app = spawn_app_on(backend, |config| config.workers = 1).await;
     let single = app.submit(json!({"steps": 7})).await;
     app.wait_until_finished(&single).await;
     assert_eq!(app.probe.started(), 1);
@@ -390,9 +397,8 @@ async fn identical_runs_are_computed_once_across_single_jobs_and_sweeps() {
     );
 }
 
-#[tokio::test]
-async fn single_jobs_submitted_after_a_big_sweep_do_not_wait_for_it() {
-    let app = spawn_app_with(|config| config.workers = 1).await;
+async fn single_jobs_submitted_after_a_big_sweep_do_not_wait_for_it(backend: Backend) {
+    let app = spawn_app_on(backend, |config| config.workers = 1).await;
     let steps: Vec<u64> = (10..30).collect();
     let id = app
         .create_sweep(sweep(
@@ -491,9 +497,8 @@ async fn a_calibration_grid_maps_validity_shrinking_as_rk_and_time_step_grow() {
     assert_eq!(problem["errors"][0]["pointer"], "/inputs/solver/time_step");
 }
 
-#[tokio::test]
-async fn sweeps_are_listed_newest_first_with_paging_and_unknown_ones_are_404() {
-    let app = spawn_app().await;
+async fn sweeps_are_listed_newest_first_with_paging_and_unknown_ones_are_404(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
     let mut ids = Vec::new();
     for steps in [1, 2, 3] {
         ids.push(

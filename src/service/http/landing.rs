@@ -120,11 +120,8 @@ pub async fn conformance() -> Json<Conformance> {
         (status = 503, description = "The database does not respond", body = super::openapi::ProblemSchema,
             content_type = "application/problem+json")))]
 pub async fn healthz(State(state): State<AppState>) -> Response {
-    match sqlx::query_scalar::<_, i64>("SELECT 1")
-        .fetch_one(state.queue.pool())
-        .await
-    {
-        Ok(_) => Json(Health { status: "ok" }).into_response(),
+    match state.queue.database().ping().await {
+        Ok(()) => Json(Health { status: "ok" }).into_response(),
         Err(error) => {
             tracing::error!(%error, "health check: database unavailable");
             crate::problem::Problem::from_status(503, "Service Unavailable", "the database does not respond")

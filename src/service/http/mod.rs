@@ -93,6 +93,15 @@ pub fn router(state: AppState, max_body_bytes: usize) -> Router {
         .with_state(state)
 }
 
+/// The worker role's optional port: liveness and metrics only.
+pub fn health_router(state: AppState) -> Router {
+    Router::new()
+        .route("/healthz", get(landing::healthz))
+        .route("/metrics", get(landing::metrics))
+        .fallback(not_found)
+        .with_state(state)
+}
+
 /// Unknown routes: 404 problem.
 async fn not_found(uri: Uri) -> Response {
     Problem::from_status(

@@ -2,12 +2,13 @@
 //!
 //! Only the lease's owner, for the same attempt, on a job still `running`, can extend it:
 //! when the statement touches no row the worker has lost the job (dismissed, or
-//! recovered by another instance after a stall) and must stop.
+//! recovered by another worker or process after a stall) and must stop.
 
 use std::time::Duration;
 
 use super::{JobQueue, Lease};
 use crate::service::clock::duration_ms;
+use crate::service::db::with_pool;
 
 impl JobQueue {
     /// Extends the lease to now + `lease`, and sets `progress` (percent) when given; the
@@ -20,35 +21,40 @@ impl JobQueue {
         lease_for: Duration,
     ) -> Result<bool, sqlx::Error> {
         let now = self.now();
-        let result = sqlx::query(
-            "UPDATE jobs SET lease_expires_at = ?4, \
-                 updated_at = CASE WHEN ?5 IS NOT NULL AND ?5 <> progress THEN ?6 ELSE updated_at END, \
-                 progress = COALESCE(?5, progress) \
-             WHERE id = ?1 AND lease_owner = ?2 AND attempt = ?3 AND status = 'running' \
-                 AND cancel_requested = 0",
-        )
-        .bind(&lease.job_id)
-        .bind(&lease.owner)
-        .bind(lease.attempt)
-        .bind(now.saturating_add(duration_ms(lease_for)))
-        .bind(progress.map(i64::from))
-        .bind(now)
-        .execute(&self.pool)
-        .await?;
-        Ok(result.rows_affected() == 1)
+        let updated = with_pool!(&self.db, pool => {
+            sqlx::query(
+                "UPDATE jobs SET lease_expires_at = $4, \
+                     updated_at = CASE WHEN $5 IS NOT NULL AND $5 <> progress THEN $6 ELSE updated_at END, \
+                     progress = COALESCE($5, progress) \
+                 WHERE id = $1 AND lease_owner = $2 AND attempt = $3 AND status = 'running' \
+                     AND NOT cancel_requested",
+            )
+            .bind(&lease.job_id)
+            .bind(&lease.owner)
+            .bind(lease.attempt)
+            .bind(now.saturating_add(duration_ms(lease_for)))
+            .bind(progress.map(i64::from))
+            .bind(now)
+            .execute(pool)
+            .await?
+            .rows_affected()
+        });
+        Ok(updated == 1)
     }
 
     /// Whether the lease is still held (a read: cheap enough to poll for cancellation).
     pub async fn is_held(&self, lease: &Lease) -> Result<bool, sqlx::Error> {
-        let held: Option<i64> = sqlx::query_scalar(
-            "SELECT 1 FROM jobs WHERE id = ?1 AND lease_owner = ?2 AND attempt = ?3 \
-                 AND status = 'running' AND cancel_requested = 0",
-        )
-        .bind(&lease.job_id)
-        .bind(&lease.owner)
-        .bind(lease.attempt)
-        .fetch_optional(&self.pool)
-        .await?;
+        let held: Option<i64> = with_pool!(&self.db, pool => {
+            sqlx::query_scalar(
+                "SELECT attempt FROM jobs WHERE id = $1 AND lease_owner = $2 AND attempt = $3 \
+                     AND status = 'running' AND NOT cancel_requested",
+            )
+            .bind(&lease.job_id)
+            .bind(&lease.owner)
+            .bind(lease.attempt)
+            .fetch_optional(pool)
+            .await?
+        });
         Ok(held.is_some())
     }
 }

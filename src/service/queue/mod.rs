@@ -1,11 +1,14 @@
-//! The durable job queue, one table in SQLite (`migrations/0001_jobs.sql`).
+//! The durable job queue: a `jobs` table in SQLite or PostgreSQL ([`Database`]), the
+//! same statements and guarantees on both (`migrations/`, `migrations/postgres/`).
 //!
 //! Life of a job: `accepted` (enqueued) → `running` (claimed by a worker, under a lease
 //! that its heartbeat renews) → `successful` | `failed` | `dismissed`. Every write a
 //! worker makes after its claim is guarded by its [`Lease`] (owner and attempt), so a
 //! worker that lost its lease (it stalled, the job was dismissed, recovery re-queued it)
 //! can never overwrite the row. No transaction is held while a job computes: each step
-//! is one short statement. One operation per file:
+//! is one short statement. Each operation runs the same Rust on either backend
+//! (`with_pool!`); where SQL differs, both texts sit side by side in its file. One
+//! operation per file:
 //!
 //! - [`enqueue`]: insert an accepted job;
 //! - [`claim`]: atomically take the oldest accepted job;
@@ -33,9 +36,8 @@ pub mod sweep_create;
 pub mod sweep_dismiss;
 pub mod sweep_read;
 
-use sqlx::SqlitePool;
-
 use super::clock::SharedClock;
+use super::db::Database;
 
 /// Status of a job (OGC API – Processes `statusCode`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize, utoipa::ToSchema)]
@@ -117,9 +119,14 @@ macro_rules! record_columns {
 }
 pub(crate) use record_columns;
 
-impl<'r> sqlx::FromRow<'r, sqlx::sqlite::SqliteRow> for JobRecord {
-    fn from_row(row: &'r sqlx::sqlite::SqliteRow) -> Result<Self, sqlx::Error> {
-        use sqlx::Row;
+impl<'r, R> sqlx::FromRow<'r, R> for JobRecord
+where
+    R: sqlx::Row,
+    &'r str: sqlx::ColumnIndex<R>,
+    String: sqlx::Decode<'r, R::Database> + sqlx::Type<R::Database>,
+    i64: sqlx::Decode<'r, R::Database> + sqlx::Type<R::Database>,
+{
+    fn from_row(row: &'r R) -> Result<Self, sqlx::Error> {
         let status: String = row.try_get("status")?;
         let progress: i64 = row.try_get("progress")?;
         Ok(Self {
@@ -166,20 +173,20 @@ pub struct ClaimedJob {
     pub started_at: i64,
 }
 
-/// The queue: a database pool and the clock that stamps every write.
+/// The queue: a database (either backend) and the clock that stamps every write.
 #[derive(Debug, Clone)]
 pub struct JobQueue {
-    pool: SqlitePool,
+    db: Database,
     clock: SharedClock,
 }
 
 impl JobQueue {
-    pub fn new(pool: SqlitePool, clock: SharedClock) -> Self {
-        Self { pool, clock }
+    pub fn new(db: Database, clock: SharedClock) -> Self {
+        Self { db, clock }
     }
 
-    pub fn pool(&self) -> &SqlitePool {
-        &self.pool
+    pub fn database(&self) -> &Database {
+        &self.db
     }
 
     pub fn clock(&self) -> &SharedClock {

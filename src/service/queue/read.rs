@@ -3,7 +3,31 @@
 use sqlx::Row;
 
 use super::{JobQueue, JobRecord, JobStatus, record_columns};
+use crate::service::db::with_pool;
 use crate::service::store::StoredHistory;
+
+/// `GET /jobs`. Each list filter is one parameter, a JSON array of text (NULL: any),
+/// whatever its length.
+const LIST_SQLITE: &str = concat!(
+    "SELECT ",
+    record_columns!(),
+    " FROM jobs \
+     WHERE ($1 IS NULL OR status IN (SELECT value FROM json_each($1))) \
+       AND ($2 IS NULL OR process_id IN (SELECT value FROM json_each($2))) \
+       AND ($3 IS NULL OR seq < $3) \
+       AND ($5 IS NULL OR sweep_id IN (SELECT value FROM json_each($5))) \
+     ORDER BY seq DESC LIMIT $4"
+);
+const LIST_POSTGRES: &str = concat!(
+    "SELECT ",
+    record_columns!(),
+    " FROM jobs \
+     WHERE ($1 IS NULL OR status IN (SELECT json_array_elements_text(CAST($1 AS json)))) \
+       AND ($2 IS NULL OR process_id IN (SELECT json_array_elements_text(CAST($2 AS json)))) \
+       AND ($3 IS NULL OR seq < $3) \
+       AND ($5 IS NULL OR sweep_id IN (SELECT json_array_elements_text(CAST($5 AS json)))) \
+     ORDER BY seq DESC LIMIT $4"
+);
 
 /// Filters of `GET /jobs`; an empty list means "any".
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -26,10 +50,12 @@ pub struct JobOutcome {
 
 impl JobQueue {
     pub async fn get(&self, id: &str) -> Result<Option<JobRecord>, sqlx::Error> {
-        sqlx::query_as(concat!("SELECT ", record_columns!(), " FROM jobs WHERE id = ?1"))
-            .bind(id)
-            .fetch_optional(&self.pool)
-            .await
+        with_pool!(&self.db, pool => {
+            sqlx::query_as(concat!("SELECT ", record_columns!(), " FROM jobs WHERE id = $1"))
+                .bind(id)
+                .fetch_optional(pool)
+                .await
+        })
     }
 
     /// Up to `limit` jobs matching `filter`, newest first, strictly older than the job
@@ -48,64 +74,60 @@ impl JobQueue {
             .then(|| serde_json::to_string(&filter.process_ids).unwrap_or_default());
         let sweep_ids = (!filter.sweep_ids.is_empty())
             .then(|| serde_json::to_string(&filter.sweep_ids).unwrap_or_default());
-        sqlx::query_as(concat!(
-            "SELECT ",
-            record_columns!(),
-            " FROM jobs \
-             WHERE (?1 IS NULL OR status IN (SELECT value FROM json_each(?1))) \
-               AND (?2 IS NULL OR process_id IN (SELECT value FROM json_each(?2))) \
-               AND (?3 IS NULL OR seq < ?3) \
-               AND (?5 IS NULL OR sweep_id IN (SELECT value FROM json_each(?5))) \
-             ORDER BY seq DESC LIMIT ?4"
-        ))
-        .bind(statuses)
-        .bind(process_ids)
-        .bind(before)
-        .bind(i64::from(limit))
-        .bind(sweep_ids)
-        .fetch_all(&self.pool)
-        .await
+        let sql = self.db.choose(LIST_SQLITE, LIST_POSTGRES);
+        with_pool!(&self.db, pool => {
+            sqlx::query_as(sql)
+                .bind(&statuses)
+                .bind(&process_ids)
+                .bind(before)
+                .bind(i64::from(limit))
+                .bind(&sweep_ids)
+                .fetch_all(pool)
+                .await
+        })
     }
 
     pub async fn outcome(&self, id: &str) -> Result<Option<JobOutcome>, sqlx::Error> {
-        let row = sqlx::query(concat!(
-            "SELECT ",
-            record_columns!(),
-            ", results, error FROM jobs WHERE id = ?1"
-        ))
-        .bind(id)
-        .fetch_optional(&self.pool)
-        .await?;
-        row.map(|row| {
-            Ok(JobOutcome {
-                record: sqlx::FromRow::from_row(&row)?,
-                results: row.try_get("results")?,
-                error: row.try_get("error")?,
+        with_pool!(&self.db, pool => {
+            let row = sqlx::query(concat!(
+                "SELECT ",
+                record_columns!(),
+                ", results, error FROM jobs WHERE id = $1"
+            ))
+            .bind(id)
+            .fetch_optional(pool)
+            .await?;
+            row.map(|row| {
+                Ok(JobOutcome {
+                    record: sqlx::FromRow::from_row(&row)?,
+                    results: row.try_get("results")?,
+                    error: row.try_get("error")?,
+                })
             })
+            .transpose()
         })
-        .transpose()
     }
 
     /// The stored history `name` of job `id`.
     pub async fn history(&self, id: &str, name: &str) -> Result<Option<StoredHistory>, sqlx::Error> {
-        let row = sqlx::query(
-            "SELECT name, series, samples, data FROM job_histories WHERE job_id = ?1 AND name = ?2",
-        )
-        .bind(id)
-        .bind(name)
-        .fetch_optional(&self.pool)
-        .await?;
-        row.map(|row| {
-            let series: String = row.try_get("series")?;
-            let samples: i64 = row.try_get("samples")?;
+        let row = with_pool!(&self.db, pool => {
+            sqlx::query_as::<_, (String, String, i64, Vec<u8>)>(
+                "SELECT name, series, samples, data FROM job_histories WHERE job_id = $1 AND name = $2",
+            )
+            .bind(id)
+            .bind(name)
+            .fetch_optional(pool)
+            .await?
+        });
+        row.map(|(name, series, samples, data)| {
             Ok(StoredHistory {
-                name: row.try_get("name")?,
+                name,
                 series: serde_json::from_str(&series).map_err(|e| sqlx::Error::ColumnDecode {
                     index: "series".into(),
                     source: Box::new(e),
                 })?,
                 samples: usize::try_from(samples).unwrap_or(0),
-                data: row.try_get("data")?,
+                data,
             })
         })
         .transpose()
@@ -113,9 +135,11 @@ impl JobQueue {
 
     /// Number of jobs in each status (every status present, zeros included).
     pub async fn count_by_status(&self) -> Result<Vec<(JobStatus, i64)>, sqlx::Error> {
-        let rows: Vec<(String, i64)> = sqlx::query_as("SELECT status, COUNT(*) FROM jobs GROUP BY status")
-            .fetch_all(&self.pool)
-            .await?;
+        let rows: Vec<(String, i64)> = with_pool!(&self.db, pool => {
+            sqlx::query_as("SELECT status, COUNT(*) FROM jobs GROUP BY status")
+                .fetch_all(pool)
+                .await?
+        });
         Ok(JobStatus::ALL
             .into_iter()
             .map(|status| {

@@ -6,61 +6,76 @@
 //! together (in one sweep, or while the first one computes) are computed once too.
 
 use super::{JobQueue, Lease};
+use crate::service::db::with_pool;
+
+/// Completes the leased job ($1–$3) with results $5 copied from job $6, only while $6
+/// is still successful. SQLite: this first write takes the database's write lock, so
+/// the source cannot change before the histories are copied. PostgreSQL: the source
+/// row is locked `FOR SHARE` (a dismissal or purge of it waits for this transaction).
+const TAKE_SQLITE: &str = "\
+    UPDATE jobs SET status = 'successful', progress = 100, finished_at = $4, updated_at = $4, \
+        lease_owner = NULL, lease_expires_at = NULL, results = $5, \
+        message = 'finished: reused the results of job ' || $6 \
+    WHERE id = $1 AND lease_owner = $2 AND attempt = $3 AND status = 'running' \
+        AND EXISTS (SELECT 1 FROM jobs WHERE id = $6 AND status = 'successful')";
+
+const TAKE_POSTGRES: &str = "\
+    UPDATE jobs SET status = 'successful', progress = 100, finished_at = $4, updated_at = $4, \
+        lease_owner = NULL, lease_expires_at = NULL, results = $5, \
+        message = 'finished: reused the results of job ' || $6 \
+    WHERE id = $1 AND lease_owner = $2 AND attempt = $3 AND status = 'running' \
+        AND EXISTS (SELECT 1 FROM jobs source WHERE source.id = $6 AND source.status = 'successful' \
+            FOR SHARE OF source)";
 
 impl JobQueue {
     /// If a successful job has `hash`, completes the leased job with a copy of its
     /// results and histories and returns that job's id; `None` when nothing matches
     /// (or the lease was lost).
     pub async fn reuse(&self, lease: &Lease, hash: &str) -> Result<Option<String>, sqlx::Error> {
-        let source: Option<(String, String)> = sqlx::query_as(
-            "SELECT id, results FROM jobs \
-             WHERE content_hash = ?1 AND status = 'successful' AND id <> ?2 AND results IS NOT NULL \
-             ORDER BY seq LIMIT 1",
-        )
-        .bind(hash)
-        .bind(&lease.job_id)
-        .fetch_optional(&self.pool)
-        .await?;
-        let Some((source_id, results)) = source else {
-            return Ok(None);
-        };
-        // The results document links to the histories of its own job.
-        let results = results.replace(
-            &format!("/jobs/{source_id}/"),
-            &format!("/jobs/{}/", lease.job_id),
-        );
-        let now = self.now();
-        let mut tx = self.pool.begin().await?;
-        // Writes first (the transaction holds the write lock from here), and only while
-        // the source is still successful: its histories are then copied whole.
-        let updated = sqlx::query(
-            "UPDATE jobs SET status = 'successful', progress = 100, finished_at = ?4, updated_at = ?4, \
-                 lease_owner = NULL, lease_expires_at = NULL, results = ?5, \
-                 message = 'finished: reused the results of job ' || ?6 \
-             WHERE id = ?1 AND lease_owner = ?2 AND attempt = ?3 AND status = 'running' \
-                 AND EXISTS (SELECT 1 FROM jobs WHERE id = ?6 AND status = 'successful')",
-        )
-        .bind(&lease.job_id)
-        .bind(&lease.owner)
-        .bind(lease.attempt)
-        .bind(now)
-        .bind(&results)
-        .bind(&source_id)
-        .execute(&mut *tx)
-        .await?;
-        if updated.rows_affected() != 1 {
-            tx.rollback().await?;
-            return Ok(None);
-        }
-        sqlx::query(
-            "INSERT INTO job_histories (job_id, name, series, samples, data) \
-             SELECT ?1, name, series, samples, data FROM job_histories WHERE job_id = ?2",
-        )
-        .bind(&lease.job_id)
-        .bind(&source_id)
-        .execute(&mut *tx)
-        .await?;
-        tx.commit().await?;
-        Ok(Some(source_id))
+        let take = self.db.choose(TAKE_SQLITE, TAKE_POSTGRES);
+        with_pool!(&self.db, pool => {
+            let source: Option<(String, String)> = sqlx::query_as(
+                "SELECT id, results FROM jobs \
+                 WHERE content_hash = $1 AND status = 'successful' AND id <> $2 AND results IS NOT NULL \
+                 ORDER BY seq LIMIT 1",
+            )
+            .bind(hash)
+            .bind(&lease.job_id)
+            .fetch_optional(pool)
+            .await?;
+            let Some((source_id, results)) = source else {
+                return Ok(None);
+            };
+            // The results document links to the histories of its own job.
+            let results = results.replace(
+                &format!("/jobs/{source_id}/"),
+                &format!("/jobs/{}/", lease.job_id),
+            );
+            let now = self.now();
+            let mut tx = pool.begin().await?;
+            let updated = sqlx::query(take)
+                .bind(&lease.job_id)
+                .bind(&lease.owner)
+                .bind(lease.attempt)
+                .bind(now)
+                .bind(&results)
+                .bind(&source_id)
+                .execute(&mut *tx)
+                .await?;
+            if updated.rows_affected() != 1 {
+                tx.rollback().await?;
+                return Ok(None);
+            }
+            sqlx::query(
+                "INSERT INTO job_histories (job_id, name, series, samples, data) \
+                 SELECT $1, name, series, samples, data FROM job_histories WHERE job_id = $2",
+            )
+            .bind(&lease.job_id)
+            .bind(&source_id)
+            .execute(&mut *tx)
+            .await?;
+            tx.commit().await?;
+            Ok(Some(source_id))
+        })
     }
 }

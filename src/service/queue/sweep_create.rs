@@ -1,14 +1,40 @@
 //! Create a sweep: the sweep row and all its runs, as `accepted` jobs, in one
 //! transaction (a sweep is queued whole or not at all).
 //!
-//! The runs go in with one `INSERT ... SELECT FROM json_each(?)` statement: ten
-//! thousand runs are one round trip to the database, not ten thousand.
+//! The runs go in with one `INSERT ... SELECT` over a JSON array parameter
+//! (`json_each` in SQLite, `jsonb_array_elements` in PostgreSQL): ten thousand runs are
+//! one round trip to the database, not ten thousand.
 
 use serde_json::{Value, json};
 
 use super::content_hash::content_hash;
 use super::{JobQueue, SweepRecord, sweep_columns};
 use crate::problem::Problem;
+use crate::service::db::with_pool;
+
+/// Inserts the runs of sweep $3 of process $1 at time $2 from $4, a JSON array of
+/// `{id, run, inputs, hash, error, message}` (an `error` makes the run `failed`).
+const RUNS_SQLITE: &str = "\
+    INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
+        finished_at, error, sweep_id, sweep_run, content_hash) \
+    SELECT json_extract(value, '$.id'), $1, json_extract(value, '$.inputs'), \
+        CASE WHEN json_extract(value, '$.error') IS NULL THEN 'accepted' ELSE 'failed' END, 0, \
+        COALESCE(json_extract(value, '$.message'), \
+            'queued (sweep run ' || json_extract(value, '$.run') || ')'), $2, $2, \
+        CASE WHEN json_extract(value, '$.error') IS NULL THEN NULL ELSE $2 END, \
+        json_extract(value, '$.error'), $3, json_extract(value, '$.run'), json_extract(value, '$.hash') \
+    FROM json_each($4) ORDER BY key";
+
+const RUNS_POSTGRES: &str = "\
+    INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
+        finished_at, error, sweep_id, sweep_run, content_hash) \
+    SELECT run->>'id', $1, run->>'inputs', \
+        CASE WHEN run->>'error' IS NULL THEN 'accepted' ELSE 'failed' END, 0, \
+        COALESCE(run->>'message', 'queued (sweep run ' || (run->>'run') || ')'), $2, $2, \
+        CASE WHEN run->>'error' IS NULL THEN NULL ELSE $2 END, \
+        run->>'error', $3, CAST(run->>'run' AS BIGINT), run->>'hash' \
+    FROM jsonb_array_elements(CAST($4 AS jsonb)) WITH ORDINALITY AS runs (run, position) \
+    ORDER BY position";
 
 /// What the queue stores of a new sweep.
 #[derive(Debug, Clone)]
@@ -53,39 +79,34 @@ impl JobQueue {
                 })
             })
             .collect();
-        let mut tx = self.pool.begin().await?;
-        let record: SweepRecord = sqlx::query_as(concat!(
-            "INSERT INTO sweeps (id, process_id, definition, design, policy, runs, created_at, updated_at) \
-             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?7) RETURNING ",
-            sweep_columns!()
-        ))
-        .bind(&id)
-        .bind(sweep.process_id)
-        .bind(sweep.definition.to_string())
-        .bind(sweep.design)
-        .bind(sweep.policy)
-        .bind(sweep.runs.len() as i64)
-        .bind(now)
-        .fetch_one(&mut *tx)
-        .await?;
-        sqlx::query(
-            "INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
-                 finished_at, error, sweep_id, sweep_run, content_hash) \
-             SELECT json_extract(value, '$.id'), ?1, json_extract(value, '$.inputs'), \
-                 CASE WHEN json_extract(value, '$.error') IS NULL THEN 'accepted' ELSE 'failed' END, 0, \
-                 COALESCE(json_extract(value, '$.message'), \
-                     'queued (sweep run ' || json_extract(value, '$.run') || ')'), ?2, ?2, \
-                 CASE WHEN json_extract(value, '$.error') IS NULL THEN NULL ELSE ?2 END, \
-                 json_extract(value, '$.error'), ?3, json_extract(value, '$.run'), json_extract(value, '$.hash') \
-             FROM json_each(?4) ORDER BY key",
-        )
-        .bind(sweep.process_id)
-        .bind(now)
-        .bind(&id)
-        .bind(Value::Array(children).to_string())
-        .execute(&mut *tx)
-        .await?;
-        tx.commit().await?;
+        let runs = self.db.choose(RUNS_SQLITE, RUNS_POSTGRES);
+        let record = with_pool!(&self.db, pool => {
+            let mut tx = pool.begin().await?;
+            let record: SweepRecord = sqlx::query_as(concat!(
+                "INSERT INTO sweeps (id, process_id, definition, design, policy, runs, created_at, updated_at) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $7) RETURNING ",
+                sweep_columns!()
+            ))
+            .bind(&id)
+            .bind(sweep.process_id)
+            .bind(sweep.definition.to_string())
+            .bind(sweep.design)
+            .bind(sweep.policy)
+            .bind(sweep.runs.len() as i64)
+            .bind(now)
+            .fetch_one(&mut *tx)
+            .await?;
+            sqlx::query(runs)
+                .bind(sweep.process_id)
+                .bind(now)
+                .bind(&id)
+                .bind(Value::Array(children).to_string())
+                .execute(&mut *tx)
+                .await?;
+            tx.commit().await?;
+            record
+        });
+        self.announce_queued().await;
         Ok(record)
     }
 }

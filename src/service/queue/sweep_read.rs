@@ -3,9 +3,20 @@
 
 use std::collections::HashMap;
 
-use sqlx::Row;
-
 use super::{JobQueue, JobStatus, SweepRecord, sweep_columns};
+use crate::service::db::with_pool;
+
+/// Counts of runs per sweep and status; $1 is a JSON array of sweep ids.
+const COUNTS_SQLITE: &str = "\
+    SELECT sweep_id, status, COUNT(*) AS n, CAST(SUM(progress) AS BIGINT) AS progress, \
+        MAX(updated_at) AS updated, MAX(finished_at) AS finished \
+    FROM jobs WHERE sweep_id IN (SELECT value FROM json_each($1)) GROUP BY sweep_id, status";
+
+const COUNTS_POSTGRES: &str = "\
+    SELECT sweep_id, status, COUNT(*) AS n, CAST(SUM(progress) AS BIGINT) AS progress, \
+        MAX(updated_at) AS updated, MAX(finished_at) AS finished \
+    FROM jobs WHERE sweep_id IN (SELECT json_array_elements_text(CAST($1 AS json))) \
+    GROUP BY sweep_id, status";
 
 /// How a sweep's runs stand.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -60,10 +71,12 @@ pub struct SweepRun {
 
 impl JobQueue {
     pub async fn get_sweep(&self, id: &str) -> Result<Option<SweepRecord>, sqlx::Error> {
-        sqlx::query_as(concat!("SELECT ", sweep_columns!(), " FROM sweeps WHERE id = ?1"))
-            .bind(id)
-            .fetch_optional(&self.pool)
-            .await
+        with_pool!(&self.db, pool => {
+            sqlx::query_as(concat!("SELECT ", sweep_columns!(), " FROM sweeps WHERE id = $1"))
+                .bind(id)
+                .fetch_optional(pool)
+                .await
+        })
     }
 
     /// Up to `limit` sweeps, newest first, strictly older than sequence `before` when given.
@@ -72,15 +85,17 @@ impl JobQueue {
         limit: u32,
         before: Option<i64>,
     ) -> Result<Vec<SweepRecord>, sqlx::Error> {
-        sqlx::query_as(concat!(
-            "SELECT ",
-            sweep_columns!(),
-            " FROM sweeps WHERE (?1 IS NULL OR seq < ?1) ORDER BY seq DESC LIMIT ?2"
-        ))
-        .bind(before)
-        .bind(i64::from(limit))
-        .fetch_all(&self.pool)
-        .await
+        with_pool!(&self.db, pool => {
+            sqlx::query_as(concat!(
+                "SELECT ",
+                sweep_columns!(),
+                " FROM sweeps WHERE ($1 IS NULL OR seq < $1) ORDER BY seq DESC LIMIT $2"
+            ))
+            .bind(before)
+            .bind(i64::from(limit))
+            .fetch_all(pool)
+            .await
+        })
     }
 
     /// Counts of the runs of each of `sweep_ids` (every id present, zeros included).
@@ -88,52 +103,48 @@ impl JobQueue {
         &self,
         sweep_ids: &[String],
     ) -> Result<HashMap<String, SweepCounts>, sqlx::Error> {
-        let rows = sqlx::query(
-            "SELECT sweep_id, status, COUNT(*) AS n, SUM(progress) AS progress, MAX(updated_at) AS updated, \
-                 MAX(finished_at) AS finished \
-             FROM jobs WHERE sweep_id IN (SELECT value FROM json_each(?1)) GROUP BY sweep_id, status",
-        )
-        .bind(serde_json::to_string(sweep_ids).unwrap_or_default())
-        .fetch_all(&self.pool)
-        .await?;
+        type Row = (String, String, i64, Option<i64>, Option<i64>, Option<i64>);
+        let sql = self.db.choose(COUNTS_SQLITE, COUNTS_POSTGRES);
+        let rows: Vec<Row> = with_pool!(&self.db, pool => {
+            sqlx::query_as(sql)
+                .bind(serde_json::to_string(sweep_ids).unwrap_or_default())
+                .fetch_all(pool)
+                .await?
+        });
         let mut counts: HashMap<String, SweepCounts> = sweep_ids
             .iter()
             .map(|id| (id.clone(), SweepCounts::default()))
             .collect();
-        for row in rows {
-            let id: String = row.try_get("sweep_id")?;
-            let status: String = row.try_get("status")?;
-            counts.entry(id).or_default().add(
-                &status,
-                row.try_get("n")?,
-                row.try_get::<Option<i64>, _>("progress")?.unwrap_or(0),
-                row.try_get("updated")?,
-                row.try_get("finished")?,
-            );
+        for (id, status, count, progress, updated, finished) in rows {
+            counts
+                .entry(id)
+                .or_default()
+                .add(&status, count, progress.unwrap_or(0), updated, finished);
         }
         Ok(counts)
     }
 
     /// The runs of sweep `id` that ended (successful, failed, dismissed), in run order.
     pub async fn ended_sweep_runs(&self, id: &str) -> Result<Vec<SweepRun>, sqlx::Error> {
-        let rows = sqlx::query(
-            "SELECT id, sweep_run, status, inputs, results FROM jobs \
-             WHERE sweep_id = ?1 AND status IN ('successful', 'failed', 'dismissed') ORDER BY sweep_run",
-        )
-        .bind(id)
-        .fetch_all(&self.pool)
-        .await?;
-        rows.into_iter()
-            .map(|row| {
-                let status: String = row.try_get("status")?;
-                Ok(SweepRun {
-                    run: row.try_get::<Option<i64>, _>("sweep_run")?.unwrap_or(0),
-                    job_id: row.try_get("id")?,
-                    status: JobStatus::parse(&status).unwrap_or(JobStatus::Failed),
-                    inputs: row.try_get("inputs")?,
-                    results: row.try_get("results")?,
-                })
+        type Row = (String, Option<i64>, String, String, Option<String>);
+        let rows: Vec<Row> = with_pool!(&self.db, pool => {
+            sqlx::query_as(
+                "SELECT id, sweep_run, status, inputs, results FROM jobs \
+                 WHERE sweep_id = $1 AND status IN ('successful', 'failed', 'dismissed') ORDER BY sweep_run",
+            )
+            .bind(id)
+            .fetch_all(pool)
+            .await?
+        });
+        Ok(rows
+            .into_iter()
+            .map(|(job_id, run, status, inputs, results)| SweepRun {
+                run: run.unwrap_or(0),
+                job_id,
+                status: JobStatus::parse(&status).unwrap_or(JobStatus::Failed),
+                inputs,
+                results,
             })
-            .collect()
+            .collect())
     }
 }

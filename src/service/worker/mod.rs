@@ -53,7 +53,7 @@ impl Workers {
     pub fn start(context: Arc<WorkerContext>, count: usize) -> Self {
         let (stop_claiming, stop_rx) = watch::channel(false);
         let (hand_back, hand_back_rx) = watch::channel(false);
-        let instance = uuid::Uuid::new_v4();
+        let instance = instance_id();
         let mut tasks = JoinSet::new();
         for slot in 0..count {
             let owner = format!("{instance}/{slot}");
@@ -91,6 +91,19 @@ impl Workers {
             self.tasks.abort_all();
         }
     }
+}
+
+/// `<host>:<pid>:<random>`: names the machine and process holding a lease (seen in
+/// `jobs.lease_owner` and the logs), unique even when a process restarts with the same pid.
+fn instance_id() -> String {
+    let host = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|host| host.trim().to_owned())
+        .filter(|host| !host.is_empty())
+        .unwrap_or_else(|| "localhost".to_owned());
+    let random = uuid::Uuid::new_v4().simple().to_string();
+    format!("{host}:{}:{}", std::process::id(), &random[..8])
 }
 
 async fn drain(tasks: &mut JoinSet<()>) {

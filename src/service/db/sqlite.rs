@@ -1,4 +1,4 @@
-//! The embedded SQLite database: connection settings and migrations.
+//! The embedded SQLite database (one machine): connection settings and migrations.
 //!
 //! WAL lets the API read while a worker writes; `busy_timeout` makes concurrent writers
 //! wait for the lock instead of failing with `database is locked`; foreign keys make
@@ -15,7 +15,8 @@ use sqlx::sqlite::{SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, S
 /// How long a connection waits for another writer before giving up.
 pub const BUSY_TIMEOUT: Duration = Duration::from_secs(10);
 
-/// Opens (creating if missing) the database at `path` and runs the migrations.
+/// Opens (creating if missing) the database at `path` and runs the migrations in
+/// `migrations/`.
 pub async fn open(path: &Path) -> Result<SqlitePool, sqlx::Error> {
     let options = SqliteConnectOptions::from_str("sqlite:")?
         .filename(path)
