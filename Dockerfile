@@ -1,5 +1,6 @@
 # chocmodal service image: `docker build -t chocmodal .` then
-# `docker run -p 8080:8080 -v chocmodal-data:/data chocmodal`
+# `docker run -p 8080:8080 -v chocmodal-data:/data chocmodal` (API + workers on SQLite), or
+# with PostgreSQL, API and workers apart: `docker compose up` (compose.yaml).
 FROM rust:1.95-bookworm AS build
 WORKDIR /src
 COPY Cargo.toml Cargo.lock ./
