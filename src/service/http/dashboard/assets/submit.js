@@ -21,6 +21,7 @@ export async function submit(main) {
     state.kind = e.kind;
     state.process = e.process || e.body.process;
     state.body = structuredClone(e.body);
+    state.file = e.file;
   };
   if (params.has('from')) {
     const id = params.get('from');
@@ -79,6 +80,7 @@ export async function submit(main) {
     text.value = JSON.stringify(state.body, null, 2);
   };
   const render = () => {
+    templateSelect.value = state.file || '';
     processSelect.value = state.process;
     processSelect.disabled = state.kind === 'sweep';
     target.textContent = state.kind === 'sweep' ? 'POST /sweeps' : `POST /processes/${state.process}/execution`;
