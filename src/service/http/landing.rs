@@ -56,8 +56,8 @@ fn landing_links() -> Vec<Link> {
 
 /// Landing page
 ///
-/// Links to everything else. JSON, or the dashboard's home page when the client prefers
-/// `text/html` (a browser; see the `dashboard` module).
+/// Links to everything else. JSON, or the dashboard's home page (HTML) when the client
+/// prefers `text/html` to `application/json` (a browser) or asks `?f=html`.
 #[utoipa::path(get, path = "/", operation_id = "getLandingPage", tag = "Capabilities",
     responses((status = 200, description = "Links to the API's resources",
         content((LandingPage = "application/json"), (String = "text/html")))))]
