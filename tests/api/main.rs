@@ -5,14 +5,17 @@ mod counting;
 mod helpers;
 
 mod capabilities;
+mod dashboard;
 mod database;
 mod dismissal;
 mod errors;
 mod execution;
 mod listing;
 mod load;
+mod negotiation;
 mod physics;
 mod recovery;
 mod responsiveness;
 mod results;
+mod spectra;
 mod sweeps;
