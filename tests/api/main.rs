@@ -7,15 +7,18 @@ mod helpers;
 mod postgres;
 
 mod capabilities;
+mod dashboard;
 mod database;
 mod dismissal;
 mod errors;
 mod execution;
 mod listing;
 mod load;
+mod negotiation;
 mod physics;
 mod recovery;
 mod responsiveness;
 mod results;
 mod scale_out;
+mod spectra;
 mod sweeps;

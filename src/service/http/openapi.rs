@@ -6,7 +6,7 @@
 
 use utoipa::OpenApi;
 
-use super::{jobs, landing, models, processes, results, sweep_models, sweeps};
+use super::{job_inputs, jobs, landing, models, processes, results, spectra, sweep_models, sweeps};
 use crate::service::queue::JobStatus;
 
 /// A field at fault in an execution request.
@@ -62,8 +62,10 @@ pub struct ProblemSchema {
         jobs::list,
         jobs::status,
         jobs::dismiss,
+        job_inputs::inputs,
         results::results,
         results::output,
+        spectra::spectrum,
         sweeps::create,
         sweeps::list,
         sweeps::status,
@@ -84,6 +86,8 @@ pub struct ProblemSchema {
         models::Results,
         models::HistoryDocument,
         models::Series,
+        spectra::SpectrumDocument,
+        spectra::SpectrumComparison,
         models::LandingPage,
         models::Conformance,
         models::Health,
