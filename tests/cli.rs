@@ -77,3 +77,34 @@ fn malformed_json_and_unknown_process_exit_with_status_2() {
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("no-such-process"));
 }
+
+#[test]
+fn an_unknown_database_url_is_refused_before_anything_starts() {
+    for role in ["serve", "worker"] {
+        let output = chocmodal()
+            .args([role, "--database", "mysql://chocmodal@db/queue"])
+            .output()
+            .unwrap();
+        assert_eq!(output.status.code(), Some(2), "{role}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            stderr.contains("sqlite://") && stderr.contains("postgres://"),
+            "{role}: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn a_database_password_in_the_environment_stays_out_of_the_help() {
+    let output = chocmodal()
+        .args(["worker", "--help"])
+        .env("CHOCMODAL_DATABASE_URL", "postgres://chocmodal:s3cret@db/queue")
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let help = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        help.contains("--health-bind") && !help.contains("s3cret"),
+        "{help}"
+    );
+}

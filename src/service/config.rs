@@ -24,7 +24,12 @@ pub struct QueueArgs {
     /// Database: `sqlite://<path>` (one machine) or
     /// `postgres://<user>:<password>@<host>:<port>/<database>` (shared by API and worker
     /// processes on any number of machines). Default: `sqlite://<data-dir>/chocmodal.sqlite`.
-    #[arg(long, env = "CHOCMODAL_DATABASE_URL", value_name = "URL")]
+    #[arg(
+        long,
+        env = "CHOCMODAL_DATABASE_URL",
+        value_name = "URL",
+        hide_env_values = true
+    )]
     pub database: Option<DatabaseUrl>,
     /// Directory of the default SQLite database (`chocmodal.sqlite`); created if missing.
     #[arg(long, env = "CHOCMODAL_DATA_DIR", default_value = "./data")]
