@@ -24,6 +24,7 @@ use crate::helpers::{Backend, on_both_backends, spawn_app_on, test_config};
 
 on_both_backends!(
     concurrent_claimers_never_take_the_same_job,
+    concurrent_recovery_passes_requeue_each_lost_job_once,
     a_worker_service_runs_jobs_queued_by_an_api_and_serves_health_and_metrics
 );
 
@@ -55,6 +56,38 @@ async fn concurrent_claimers_never_take_the_same_job(backend: Backend) {
     }
     assert_eq!(claimed.len(), 40, "every job claimed once, none twice");
     assert_eq!(claimed.into_iter().collect::<HashSet<_>>(), submitted);
+}
+
+/// Every process runs lease recovery: passes that overlap must not requeue (or count)
+/// a job twice.
+async fn concurrent_recovery_passes_requeue_each_lost_job_once(backend: Backend) {
+    let app = spawn_app_on(backend, |config| {
+        config.workers = 0;
+        config.maintenance_interval = Duration::from_secs(3600);
+    })
+    .await;
+    let mut lost = HashSet::new();
+    for _ in 0..30 {
+        app.submit(json!({"steps": 1})).await;
+        let claimed = app.queue.claim("dead-worker", Duration::ZERO).await.unwrap();
+        lost.insert(claimed.unwrap().lease.job_id);
+    }
+    tokio::time::sleep(Duration::from_millis(5)).await;
+    let mut passes = tokio::task::JoinSet::new();
+    for _ in 0..4 {
+        let queue = app.queue.clone();
+        passes.spawn(async move { queue.recover_expired(3).await.unwrap() });
+    }
+    let mut requeued = Vec::new();
+    while let Some(recovered) = passes.join_next().await {
+        let recovered = recovered.unwrap();
+        assert!(recovered.failed.is_empty());
+        requeued.extend(recovered.requeued);
+    }
+    assert_eq!(requeued.len(), 30, "each lost job requeued by exactly one pass");
+    assert_eq!(requeued.into_iter().collect::<HashSet<_>>(), lost);
+    let accepted = app.get_json("/jobs?status=accepted&limit=100").await;
+    assert_eq!(accepted["jobs"].as_array().unwrap().len(), 30);
 }
 
 /// Workers in their own service, as `chocmodal worker` runs them: another `wake`, so
