@@ -97,12 +97,19 @@ fn start_cluster() -> Result<Server, String> {
              the PostgreSQL tests"
         )
     })?;
+    let root = id(&["-u"])? == 0;
+    // Short (the socket path must fit in 107 bytes) and, as root, reachable by `nobody`.
+    let parent = if root {
+        PathBuf::from("/tmp")
+    } else {
+        std::env::temp_dir()
+    };
     let dir = tempfile::Builder::new()
         .prefix("chocmodal-pg-")
-        .tempdir()
+        .tempdir_in(parent)
         .map_err(|e| format!("cannot create a temporary directory: {e}"))?
         .keep();
-    let run_as = unprivileged_user(&dir)?;
+    let run_as = if root { Some(give_to_nobody(&dir)?) } else { None };
     let command = |program: &str| {
         let mut command = match &run_as {
             Some(user) => {
@@ -203,31 +210,30 @@ fn find_binaries() -> Option<PathBuf> {
     std::env::split_paths(&std::env::var_os("PATH")?).find(|dir| has_server(dir))
 }
 
-/// As root, `nobody`, who is given `dir`; otherwise the current user.
-fn unprivileged_user(dir: &Path) -> Result<Option<String>, String> {
-    let id = |args: &[&str]| -> Result<u32, String> {
-        let mut output = String::new();
-        Command::new("id")
-            .args(args)
-            .stdout(Stdio::piped())
-            .spawn()
-            .and_then(|mut child| {
-                child.stdout.take().unwrap().read_to_string(&mut output)?;
-                child.wait()
-            })
-            .map_err(|e| format!("cannot run id: {e}"))?;
-        output
-            .trim()
-            .parse()
-            .map_err(|_| format!("unexpected output of id {args:?}: {output}"))
-    };
-    if id(&["-u"])? != 0 {
-        return Ok(None);
-    }
+/// Output of `id <args>`: a user or group id.
+fn id(args: &[&str]) -> Result<u32, String> {
+    let mut output = String::new();
+    Command::new("id")
+        .args(args)
+        .stdout(Stdio::piped())
+        .spawn()
+        .and_then(|mut child| {
+            child.stdout.take().unwrap().read_to_string(&mut output)?;
+            child.wait()
+        })
+        .map_err(|e| format!("cannot run id: {e}"))?;
+    output
+        .trim()
+        .parse()
+        .map_err(|_| format!("unexpected output of id {args:?}: {output}"))
+}
+
+/// Gives `dir` to `nobody`, who runs the server when the tests run as root.
+fn give_to_nobody(dir: &Path) -> Result<String, String> {
     let (uid, gid) = (id(&["-u", "nobody"])?, id(&["-g", "nobody"])?);
     std::os::unix::fs::chown(dir, Some(uid), Some(gid))
         .map_err(|e| format!("cannot give {} to nobody: {e}", dir.display()))?;
-    Ok(Some("nobody".to_owned()))
+    Ok("nobody".to_owned())
 }
 
 fn free_port() -> Result<u16, String> {
