@@ -6,12 +6,14 @@
 //! document and the compressed histories ([`store`]); [`http`] serves them, thinned on
 //! request ([`thinning`]).
 
+pub mod auth;
 pub mod clock;
 pub mod config;
 pub mod db;
 pub mod http;
 pub mod metrics;
 pub mod queue;
+mod server;
 mod startup;
 pub mod store;
 pub mod telemetry;
@@ -32,7 +34,14 @@ pub fn serve(args: &ServeArgs, registry: crate::processes::Registry) -> std::pro
         }
     };
     runtime.block_on(async {
-        let application = match Application::build(ServiceConfig::from(args), registry).await {
+        let config = match ServiceConfig::from_args(args) {
+            Ok(config) => config,
+            Err(error) => {
+                tracing::error!(%error, "cannot start");
+                return std::process::ExitCode::FAILURE;
+            }
+        };
+        let application = match Application::build(config, registry).await {
             Ok(application) => application,
             Err(error) => {
                 tracing::error!(%error, "cannot start");

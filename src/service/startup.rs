@@ -14,9 +14,10 @@ use tokio::sync::Notify;
 
 use super::config::ServiceConfig;
 use super::db;
-use super::http::{self, AppState};
+use super::http::{self, AppState, HttpSettings};
 use super::metrics::Metrics;
 use super::queue::JobQueue;
+use super::server;
 use super::worker::{Maintenance, RunningJobs, WorkerContext, Workers};
 use crate::processes::Registry;
 
@@ -32,6 +33,11 @@ pub enum StartupError {
         address: SocketAddr,
         source: std::io::Error,
     },
+    #[error(
+        "refusing to listen on {address} without an auth file: anyone who can reach it could \
+         run and read every job; give `--auth-file`, bind a loopback address, or pass `--insecure`"
+    )]
+    Insecure { address: SocketAddr },
 }
 
 /// A built service, bound to its address, workers started, ready to serve.
@@ -44,12 +50,16 @@ pub struct Application {
     workers: Workers,
     maintenance: tokio::task::JoinHandle<()>,
     shutdown_grace: Duration,
+    header_read_timeout: Duration,
 }
 
 impl Application {
     /// Opens the database under `config.data_dir`, recovers jobs whose worker was lost,
     /// binds `config.bind` and starts `config.workers` workers running `registry`'s processes.
     pub async fn build(config: ServiceConfig, registry: Registry) -> Result<Self, StartupError> {
+        if config.auth.is_none() && !config.insecure && !config.bind.ip().is_loopback() {
+            return Err(StartupError::Insecure { address: config.bind });
+        }
         std::fs::create_dir_all(&config.data_dir).map_err(|source| StartupError::DataDir {
             path: config.data_dir.display().to_string(),
             source,
@@ -90,6 +100,7 @@ impl Application {
             lease: config.lease,
             poll_interval: config.poll_interval,
             progress_interval: config.progress_interval,
+            max_job_time: config.max_job_time,
         });
         let workers = Workers::start(context, config.workers);
         let maintenance = tokio::spawn(maintenance.run_every(config.maintenance_interval));
@@ -101,9 +112,25 @@ impl Application {
             metrics,
             wake,
             max_sweep_runs: config.max_sweep_runs,
+            limits: config.limits,
+            max_queued_jobs: config.max_queued_jobs,
+            max_history_points: config.max_history_points,
         };
-        let router = http::router(state, config.max_body_bytes);
-        tracing::info!(%address, workers = config.workers, database = %config.database_path().display(), "chocmodal is ready");
+        let tenants = config.auth.as_ref().map_or(0, |table| table.len());
+        let database = config.database_path();
+        let router = http::router(
+            state,
+            &HttpSettings {
+                max_body_bytes: config.max_body_bytes,
+                request_timeout: config.request_timeout,
+                auth: config.auth,
+                metrics_public: config.metrics_public,
+            },
+        );
+        if tenants == 0 {
+            tracing::warn!("no auth file: every client is the one implicit tenant, unauthenticated");
+        }
+        tracing::info!(%address, workers = config.workers, tokens = tenants, database = %database.display(), "chocmodal is ready");
         Ok(Self {
             address,
             listener,
@@ -112,6 +139,7 @@ impl Application {
             workers,
             maintenance,
             shutdown_grace: config.shutdown_grace,
+            header_read_timeout: config.header_read_timeout,
         })
     }
 
@@ -134,9 +162,7 @@ impl Application {
     /// in flight, stops claiming jobs, lets running jobs finish within the grace period,
     /// hands the rest back to the queue, closes the database.
     pub async fn run_until(self, stop: impl Future<Output = ()> + Send + 'static) -> std::io::Result<()> {
-        let served = axum::serve(self.listener, self.router)
-            .with_graceful_shutdown(stop)
-            .await;
+        let served = server::serve(self.listener, self.router, self.header_read_timeout, stop).await;
         tracing::info!("shutting down: no new jobs are claimed");
         self.workers.shutdown(self.shutdown_grace).await;
         self.maintenance.abort();

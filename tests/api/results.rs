@@ -144,7 +144,7 @@ async fn a_deterministic_failure_fails_at_once_without_retry() {
     assert_eq!(problem["detail"], "diverged at step 5");
     tokio::time::sleep(Duration::from_millis(300)).await;
     assert_eq!(app.probe.started(), 1, "a deterministic failure is not retried");
-    assert_eq!(app.queue.get(&job).await.unwrap().unwrap().attempt, 1);
+    assert_eq!(app.queue.get("default", &job).await.unwrap().unwrap().attempt, 1);
 }
 
 #[tokio::test]

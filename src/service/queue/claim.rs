@@ -25,7 +25,7 @@ impl JobQueue {
              WHERE seq = COALESCE( \
                  (SELECT seq FROM jobs WHERE status = 'accepted' AND sweep_id IS NULL ORDER BY seq LIMIT 1), \
                  (SELECT seq FROM jobs WHERE status = 'accepted' ORDER BY seq LIMIT 1)) \
-             RETURNING id, process_id, inputs, attempt, created_at, content_hash",
+             RETURNING id, process_id, inputs, attempt, created_at, content_hash, tenant",
         )
         .bind(owner)
         .bind(now.saturating_add(duration_ms(lease)))
@@ -48,6 +48,7 @@ impl JobQueue {
             },
             process_id: row.try_get("process_id")?,
             inputs,
+            tenant: row.try_get("tenant")?,
             content_hash: row.try_get("content_hash")?,
             created_at: row.try_get("created_at")?,
             started_at: now,

@@ -1,5 +1,7 @@
-//! Create a sweep: the sweep row and all its runs, as `accepted` jobs, in one
-//! transaction (a sweep is queued whole or not at all).
+//! Create a sweep: the sweep row and all its runs, as `accepted` jobs of its tenant, in
+//! one transaction (a sweep is queued whole or not at all), unless its runs would take
+//! the tenant over its limit of queued jobs (checked by the first insert, which holds
+//! the write lock from then on).
 //!
 //! The runs go in with one `INSERT ... SELECT FROM json_each(?)` statement: ten
 //! thousand runs are one round trip to the database, not ten thousand.
@@ -7,12 +9,14 @@
 use serde_json::{Value, json};
 
 use super::content_hash::content_hash;
-use super::{JobQueue, SweepRecord, sweep_columns};
+use super::{Admission, JobQueue, SweepRecord, sweep_columns};
 use crate::problem::Problem;
 
 /// What the queue stores of a new sweep.
 #[derive(Debug, Clone)]
 pub struct NewSweep<'a> {
+    /// The tenant that owns the sweep and its runs.
+    pub tenant: &'a str,
     pub process_id: &'a str,
     /// The normalized definition (JSON), served back by `GET /sweeps/{id}`.
     pub definition: &'a Value,
@@ -34,8 +38,15 @@ pub struct NewRun {
 }
 
 impl JobQueue {
-    /// Inserts the sweep and its runs (invalid runs directly as `failed`); returns the sweep.
-    pub async fn create_sweep(&self, sweep: &NewSweep<'_>) -> Result<SweepRecord, sqlx::Error> {
+    /// Inserts the sweep and its runs (invalid runs directly as `failed`); returns the
+    /// sweep, or nothing when its queued runs would give the tenant more than
+    /// `max_queued` accepted jobs.
+    pub async fn create_sweep(
+        &self,
+        sweep: &NewSweep<'_>,
+        max_queued: Option<u64>,
+    ) -> Result<Admission<SweepRecord>, sqlx::Error> {
+        let queued_runs = sweep.runs.iter().filter(|run| run.invalid.is_none()).count();
         let id = uuid::Uuid::new_v4().to_string();
         let now = self.now();
         let children: Vec<Value> = sweep
@@ -54,9 +65,12 @@ impl JobQueue {
             })
             .collect();
         let mut tx = self.pool.begin().await?;
-        let record: SweepRecord = sqlx::query_as(concat!(
-            "INSERT INTO sweeps (id, process_id, definition, design, policy, runs, created_at, updated_at) \
-             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?7) RETURNING ",
+        let record: Option<SweepRecord> = sqlx::query_as(concat!(
+            "INSERT INTO sweeps (id, tenant, process_id, definition, design, policy, runs, created_at, updated_at) \
+             SELECT ?1, ?8, ?2, ?3, ?4, ?5, ?6, ?7, ?7 \
+             WHERE ?9 IS NULL \
+                OR (SELECT COUNT(*) FROM jobs WHERE tenant = ?8 AND status = 'accepted') + ?10 <= ?9 \
+             RETURNING ",
             sweep_columns!()
         ))
         .bind(&id)
@@ -66,26 +80,36 @@ impl JobQueue {
         .bind(sweep.policy)
         .bind(sweep.runs.len() as i64)
         .bind(now)
-        .fetch_one(&mut *tx)
+        .bind(sweep.tenant)
+        .bind(max_queued.map(|n| i64::try_from(n).unwrap_or(i64::MAX)))
+        .bind(queued_runs as i64)
+        .fetch_optional(&mut *tx)
         .await?;
+        let Some(record) = record else {
+            tx.rollback().await?;
+            return Ok(Admission::QueueFull {
+                queued: self.queued_count(sweep.tenant).await?,
+            });
+        };
         sqlx::query(
             "INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
-                 finished_at, error, sweep_id, sweep_run, content_hash) \
+                 finished_at, error, sweep_id, sweep_run, content_hash, tenant) \
              SELECT json_extract(value, '$.id'), ?1, json_extract(value, '$.inputs'), \
                  CASE WHEN json_extract(value, '$.error') IS NULL THEN 'accepted' ELSE 'failed' END, 0, \
                  COALESCE(json_extract(value, '$.message'), \
                      'queued (sweep run ' || json_extract(value, '$.run') || ')'), ?2, ?2, \
                  CASE WHEN json_extract(value, '$.error') IS NULL THEN NULL ELSE ?2 END, \
-                 json_extract(value, '$.error'), ?3, json_extract(value, '$.run'), json_extract(value, '$.hash') \
+                 json_extract(value, '$.error'), ?3, json_extract(value, '$.run'), json_extract(value, '$.hash'), ?5 \
              FROM json_each(?4) ORDER BY key",
         )
         .bind(sweep.process_id)
         .bind(now)
         .bind(&id)
         .bind(Value::Array(children).to_string())
+        .bind(sweep.tenant)
         .execute(&mut *tx)
         .await?;
         tx.commit().await?;
-        Ok(record)
+        Ok(Admission::Admitted(record))
     }
 }

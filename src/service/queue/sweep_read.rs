@@ -59,41 +59,53 @@ pub struct SweepRun {
 }
 
 impl JobQueue {
-    pub async fn get_sweep(&self, id: &str) -> Result<Option<SweepRecord>, sqlx::Error> {
-        sqlx::query_as(concat!("SELECT ", sweep_columns!(), " FROM sweeps WHERE id = ?1"))
-            .bind(id)
-            .fetch_optional(&self.pool)
-            .await
+    /// Sweep `id` if `tenant` owns it.
+    pub async fn get_sweep(&self, tenant: &str, id: &str) -> Result<Option<SweepRecord>, sqlx::Error> {
+        sqlx::query_as(concat!(
+            "SELECT ",
+            sweep_columns!(),
+            " FROM sweeps WHERE id = ?1 AND tenant = ?2"
+        ))
+        .bind(id)
+        .bind(tenant)
+        .fetch_optional(&self.pool)
+        .await
     }
 
-    /// Up to `limit` sweeps, newest first, strictly older than sequence `before` when given.
+    /// Up to `limit` sweeps of `tenant`, newest first, strictly older than sequence
+    /// `before` when given.
     pub async fn list_sweeps(
         &self,
+        tenant: &str,
         limit: u32,
         before: Option<i64>,
     ) -> Result<Vec<SweepRecord>, sqlx::Error> {
         sqlx::query_as(concat!(
             "SELECT ",
             sweep_columns!(),
-            " FROM sweeps WHERE (?1 IS NULL OR seq < ?1) ORDER BY seq DESC LIMIT ?2"
+            " FROM sweeps WHERE (?1 IS NULL OR seq < ?1) AND tenant = ?3 ORDER BY seq DESC LIMIT ?2"
         ))
         .bind(before)
         .bind(i64::from(limit))
+        .bind(tenant)
         .fetch_all(&self.pool)
         .await
     }
 
-    /// Counts of the runs of each of `sweep_ids` (every id present, zeros included).
+    /// Counts of the runs of each of `sweep_ids` of `tenant` (every id present, zeros included).
     pub async fn sweep_counts(
         &self,
+        tenant: &str,
         sweep_ids: &[String],
     ) -> Result<HashMap<String, SweepCounts>, sqlx::Error> {
         let rows = sqlx::query(
             "SELECT sweep_id, status, COUNT(*) AS n, SUM(progress) AS progress, MAX(updated_at) AS updated, \
                  MAX(finished_at) AS finished \
-             FROM jobs WHERE sweep_id IN (SELECT value FROM json_each(?1)) GROUP BY sweep_id, status",
+             FROM jobs WHERE sweep_id IN (SELECT value FROM json_each(?1)) AND tenant = ?2 \
+             GROUP BY sweep_id, status",
         )
         .bind(serde_json::to_string(sweep_ids).unwrap_or_default())
+        .bind(tenant)
         .fetch_all(&self.pool)
         .await?;
         let mut counts: HashMap<String, SweepCounts> = sweep_ids
@@ -114,13 +126,15 @@ impl JobQueue {
         Ok(counts)
     }
 
-    /// The runs of sweep `id` that ended (successful, failed, dismissed), in run order.
-    pub async fn ended_sweep_runs(&self, id: &str) -> Result<Vec<SweepRun>, sqlx::Error> {
+    /// The runs of sweep `id` of `tenant` that ended (successful, failed, dismissed), in run order.
+    pub async fn ended_sweep_runs(&self, tenant: &str, id: &str) -> Result<Vec<SweepRun>, sqlx::Error> {
         let rows = sqlx::query(
             "SELECT id, sweep_run, status, inputs, results FROM jobs \
-             WHERE sweep_id = ?1 AND status IN ('successful', 'failed', 'dismissed') ORDER BY sweep_run",
+             WHERE sweep_id = ?1 AND tenant = ?2 AND status IN ('successful', 'failed', 'dismissed') \
+             ORDER BY sweep_run",
         )
         .bind(id)
+        .bind(tenant)
         .fetch_all(&self.pool)
         .await?;
         rows.into_iter()
