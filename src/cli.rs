@@ -157,8 +157,7 @@ fn read_body(source: &str) -> Result<String, String> {
 
 /// Parses an execution request body and returns its `inputs` object.
 pub fn parse_envelope(text: &str) -> Result<serde_json::Value, Problem> {
-    let body: serde_json::Value =
-        serde_json::from_str(text).map_err(|e| Problem::malformed_body(format!("not valid JSON: {e}")))?;
+    let body = crate::json_body::parse(text)?;
     let serde_json::Value::Object(mut map) = body else {
         return Err(Problem::malformed_body(
             "the body must be a JSON object `{\"inputs\": {...}}`",

@@ -5,6 +5,8 @@
 
 /// The `chocmodal` command line (serve, run).
 pub mod cli;
+/// Request bodies as JSON values, with pointer-bearing errors (numbers out of range).
+pub mod json_body;
 /// Pure numerics: beams, modal bases, contacts, explicit integration, reference solution.
 pub mod physics;
 /// RFC 9457 problem details shared by the HTTP API and the CLI.

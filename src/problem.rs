@@ -4,7 +4,8 @@
 //! `no-such-job`, `result-not-ready`); chocmodal's own types live under
 //! `https://chocmodal.dev/problems/`.
 
-use crate::processes::{FieldError, InvalidInputs};
+use crate::processes::cost::Excess;
+use crate::processes::{FieldError, InvalidInputs, TooCostly};
 
 /// OGC exception type prefix.
 pub const OGC_EXCEPTIONS: &str = "http://www.opengis.net/def/exceptions/ogcapi-processes-1/1.0";
@@ -26,6 +27,10 @@ pub struct Problem {
     /// For invalid inputs: every field at fault, by JSON pointer into the request body.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub errors: Vec<FieldError>,
+    /// For runs over a cost ceiling: each ceiling exceeded, with the estimate and the
+    /// limit (boxed: most problems have none, and problems travel in `Result`s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exceeded: Option<Box<Vec<Excess>>>,
 }
 
 impl Problem {
@@ -41,6 +46,7 @@ impl Problem {
             status,
             detail: detail.into(),
             errors: Vec::new(),
+            exceeded: None,
         }
     }
 
@@ -160,6 +166,69 @@ impl Problem {
                 format!("the sweep has {runs} runs, more than the limit of {limit} (`--max-sweep-runs`)"),
             )
         }
+    }
+
+    /// 422: the run's estimated cost is above a ceiling of this service: `errors` points
+    /// at the fields that drive the cost, `exceeded` gives the estimates and limits.
+    pub fn too_costly(refused: &TooCostly) -> Self {
+        let detail = refused
+            .exceeded
+            .iter()
+            .map(|e| {
+                format!(
+                    "{} {:.3e} is above the limit of {:.3e}",
+                    e.quantity, e.estimate, e.limit
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; ");
+        Self {
+            errors: refused.errors.clone(),
+            exceeded: Some(Box::new(refused.exceeded.clone())),
+            ..Self::new(
+                format!("{CHOCMODAL_PROBLEMS}/too-costly"),
+                "Run too costly",
+                422,
+                format!("the estimated cost of this run is above this service's limits: {detail}"),
+            )
+        }
+    }
+
+    /// 429: the tenant already has as many queued jobs as this service accepts.
+    pub fn too_many_queued_jobs(queued: i64, adding: usize, limit: u64) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/too-many-queued-jobs"),
+            "Too many queued jobs",
+            429,
+            format!(
+                "you have {queued} queued jobs; {adding} more would exceed the limit of {limit} \
+                 (`--max-queued-jobs`): retry once some have started, or dismiss some"
+            ),
+        )
+    }
+
+    /// 401: no valid bearer token.
+    pub fn unauthorized(detail: impl Into<String>) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/unauthorized"),
+            "Unauthorized",
+            401,
+            detail,
+        )
+    }
+
+    /// 422 (stored with a failed job): the run went over the wall-time limit and was stopped.
+    pub fn job_time_limit(limit: std::time::Duration) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/job-time-limit"),
+            "Job over its time limit",
+            422,
+            format!(
+                "the run was stopped after {} s, this service's wall-time limit per job \
+                 (`--max-job-seconds`): shorten the run or split it",
+                limit.as_secs_f64()
+            ),
+        )
     }
 
     /// 400: a query parameter is missing, unknown or out of range.

@@ -7,9 +7,9 @@ use serde_json::json;
 
 use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
 use super::inputs::{self, at};
-use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput};
+use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::contact::Contact;
-use crate::physics::integrate::{Model, Settings, SimulationError, simulate_resolved};
+use crate::physics::integrate::{Model, Settings, SimulationError, simulate_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
 
 /// Most pins in one row.
@@ -54,6 +54,45 @@ impl Prepared {
                 .iter()
                 .map(|f| f.physics())
                 .collect(),
+        }
+    }
+
+    /// What the run costs: pins × modes modal DOFs and every contact at each step;
+    /// histories `contact_forces` (time + one column per contact) and `displacements`
+    /// (time + one column per pin and output height).
+    fn estimate(&self) -> WorkEstimate {
+        let (dt, _) = self.steps;
+        let (steps, every) = step_counts(self.settings.duration, dt, self.settings.output_interval);
+        let columns = (1 + self.contacts.len()) + (1 + self.pins * self.settings.output_heights.len());
+        let generated = self.inputs.bundle.is_some();
+        let (pins, contacts) = if generated {
+            ("/inputs/bundle/pins", "/inputs/bundle/levels")
+        } else {
+            ("/inputs/pins", "/inputs/contacts")
+        };
+        let mut history_drivers = vec![
+            "/inputs/solver/duration".to_owned(),
+            "/inputs/output/interval".to_owned(),
+            pins.to_owned(),
+        ];
+        if self.inputs.output.heights.is_some() {
+            history_drivers.push("/inputs/output/heights".to_owned());
+        }
+        WorkEstimate {
+            steps: steps as f64,
+            modal_dofs: (self.pins * self.basis.modes()) as f64,
+            contacts: self.contacts.len() as f64,
+            history_values: (steps / every + 1) as f64 * columns as f64,
+            work_drivers: [
+                "/inputs/solver/duration",
+                "/inputs/solver/time_step",
+                "/inputs/pin/modes",
+                pins,
+                contacts,
+            ]
+            .map(str::to_owned)
+            .to_vec(),
+            history_drivers,
         }
     }
 }
@@ -284,8 +323,8 @@ impl Process for BundleDynamics {
         })
     }
 
-    fn validate(&self, inputs: &serde_json::Value) -> Result<(), InvalidInputs> {
-        prepare(inputs).map(|_| ())
+    fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs> {
+        prepare(inputs).map(|prepared| prepared.estimate())
     }
 
     fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {

@@ -121,11 +121,40 @@ pub struct BundleGenerator {
 }
 
 /// Contact levels.
-#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
-#[serde(untagged, expecting = "{first, spacing, count} or a list of heights")]
+///
+/// Deserialized by hand rather than as an untagged enum: an object is parsed as
+/// [`RegularLevels`] and a list as heights, so that a mistake inside either (an unknown
+/// member, a wrong type) is reported at its own pointer, not as "matches no variant".
+/// The `serde` attribute only shapes the schema.
+#[derive(Debug, Clone, PartialEq, ToSchema)]
+#[serde(untagged)]
 pub enum LevelsInput {
     Regular(RegularLevels),
     Explicit(Vec<f64>),
+}
+
+impl<'de> Deserialize<'de> for LevelsInput {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Levels;
+        impl<'de> serde::de::Visitor<'de> for Levels {
+            type Value = LevelsInput;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("{first, spacing, count} or a list of heights")
+            }
+
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<LevelsInput, A::Error> {
+                Vec::<f64>::deserialize(serde::de::value::SeqAccessDeserializer::new(seq))
+                    .map(LevelsInput::Explicit)
+            }
+
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<LevelsInput, A::Error> {
+                RegularLevels::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(LevelsInput::Regular)
+            }
+        }
+        deserializer.deserialize_any(Levels)
+    }
 }
 
 /// Levels first + k·spacing, k = 0..count (m).
@@ -138,12 +167,12 @@ pub struct RegularLevels {
 }
 
 /// Gap state.
-#[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum GapsInput {
-    /// Nominal gaps everywhere.
-    #[default]
-    Uniform,
+    /// Nominal gaps everywhere. (A struct variant: serde ignores `deny_unknown_fields`
+    /// on the unit variants of internally tagged enums, and a typo must not pass.)
+    Uniform {},
     /// One gap per contact (m), in expansion order (level by level: wall–0, 0–1, …, n−1–wall).
     PerContact { values: Vec<f64> },
     /// Independent draws in expansion order, reproducible from the seed on every machine.
@@ -154,6 +183,12 @@ pub enum GapsInput {
         #[serde(default)]
         relative: bool,
     },
+}
+
+impl Default for GapsInput {
+    fn default() -> Self {
+        GapsInput::Uniform {}
+    }
 }
 
 /// Law of random gaps.
@@ -200,7 +235,7 @@ impl BundleGenerator {
             wall_gap: self.wall_gap,
             pin_gap: self.pin_gap,
             gaps: match &self.gaps {
-                GapsInput::Uniform => GapState::Uniform,
+                GapsInput::Uniform {} => GapState::Uniform,
                 GapsInput::PerContact { values } => GapState::PerContact(values.clone()),
                 GapsInput::Random {
                     distribution,

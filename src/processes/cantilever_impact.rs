@@ -8,10 +8,10 @@ use serde_json::json;
 use utoipa::ToSchema;
 
 use super::inputs::{self, BeamInput, SchemeInput, SupportInput, TimeStepInput, at};
-use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput};
+use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
-use crate::physics::integrate::{Model, Settings, SimulationError, simulate_resolved};
+use crate::physics::integrate::{Model, Settings, SimulationError, simulate_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
@@ -164,6 +164,34 @@ impl Prepared {
             initial_tip_displacements: vec![self.inputs.release.tip_displacement],
             base_acceleration: None,
             point_forces: vec![],
+        }
+    }
+
+    /// What the run costs: one pin of `modes` modes and one contact per step; two
+    /// histories of three columns (time, numerical, reference).
+    fn estimate(&self) -> WorkEstimate {
+        let (dt, _) = self.steps;
+        let (steps, every) = step_counts(self.settings.duration, dt, self.settings.output_interval);
+        let mut history_drivers = vec![
+            "/inputs/solver/duration".to_owned(),
+            "/inputs/output/interval".to_owned(),
+        ];
+        if self.settings.output_interval.is_none() {
+            history_drivers.push("/inputs/solver/time_step".to_owned());
+        }
+        WorkEstimate {
+            steps: steps as f64,
+            modal_dofs: self.basis.modes() as f64,
+            contacts: 1.0,
+            history_values: (steps / every + 1) as f64 * 6.0,
+            work_drivers: [
+                "/inputs/solver/duration",
+                "/inputs/solver/time_step",
+                "/inputs/beam/modes",
+            ]
+            .map(str::to_owned)
+            .to_vec(),
+            history_drivers,
         }
     }
 }
@@ -353,8 +381,8 @@ impl Process for CantileverImpact {
         })
     }
 
-    fn validate(&self, inputs: &serde_json::Value) -> Result<(), InvalidInputs> {
-        prepare(inputs).map(|_| ())
+    fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs> {
+        prepare(inputs).map(|prepared| prepared.estimate())
     }
 
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {

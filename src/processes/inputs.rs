@@ -293,30 +293,62 @@ fn join_pointer(prefix: &str, field: &str) -> String {
 
 /// Deserializes process inputs strictly; a failure names its JSON pointer (under `/inputs`).
 pub fn parse<T: DeserializeOwned>(inputs: &serde_json::Value) -> Result<T, InvalidInputs> {
-    serde_path_to_error::deserialize(inputs).map_err(|error| {
-        let mut pointer = String::from("/inputs");
-        for segment in error.path().iter() {
-            match segment {
-                serde_path_to_error::Segment::Seq { index } => pointer.push_str(&format!("/{index}")),
-                serde_path_to_error::Segment::Map { key } => {
-                    pointer.push('/');
-                    pointer.push_str(&key.replace('~', "~0").replace('/', "~1"));
-                }
-                serde_path_to_error::Segment::Enum { .. } | serde_path_to_error::Segment::Unknown => {}
-            }
-        }
+    serde_path_to_error::deserialize(super::strict_json::Strict(inputs)).map_err(|error| {
+        let mut pointer = format!("/inputs{}", crate::json_body::pointer_of(error.path()));
         let detail = error.into_inner().to_string();
-        // serde reports a missing member at its parent: point at the member itself.
+        // An unknown member is reported at the member when serde tracked its key, but at
+        // an enclosing object when it could not (inside internally tagged enums, which
+        // serde buffers): point at the member, found in that object.
+        if let Some(field) = detail
+            .strip_prefix("unknown field `")
+            .and_then(|rest| rest.split_once('`'))
+            .map(|(field, _)| field)
+        {
+            let within = pointer.strip_prefix("/inputs").unwrap_or_default().to_owned();
+            if let Some(holder) = inputs
+                .pointer(&within)
+                .and_then(|scope| object_holding(scope, field, &within))
+            {
+                pointer = format!("/inputs{holder}/{}", field.replace('~', "~0").replace('/', "~1"));
+            }
+            return InvalidInputs(vec![FieldError::new(pointer, detail)]);
+        }
+        // serde reports a missing member at its parent: point at the member itself
+        // (unless the parent is no object at all, e.g. a list where a tagged object goes).
         if let Some(field) = detail
             .strip_prefix("missing field `")
             .and_then(|rest| rest.strip_suffix('`'))
         {
+            let within = pointer.strip_prefix("/inputs").unwrap_or_default();
+            if inputs.pointer(within).is_some_and(|v| !v.is_object()) {
+                return InvalidInputs(vec![FieldError::new(
+                    pointer,
+                    format!("must be an object with a `{field}` member"),
+                )]);
+            }
             pointer.push('/');
             pointer.push_str(field);
             return InvalidInputs(vec![FieldError::new(pointer, "is required")]);
         }
         InvalidInputs(vec![FieldError::new(pointer, detail)])
     })
+}
+
+/// The pointer of the first object in `scope` (itself included, depth first) that has a
+/// member `field`; `at` is the pointer of `scope`.
+fn object_holding(scope: &serde_json::Value, field: &str, at: &str) -> Option<String> {
+    match scope {
+        serde_json::Value::Object(map) if map.contains_key(field) => Some(at.to_owned()),
+        serde_json::Value::Object(map) => map.iter().find_map(|(key, child)| {
+            let escaped = key.replace('~', "~0").replace('/', "~1");
+            object_holding(child, field, &format!("{at}/{escaped}"))
+        }),
+        serde_json::Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .find_map(|(index, child)| object_holding(child, field, &format!("{at}/{index}"))),
+        _ => None,
+    }
 }
 
 /// A self-contained JSON schema of `T` (component references inlined).

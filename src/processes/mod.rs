@@ -9,10 +9,17 @@
 pub mod bundle_dynamics;
 pub mod bundle_inputs;
 pub mod cantilever_impact;
+pub mod cost;
 pub mod inputs;
+pub mod strict_json;
+
+#[cfg(test)]
+mod robustness_tests;
 
 use std::ops::ControlFlow;
 use std::sync::Arc;
+
+pub use cost::{CostLimits, TooCostly, WorkEstimate};
 
 /// One problem with the inputs: where (JSON pointer into the request body) and why.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -115,9 +122,10 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     fn inputs_description(&self) -> serde_json::Value;
     /// OGC process description `outputs` object: `{name: {title, description, schema}}`.
     fn outputs_description(&self) -> serde_json::Value;
-    /// Parses and checks the `inputs` object of an execution request. Pointers in the
-    /// errors start with `/inputs`.
-    fn validate(&self, inputs: &serde_json::Value) -> Result<(), InvalidInputs>;
+    /// Parses and checks the `inputs` object of an execution request, and estimates what
+    /// running it will cost (a service compares that with its [`CostLimits`]). Pointers in
+    /// the errors start with `/inputs`.
+    fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs>;
     /// Runs the computation on inputs that passed [`Process::validate`].
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError>;
     /// The scalar results of a results document as `(dotted.name, value)` pairs: the

@@ -6,8 +6,11 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
+use super::auth::{AuthFileError, TokenTable};
 use super::clock::{SharedClock, SystemClock};
 use super::db::DatabaseUrl;
+use crate::processes::CostLimits;
+use crate::processes::cost::{DEFAULT_MAX_HISTORY_VALUES, DEFAULT_MAX_WORK};
 
 /// Log output format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -52,6 +55,9 @@ pub struct QueueArgs {
     /// On SIGTERM/ctrl-c, how long running jobs may take to finish (s) before they are handed back to the queue.
     #[arg(long, env = "CHOCMODAL_SHUTDOWN_GRACE_SECONDS", default_value_t = 30)]
     pub shutdown_grace_seconds: u64,
+    /// Wall-time limit of one job (s): a run still computing after this long fails. 0: no limit.
+    #[arg(long, env = "CHOCMODAL_MAX_JOB_SECONDS", default_value_t = 900)]
+    pub max_job_seconds: u64,
     /// Log format on stderr.
     #[arg(long, env = "CHOCMODAL_LOG_FORMAT", value_enum, default_value = "human")]
     pub log_format: LogFormat,
@@ -71,6 +77,43 @@ pub struct ServeArgs {
     /// Most runs one sweep may expand into; larger sweeps are refused (422).
     #[arg(long, env = "CHOCMODAL_MAX_SWEEP_RUNS", default_value_t = DEFAULT_MAX_SWEEP_RUNS)]
     pub max_sweep_runs: usize,
+    /// Tenants and their bearer tokens, one `<tenant> <token>` per line (`#` comments).
+    /// Every route but `/healthz` then needs `Authorization: Bearer <token>`.
+    #[arg(long, env = "CHOCMODAL_AUTH_FILE", value_name = "PATH")]
+    pub auth_file: Option<PathBuf>,
+    /// Serve `/metrics` without a token even when an auth file is set.
+    #[arg(long, env = "CHOCMODAL_METRICS_PUBLIC", value_parser = clap::builder::BoolishValueParser::new())]
+    pub metrics_public: bool,
+    /// Allow binding a non-loopback address without an auth file (anyone who can reach
+    /// the port can then submit and read every job).
+    #[arg(long, env = "CHOCMODAL_INSECURE", value_parser = clap::builder::BoolishValueParser::new())]
+    pub insecure: bool,
+    /// Largest estimated work of one run: steps × (pins × modes + contacts); larger runs are refused (422).
+    #[arg(long, env = "CHOCMODAL_MAX_WORK", default_value_t = DEFAULT_MAX_WORK, value_parser = positive_number)]
+    pub max_work: f64,
+    /// Largest number of values (samples × columns) the histories of one run may hold (422 above).
+    #[arg(long, env = "CHOCMODAL_MAX_HISTORY_VALUES", default_value_t = DEFAULT_MAX_HISTORY_VALUES, value_parser = positive_number)]
+    pub max_history_values: f64,
+    /// Most rows one history response holds: longer windows are thinned (peaks kept).
+    #[arg(long, env = "CHOCMODAL_MAX_HISTORY_POINTS", default_value_t = DEFAULT_MAX_HISTORY_POINTS)]
+    pub max_history_points: usize,
+    /// Most queued (accepted) jobs per tenant, sweep runs included; more is a 429. 0: no limit.
+    #[arg(long, env = "CHOCMODAL_MAX_QUEUED_JOBS", default_value_t = DEFAULT_MAX_QUEUED_JOBS)]
+    pub max_queued_jobs: u64,
+    /// Longest time one request may take, its body included (s): slower ones get a 408.
+    #[arg(long, env = "CHOCMODAL_REQUEST_TIMEOUT_SECONDS", default_value_t = 30)]
+    pub request_timeout_seconds: u64,
+    /// Longest time a client may take to send a request's headers (s), and to start the
+    /// next request on a kept-alive connection; the connection is closed after that.
+    #[arg(long, env = "CHOCMODAL_HEADER_TIMEOUT_SECONDS", default_value_t = 10)]
+    pub header_timeout_seconds: u64,
+}
+
+fn positive_number(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(value) if value.is_finite() && value > 0.0 => Ok(value),
+        _ => Err(format!("`{text}` is not a positive number")),
+    }
 }
 
 /// `chocmodal worker`: workers alone, no API (any number of such processes, on any
@@ -115,12 +158,34 @@ pub struct ServiceConfig {
     pub progress_interval: Duration,
     /// Most runs one sweep may expand into.
     pub max_sweep_runs: usize,
+    /// Tenants' tokens; `None`: one implicit tenant, no authentication.
+    pub auth: Option<TokenTable>,
+    /// `/metrics` answers without a token.
+    pub metrics_public: bool,
+    /// Bind a non-loopback address even without `auth`.
+    pub insecure: bool,
+    /// Ceilings on the estimated cost of one run.
+    pub limits: CostLimits,
+    /// Most rows of one history response (longer windows are thinned).
+    pub max_history_points: usize,
+    /// Most queued jobs per tenant; `None`: no limit.
+    pub max_queued_jobs: Option<u64>,
+    /// Wall-time limit of one job; `None`: no limit.
+    pub max_job_time: Option<Duration>,
+    /// Longest time one request may take (408 after that).
+    pub request_timeout: Duration,
+    /// Longest time a client may take to send request headers.
+    pub header_read_timeout: Duration,
     /// The queue's clock.
     pub clock: SharedClock,
 }
 
 /// Default limit of runs per sweep.
 pub const DEFAULT_MAX_SWEEP_RUNS: usize = 10_000;
+/// Default limit of queued jobs per tenant: two sweeps of the largest size.
+pub const DEFAULT_MAX_QUEUED_JOBS: u64 = 2 * DEFAULT_MAX_SWEEP_RUNS as u64;
+/// Default cap of rows per history response.
+pub const DEFAULT_MAX_HISTORY_POINTS: usize = 500_000;
 
 /// Default number of workers: the cores available to this process.
 pub fn default_workers() -> usize {
@@ -151,6 +216,15 @@ impl ServiceConfig {
             poll_interval: Duration::from_millis(500),
             progress_interval: Duration::from_millis(250),
             max_sweep_runs: DEFAULT_MAX_SWEEP_RUNS,
+            auth: None,
+            metrics_public: false,
+            insecure: false,
+            limits: CostLimits::default(),
+            max_history_points: DEFAULT_MAX_HISTORY_POINTS,
+            max_queued_jobs: Some(DEFAULT_MAX_QUEUED_JOBS),
+            max_job_time: Some(Duration::from_secs(900)),
+            request_timeout: Duration::from_secs(30),
+            header_read_timeout: Duration::from_secs(10),
             clock: Arc::new(SystemClock),
         }
     }
@@ -172,6 +246,7 @@ impl ServiceConfig {
             maintenance_interval: (lease / 2).clamp(Duration::from_secs(1), Duration::from_secs(15)),
             max_attempts: args.max_attempts.max(1),
             shutdown_grace: Duration::from_secs(args.shutdown_grace_seconds),
+            max_job_time: (args.max_job_seconds > 0).then(|| Duration::from_secs(args.max_job_seconds)),
             ..Self::with_database(database)
         }
     }
@@ -180,14 +255,27 @@ impl ServiceConfig {
 /// File name of the default SQLite database in the data directory.
 pub const SQLITE_FILE: &str = "chocmodal.sqlite";
 
-impl From<&ServeArgs> for ServiceConfig {
-    fn from(args: &ServeArgs) -> Self {
-        Self {
+impl ServiceConfig {
+    /// The settings of `chocmodal serve`'s flags; fails when the auth file is unusable.
+    pub fn from_args(args: &ServeArgs) -> Result<Self, AuthFileError> {
+        let auth = args.auth_file.as_deref().map(TokenTable::load).transpose()?;
+        Ok(Self {
             bind: args.bind,
             max_body_bytes: args.max_body_bytes,
             max_sweep_runs: args.max_sweep_runs,
+            auth,
+            metrics_public: args.metrics_public,
+            insecure: args.insecure,
+            limits: CostLimits {
+                max_work: args.max_work,
+                max_history_values: args.max_history_values,
+            },
+            max_history_points: args.max_history_points.max(2),
+            max_queued_jobs: (args.max_queued_jobs > 0).then_some(args.max_queued_jobs),
+            request_timeout: Duration::from_secs(args.request_timeout_seconds.max(1)),
+            header_read_timeout: Duration::from_secs(args.header_timeout_seconds.max(1)),
             ..Self::from_queue_args(&args.queue)
-        }
+        })
     }
 }
 

@@ -7,12 +7,14 @@
 //! document and the compressed histories ([`store`]); [`http`] serves them, thinned on
 //! request ([`thinning`]).
 
+pub mod auth;
 pub mod clock;
 pub mod config;
 pub mod db;
 pub mod http;
 pub mod metrics;
 pub mod queue;
+mod server;
 mod startup;
 pub mod store;
 pub mod telemetry;
@@ -26,7 +28,8 @@ pub use startup::{Application, StartupError, WorkerService, shutdown_signal};
 pub fn serve(args: &ServeArgs, registry: crate::processes::Registry) -> std::process::ExitCode {
     telemetry::init(args.queue.log_format);
     block_on(async {
-        let application = Application::build(ServiceConfig::from(args), registry).await?;
+        let config = ServiceConfig::from_args(args)?;
+        let application = Application::build(config, registry).await?;
         Ok(application.run_until_stopped().await?)
     })
 }

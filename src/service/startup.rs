@@ -19,9 +19,10 @@ use tokio::task::JoinHandle;
 
 use super::config::ServiceConfig;
 use super::db::{self, Database};
-use super::http::{self, AppState};
+use super::http::{self, AppState, HttpSettings};
 use super::metrics::Metrics;
 use super::queue::JobQueue;
+use super::server;
 use super::worker::{Maintenance, RunningJobs, WorkerContext, Workers};
 use crate::processes::Registry;
 
@@ -37,6 +38,11 @@ pub enum StartupError {
         address: SocketAddr,
         source: std::io::Error,
     },
+    #[error(
+        "refusing to listen on {address} without an auth file: anyone who can reach it could \
+         run and read every job; give `--auth-file`, bind a loopback address, or pass `--insecure`"
+    )]
+    Insecure { address: SocketAddr },
 }
 
 /// What both roles run: the queue, its maintenance, the worker slots and their wake-ups.
@@ -95,6 +101,7 @@ impl Engine {
             lease: config.lease,
             poll_interval: config.poll_interval,
             progress_interval: config.progress_interval,
+            max_job_time: config.max_job_time,
         });
         self.workers = Some(Workers::start(context, config.workers));
         self.background.push(tokio::spawn(
@@ -110,14 +117,17 @@ impl Engine {
         }
     }
 
-    fn state(&self, registry: Registry, max_sweep_runs: usize) -> AppState {
+    fn state(&self, registry: Registry, config: &ServiceConfig) -> AppState {
         AppState {
             queue: self.queue.clone(),
             registry,
             running: self.running.clone(),
             metrics: self.metrics.clone(),
             wake: self.wake.clone(),
-            max_sweep_runs,
+            max_sweep_runs: config.max_sweep_runs,
+            limits: config.limits,
+            max_queued_jobs: config.max_queued_jobs,
+            max_history_points: config.max_history_points,
         }
     }
 
@@ -154,26 +164,40 @@ pub struct Application {
     router: axum::Router,
     engine: Engine,
     shutdown_grace: Duration,
+    header_read_timeout: Duration,
 }
 
 impl Application {
     /// Opens `config.database`, recovers jobs whose worker was lost, binds
     /// `config.bind` and starts `config.workers` workers running `registry`'s processes.
     pub async fn build(config: ServiceConfig, registry: Registry) -> Result<Self, StartupError> {
+        if config.auth.is_none() && !config.insecure && !config.bind.ip().is_loopback() {
+            return Err(StartupError::Insecure { address: config.bind });
+        }
         let mut engine = Engine::open(&config).await?;
         let (listener, address) = bind(config.bind).await?;
         engine.start(&config, registry.clone());
+        let tenants = config.auth.as_ref().map_or(0, |table| table.len());
         let router = http::router(
-            engine.state(registry, config.max_sweep_runs),
-            config.max_body_bytes,
+            engine.state(registry, &config),
+            &HttpSettings {
+                max_body_bytes: config.max_body_bytes,
+                request_timeout: config.request_timeout,
+                auth: config.auth.clone(),
+                metrics_public: config.metrics_public,
+            },
         );
-        tracing::info!(%address, workers = config.workers, database = %config.database, "chocmodal is ready");
+        if tenants == 0 {
+            tracing::warn!("no auth file: every client is the one implicit tenant, unauthenticated");
+        }
+        tracing::info!(%address, workers = config.workers, tokens = tenants, database = %config.database, "chocmodal is ready");
         Ok(Self {
             address,
             listener,
             router,
             engine,
             shutdown_grace: config.shutdown_grace,
+            header_read_timeout: config.header_read_timeout,
         })
     }
 
@@ -196,22 +220,21 @@ impl Application {
     /// in flight, stops claiming jobs, lets running jobs finish within the grace period,
     /// hands the rest back to the queue, closes the database.
     pub async fn run_until(self, stop: impl Future<Output = ()> + Send + 'static) -> std::io::Result<()> {
-        let served = axum::serve(self.listener, self.router)
-            .with_graceful_shutdown(stop)
-            .await;
+        let served = server::serve(self.listener, self.router, self.header_read_timeout, stop).await;
         self.engine.stop(self.shutdown_grace).await;
         served
     }
 }
 
 /// The worker role: worker slots and queue maintenance, no API; `/healthz` and
-/// `/metrics` on `config.health_bind` when set.
+/// `/metrics` on `config.health_bind` when set (no tokens there: they serve no job data).
 #[derive(Debug)]
 pub struct WorkerService {
     health: Option<(SocketAddr, TcpListener, axum::Router)>,
     engine: Engine,
     workers: usize,
     shutdown_grace: Duration,
+    header_read_timeout: Duration,
 }
 
 impl WorkerService {
@@ -222,7 +245,7 @@ impl WorkerService {
         let health = match config.health_bind {
             Some(address) => {
                 let (listener, address) = bind(address).await?;
-                let router = http::health_router(engine.state(registry.clone(), config.max_sweep_runs));
+                let router = http::health_router(engine.state(registry.clone(), &config));
                 Some((address, listener, router))
             }
             None => None,
@@ -239,6 +262,7 @@ impl WorkerService {
             engine,
             workers: config.workers,
             shutdown_grace: config.shutdown_grace,
+            header_read_timeout: config.header_read_timeout,
         })
     }
 
@@ -265,7 +289,9 @@ impl WorkerService {
     /// Works until `stop` completes, then shuts down like [`Application::run_until`].
     pub async fn run_until(self, stop: impl Future<Output = ()> + Send + 'static) -> std::io::Result<()> {
         let served = match self.health {
-            Some((_, listener, router)) => axum::serve(listener, router).with_graceful_shutdown(stop).await,
+            Some((_, listener, router)) => {
+                server::serve(listener, router, self.header_read_timeout, stop).await
+            }
             None => {
                 stop.await;
                 Ok(())

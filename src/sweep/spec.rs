@@ -375,6 +375,21 @@ fn parse_axis(axis: &Value, index: usize, inputs: &Value, errors: &mut Vec<Field
     let member = &object[*kind];
     let here = at(&format!("/{kind}"));
     let is_integer = |v: &Value| v.is_i64() || v.is_u64();
+    // A law's unknown members are named at their own pointer.
+    if matches!(*kind, "normal" | "lognormal")
+        && let Some(law) = member.as_object()
+    {
+        let unknown: Vec<&String> = law.keys().filter(|k| *k != "mean" && *k != "std").collect();
+        for key in &unknown {
+            errors.push(FieldError::new(
+                format!("{here}/{key}"),
+                "unknown member (expected mean, std)",
+            ));
+        }
+        if !unknown.is_empty() {
+            return None;
+        }
+    }
     let mut fail = |detail: &str| {
         errors.push(FieldError::new(here.clone(), detail));
         None
@@ -454,11 +469,8 @@ fn parse_axis(axis: &Value, index: usize, inputs: &Value, errors: &mut Vec<Field
         "normal" | "lognormal" => {
             let mean = member.get("mean").and_then(Value::as_f64);
             let std = member.get("std").and_then(Value::as_f64);
-            let extra = member
-                .as_object()
-                .is_some_and(|m| m.keys().any(|k| k != "mean" && k != "std"));
             match (mean, std) {
-                (Some(mean), Some(std)) if mean.is_finite() && std.is_finite() && std >= 0.0 && !extra => {
+                (Some(mean), Some(std)) if mean.is_finite() && std.is_finite() && std >= 0.0 => {
                     if *kind == "normal" {
                         AxisValues::Random(Law::Normal { mean, std })
                     } else {

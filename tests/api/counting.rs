@@ -11,7 +11,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use chocmodal::processes::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput};
+use chocmodal::processes::{
+    FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate,
+};
 use serde_json::{Value, json};
 
 pub const ID: &str = "count-steps";
@@ -143,8 +145,16 @@ impl Process for CountSteps {
         json!({"signal": {"title": "Signal", "description": "a sine per step", "schema": {"type": "object"}}})
     }
 
-    fn validate(&self, inputs: &Value) -> Result<(), InvalidInputs> {
-        parse(inputs).map(|_| ())
+    /// The estimate: one "modal DOF" per step, histories of three columns.
+    fn validate(&self, inputs: &Value) -> Result<WorkEstimate, InvalidInputs> {
+        parse(inputs).map(|inputs| WorkEstimate {
+            steps: inputs.steps as f64,
+            modal_dofs: 1.0,
+            contacts: 0.0,
+            history_values: 3.0 * inputs.steps as f64,
+            work_drivers: vec!["/inputs/steps".into()],
+            history_drivers: vec!["/inputs/steps".into()],
+        })
     }
 
     fn run(&self, inputs: &Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {

@@ -53,7 +53,13 @@ async fn retention_deletes_finished_jobs_and_their_histories(backend: Backend) {
     .await;
     let old = app.submit(json!({"steps": 10})).await;
     app.wait_until_finished(&old).await;
-    assert!(app.queue.history(&old, "signal").await.unwrap().is_some());
+    assert!(
+        app.queue
+            .history("default", &old, "signal")
+            .await
+            .unwrap()
+            .is_some()
+    );
     clock.advance(Duration::from_secs(20 * 86_400));
     let recent = app.submit(json!({"steps": 10})).await;
     app.wait_until_finished(&recent).await;
@@ -67,7 +73,11 @@ async fn retention_deletes_finished_jobs_and_their_histories(backend: Backend) {
     )
     .await;
     assert!(
-        app.queue.history(&old, "signal").await.unwrap().is_none(),
+        app.queue
+            .history("default", &old, "signal")
+            .await
+            .unwrap()
+            .is_none(),
         "histories go with their job"
     );
     assert_eq!(app.status(&recent).await["status"], "successful");

@@ -86,7 +86,13 @@ async fn dismissing_a_finished_job_deletes_its_results(backend: Backend) {
         "/job-dismissed",
     )
     .await;
-    assert!(app.queue.history(&job, "signal").await.unwrap().is_none());
+    assert!(
+        app.queue
+            .history("default", &job, "signal")
+            .await
+            .unwrap()
+            .is_none()
+    );
     let again = app.delete(&format!("/jobs/{job}")).await;
     assert_eq!(again.status(), StatusCode::OK, "dismissing twice is harmless");
 }

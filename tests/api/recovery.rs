@@ -40,7 +40,10 @@ async fn a_job_left_running_by_a_dead_worker_is_requeued_at_startup_and_complete
     let after = spawn_app_in(store, |config| config.workers = 1).await;
     let status = after.wait_until_finished(&job).await;
     assert_eq!(status["status"], "successful", "{status}");
-    assert_eq!(after.queue.get(&job).await.unwrap().unwrap().attempt, 2);
+    assert_eq!(
+        after.queue.get("default", &job).await.unwrap().unwrap().attempt,
+        2
+    );
     let metrics = after.get("/metrics").await.text().await.unwrap();
     assert!(metrics.contains("chocmodal_jobs_rescued_total 1"), "{metrics}");
 }
@@ -171,7 +174,7 @@ async fn a_job_survives_a_server_restart(backend: Backend) {
     let store = before.stop().await;
 
     let after = spawn_app_in(store, |config| config.workers = 0).await;
-    let record = after.queue.get(&job).await.unwrap().unwrap();
+    let record = after.queue.get("default", &job).await.unwrap().unwrap();
     assert_eq!(record.status.as_str(), "accepted", "handed back to the queue");
     assert_eq!(record.attempt, 0, "a hand-back does not count as a lost worker");
     let store = after.stop().await;

@@ -148,7 +148,7 @@ async fn a_deterministic_failure_fails_at_once_without_retry(backend: Backend) {
     assert_eq!(problem["detail"], "diverged at step 5");
     tokio::time::sleep(Duration::from_millis(300)).await;
     assert_eq!(app.probe.started(), 1, "a deterministic failure is not retried");
-    assert_eq!(app.queue.get(&job).await.unwrap().unwrap().attempt, 1);
+    assert_eq!(app.queue.get("default", &job).await.unwrap().unwrap().attempt, 1);
 }
 
 async fn a_panicking_process_fails_only_its_own_job(backend: Backend) {

@@ -25,6 +25,7 @@ use crate::helpers::{Backend, on_both_backends, spawn_app_on, test_config};
 on_both_backends!(
     concurrent_claimers_never_take_the_same_job,
     concurrent_recovery_passes_requeue_each_lost_job_once,
+    concurrent_submissions_never_take_a_tenant_over_its_queue_limit,
     a_worker_service_runs_jobs_queued_by_an_api_and_serves_health_and_metrics
 );
 
@@ -88,6 +89,38 @@ async fn concurrent_recovery_passes_requeue_each_lost_job_once(backend: Backend)
     assert_eq!(requeued.into_iter().collect::<HashSet<_>>(), lost);
     let accepted = app.get_json("/jobs?status=accepted&limit=100").await;
     assert_eq!(accepted["jobs"].as_array().unwrap().len(), 30);
+}
+
+/// API processes admit submissions concurrently: the count under the limit and the
+/// insert must act as one (SQLite's write lock, PostgreSQL's per-tenant advisory lock).
+async fn concurrent_submissions_never_take_a_tenant_over_its_queue_limit(backend: Backend) {
+    let app = Arc::new(
+        spawn_app_on(backend, |config| {
+            config.workers = 0;
+            config.max_queued_jobs = Some(5);
+        })
+        .await,
+    );
+    let mut submissions = tokio::task::JoinSet::new();
+    for steps in 1..=40 {
+        let app = app.clone();
+        submissions.spawn(async move {
+            app.post_execution(crate::counting::ID, &json!({"inputs": {"steps": steps}}))
+                .await
+                .status()
+        });
+    }
+    let mut created = 0;
+    while let Some(status) = submissions.join_next().await {
+        match status.unwrap() {
+            reqwest::StatusCode::CREATED => created += 1,
+            reqwest::StatusCode::TOO_MANY_REQUESTS => {}
+            other => panic!("unexpected {other}"),
+        }
+    }
+    assert_eq!(created, 5, "exactly the limit admitted");
+    let queued = app.get_json("/jobs?status=accepted&limit=100").await;
+    assert_eq!(queued["jobs"].as_array().unwrap().len(), 5);
 }
 
 /// Workers in their own service, as `chocmodal worker` runs them: another `wake`, so

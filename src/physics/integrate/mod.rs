@@ -179,6 +179,16 @@ pub fn simulate_resolved(
     integrate_with_step(model, settings, dt, critical, progress)
 }
 
+/// Steps of a run and the number of steps between two history samples:
+/// (⌊duration/Δt⌋ (never past the duration), round(interval/Δt) or 1 without an interval).
+/// A run records `steps / every + 1` samples.
+pub fn step_counts(duration: f64, dt: f64, interval: Option<f64>) -> (u64, u64) {
+    // Never past the duration: the last step ends at or (by rounding) just before it.
+    let total_steps = ((duration / dt) * (1.0 + 1e-12)).floor().max(1.0) as u64;
+    let output_every = interval.map_or(1, |interval| ((interval / dt).round() as u64).max(1));
+    (total_steps, output_every)
+}
+
 fn integrate_with_step(
     model: &Model<'_>,
     settings: &Settings,
@@ -187,11 +197,7 @@ fn integrate_with_step(
     progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
 ) -> Result<Simulation, SimulationError> {
     let mut run = Integrator::new(model, settings, dt, critical);
-    // Never past the duration: the last step ends at or (by rounding) just before it.
-    let total_steps = ((settings.duration / dt) * (1.0 + 1e-12)).floor().max(1.0) as u64;
-    let output_every = settings
-        .output_interval
-        .map_or(1, |interval| ((interval / dt).round() as u64).max(1));
+    let (total_steps, output_every) = step_counts(settings.duration, dt, settings.output_interval);
     run.record_sample(0.0);
     for n in 1..=total_steps {
         let t = n as f64 * dt;

@@ -156,6 +156,34 @@ impl Database {
     }
 }
 
+/// Serializes, per tenant, the transactions that count a tenant's queued jobs before
+/// adding more (its limit on queued jobs): taken first in such a transaction, held until
+/// it ends.
+pub(crate) trait TenantQueueLock {
+    async fn lock_tenant_queue(&mut self, tenant: &str) -> Result<(), sqlx::Error>;
+}
+
+impl TenantQueueLock for sqlx::SqliteConnection {
+    /// Nothing to do: the transaction's first write takes the database's write lock, and
+    /// the counting insert is that first write.
+    async fn lock_tenant_queue(&mut self, _tenant: &str) -> Result<(), sqlx::Error> {
+        Ok(())
+    }
+}
+
+impl TenantQueueLock for sqlx::PgConnection {
+    /// A transaction-level advisory lock on (`'choc'`, hash of the tenant): concurrent
+    /// submissions of one tenant queue up here, other tenants' go on (a hash collision
+    /// only serializes two tenants).
+    async fn lock_tenant_queue(&mut self, tenant: &str) -> Result<(), sqlx::Error> {
+        sqlx::query("SELECT pg_advisory_xact_lock(1667788643, hashtext($1))")
+            .bind(tenant)
+            .execute(self)
+            .await?;
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -18,12 +18,28 @@ pub enum ApiError {
     /// The problem's own status (4xx): shown to the client as is.
     #[error("{}", .0.detail)]
     Problem(Box<Problem>),
+    /// The problem's status (429): try again after `retry_after` seconds (`Retry-After`).
+    #[error("{}", .problem.detail)]
+    RetryLater { problem: Box<Problem>, retry_after: u64 },
     /// 500: the database failed; logged, hidden from the client.
     #[error("database: {0}")]
     Database(#[from] sqlx::Error),
     /// 500: any other unexpected failure; logged, hidden from the client.
     #[error("internal: {0}")]
     Internal(String),
+}
+
+/// Seconds a tenant whose queue is full is asked to wait (`Retry-After`).
+pub const QUEUE_FULL_RETRY_SECONDS: u64 = 10;
+
+impl ApiError {
+    /// 429: `queued` jobs are waiting and `adding` more would exceed `limit`.
+    pub fn queue_full(queued: i64, adding: usize, limit: u64) -> Self {
+        ApiError::RetryLater {
+            problem: Box::new(Problem::too_many_queued_jobs(queued, adding, limit)),
+            retry_after: QUEUE_FULL_RETRY_SECONDS,
+        }
+    }
 }
 
 impl From<Problem> for ApiError {
@@ -36,6 +52,13 @@ impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
         match self {
             ApiError::Problem(problem) => problem_response(&problem),
+            ApiError::RetryLater { problem, retry_after } => {
+                let mut response = problem_response(&problem);
+                response
+                    .headers_mut()
+                    .insert(header::RETRY_AFTER, HeaderValue::from(retry_after));
+                response
+            }
             ApiError::Database(error) => {
                 tracing::error!(%error, "database error while handling a request");
                 problem_response(&Problem::internal())

@@ -37,9 +37,7 @@ impl<S: Send + Sync> FromRequest<S> for JsonBody {
 
     async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
         let text = json_text(req, state, "the request").await?;
-        serde_json::from_str(&text)
-            .map(Self)
-            .map_err(|e| Problem::malformed_body(format!("the body is not valid JSON: {e}")).into())
+        Ok(Self(crate::json_body::parse(&text)?))
     }
 }
 

@@ -1,6 +1,7 @@
 //! `/jobs/{jobId}/inputs`: the execution request a job was submitted with, ready to be
 //! edited and submitted again.
 
+use axum::Extension;
 use axum::extract::{Path, State};
 use axum::http::HeaderMap;
 use axum::response::Response;
@@ -9,6 +10,7 @@ use super::AppState;
 use super::conditional::tagged;
 use super::error::ApiError;
 use crate::problem::Problem;
+use crate::service::auth::Tenant;
 
 /// A job's inputs
 ///
@@ -26,13 +28,14 @@ use crate::problem::Problem;
 pub async fn inputs(
     State(state): State<AppState>,
     Path(job_id): Path<String>,
+    Extension(tenant): Extension<Tenant>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
     // Through `get`, the read every job route uses, so that any visibility rule on jobs
     // applies here too.
     let job = state
         .queue
-        .get(&job_id)
+        .get(tenant.as_str(), &job_id)
         .await?
         .ok_or_else(|| Problem::no_such_job(&job_id))?;
     let text = state

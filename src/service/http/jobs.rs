@@ -1,6 +1,6 @@
 //! `/jobs`: the job list, one job's status, and dismissal.
 
-use axum::extract::{Path, Query, State};
+use axum::extract::{Extension, Path, Query, State};
 use axum::http::{HeaderMap, HeaderValue, header};
 use axum::response::{IntoResponse, Response};
 
@@ -9,6 +9,7 @@ use super::conditional::tagged;
 use super::error::ApiError;
 use super::models::{JobList, Link, StatusInfo};
 use crate::problem::Problem;
+use crate::service::auth::Tenant;
 use crate::service::queue::JobStatus;
 use crate::service::queue::read::JobFilter;
 
@@ -135,13 +136,14 @@ fn encode_component(text: &str) -> String {
             content_type = "application/problem+json")))]
 pub async fn list(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     query: Result<Query<Vec<(String, String)>>, axum::extract::rejection::QueryRejection>,
 ) -> Result<Response, ApiError> {
     let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
     let query = parse_list_query(&pairs)?;
     let mut jobs = state
         .queue
-        .list(&query.filter, query.limit + 1, query.cursor)
+        .list(tenant.as_str(), &query.filter, query.limit + 1, query.cursor)
         .await?;
     let more = jobs.len() > query.limit as usize;
     jobs.truncate(query.limit as usize);
@@ -179,12 +181,13 @@ pub async fn list(
             content_type = "application/problem+json")))]
 pub async fn status(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     Path(job_id): Path<String>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
     let job = state
         .queue
-        .get(&job_id)
+        .get(tenant.as_str(), &job_id)
         .await?
         .ok_or_else(|| Problem::no_such_job(&job_id))?;
     let body =
@@ -208,11 +211,12 @@ pub async fn status(
             content_type = "application/problem+json")))]
 pub async fn dismiss(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     Path(job_id): Path<String>,
 ) -> Result<Response, ApiError> {
     let job = state
         .queue
-        .dismiss(&job_id)
+        .dismiss(tenant.as_str(), &job_id)
         .await?
         .ok_or_else(|| Problem::no_such_job(&job_id))?;
     if state.running.cancel(&job_id) {

@@ -1,7 +1,8 @@
 //! The HTTP API (OGC API – Processes): routes, shared state, and the layers every
-//! request goes through (tracing, metrics, body limit, timeout, panic catching, and the
-//! rewrite of any bare error response into a problem document).
+//! request goes through (tracing, metrics, authentication, body limit, timeout, panic
+//! catching, and the rewrite of any bare error response into a problem document).
 
+pub mod auth;
 pub mod conditional;
 pub mod dashboard;
 pub mod error;
@@ -32,11 +33,13 @@ use tower_http::timeout::TimeoutLayer;
 use tower_http::trace::{DefaultMakeSpan, DefaultOnResponse, TraceLayer};
 use tracing::Level;
 
+use super::auth::TokenTable;
 use super::metrics::Metrics;
 use super::queue::JobQueue;
 use super::worker::RunningJobs;
 use crate::problem::Problem;
-use crate::processes::Registry;
+use crate::processes::{CostLimits, Registry};
+use auth::AuthPolicy;
 use error::{PROBLEM_JSON, problem_response};
 
 /// What every handler can reach.
@@ -51,13 +54,33 @@ pub struct AppState {
     pub wake: Arc<Notify>,
     /// Most runs one sweep may expand into.
     pub max_sweep_runs: usize,
+    /// Ceilings on the estimated cost of one run (every run of a sweep too).
+    pub limits: CostLimits,
+    /// Most queued jobs per tenant (sweep runs included); `None`: no limit.
+    pub max_queued_jobs: Option<u64>,
+    /// Most rows of one history response.
+    pub max_history_points: usize,
 }
 
-/// Longest time a request may take before a 408 problem.
-const REQUEST_TIMEOUT: Duration = Duration::from_secs(30);
+/// Settings of the layers around the routes.
+#[derive(Debug, Clone)]
+pub struct HttpSettings {
+    /// Largest request body (413 above).
+    pub max_body_bytes: usize,
+    /// Longest time a request may take, body included (408 after that).
+    pub request_timeout: Duration,
+    /// Tenants' tokens; `None`: no authentication.
+    pub auth: Option<TokenTable>,
+    /// `/metrics` answers without a token.
+    pub metrics_public: bool,
+}
 
 /// The application's router with all its layers.
-pub fn router(state: AppState, max_body_bytes: usize) -> Router {
+pub fn router(state: AppState, settings: &HttpSettings) -> Router {
+    let policy = Arc::new(AuthPolicy {
+        tokens: settings.auth.clone(),
+        metrics_public: settings.metrics_public,
+    });
     Router::new()
         .route("/", get(landing::landing))
         .route("/conformance", get(landing::conformance))
@@ -81,15 +104,17 @@ pub fn router(state: AppState, max_body_bytes: usize) -> Router {
         // HTML for browsers on the routes that have a page (innermost: it sees the route).
         .layer(middleware::from_fn(dashboard::negotiate))
         // Layers run outside-in from the last one added: trace and count every request,
-        // then turn any bare error below (timeout, panic, 405, 413) into a problem.
-        .layer(DefaultBodyLimit::max(max_body_bytes))
+        // turn any bare error below (timeout, panic, 405, 413) into a problem, and
+        // authenticate before anything reads the body.
+        .layer(DefaultBodyLimit::max(settings.max_body_bytes))
+        .layer(middleware::from_fn_with_state(policy, auth::authenticate))
         .layer(CatchPanicLayer::custom(|_panic| {
             tracing::error!("a request handler panicked");
             problem_response(&Problem::internal())
         }))
         .layer(TimeoutLayer::with_status_code(
             StatusCode::REQUEST_TIMEOUT,
-            REQUEST_TIMEOUT,
+            settings.request_timeout,
         ))
         .layer(middleware::map_response(problem_for_bare_errors))
         .layer(middleware::from_fn_with_state(state.clone(), track_request))

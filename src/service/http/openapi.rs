@@ -3,8 +3,15 @@
 //! Committed as `openapi/openapi.json`; a test (`tests/api/capabilities.rs`) fails when
 //! the committed file differs from [`json`]. Regenerate it with
 //! `UPDATE_OPENAPI=1 cargo test --test api openapi`.
+//!
+//! Security: every operation but `/healthz` takes a bearer token (the `bearer` scheme)
+//! and may answer 401; [`BearerSecurity`] adds both to the generated document, so a
+//! new route is covered without annotating it.
 
-use utoipa::OpenApi;
+use utoipa::openapi::path::Operation;
+use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityRequirement, SecurityScheme};
+use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
+use utoipa::{Modify, OpenApi};
 
 use super::{job_inputs, jobs, landing, models, processes, results, spectra, sweep_models, sweeps};
 use crate::service::queue::JobStatus;
@@ -38,10 +45,77 @@ pub struct ProblemSchema {
     /// Invalid inputs (422): every field at fault.
     #[schema(required = false)]
     errors: Vec<FieldErrorSchema>,
+    /// A run above the cost ceilings (422 `too-costly`): each ceiling exceeded.
+    #[schema(required = false)]
+    exceeded: Vec<ExcessSchema>,
+}
+
+/// A cost ceiling a run exceeds.
+#[derive(Debug, utoipa::ToSchema)]
+#[schema(as = Excess)]
+#[allow(dead_code)]
+pub struct ExcessSchema {
+    /// `work` (updates: steps × (pins × modes + contacts)) or `history_values`
+    /// (samples × columns of the histories).
+    quantity: String,
+    /// The run's estimate.
+    estimate: f64,
+    /// The service's ceiling.
+    limit: f64,
+}
+
+/// Adds the `bearer` security scheme, requires it everywhere but `/healthz`, and
+/// documents the 401 answer of every secured operation.
+#[derive(Debug)]
+pub struct BearerSecurity;
+
+impl Modify for BearerSecurity {
+    fn modify(&self, openapi: &mut utoipa::openapi::OpenApi) {
+        let components = openapi.components.get_or_insert_with(Default::default);
+        components.add_security_scheme(
+            "bearer",
+            SecurityScheme::Http(
+                HttpBuilder::new()
+                    .scheme(HttpAuthScheme::Bearer)
+                    .description(Some(
+                        "A token of the service's auth file (`--auth-file`), as `Authorization: Bearer \
+                         <token>`. Not needed when the service runs without an auth file (one \
+                         implicit tenant), nor for `/healthz`, nor for `/metrics` with `--metrics-public`.",
+                    ))
+                    .build(),
+            ),
+        );
+        openapi.security = Some(vec![SecurityRequirement::new("bearer", Vec::<String>::new())]);
+        let unauthorized = ResponseBuilder::new()
+            .description("No valid bearer token (`unauthorized`; `WWW-Authenticate: Bearer`)")
+            .content(
+                "application/problem+json",
+                ContentBuilder::new()
+                    .schema(Some(Ref::from_schema_name("Problem")))
+                    .build(),
+            )
+            .build();
+        for (path, item) in openapi.paths.paths.iter_mut() {
+            let operations: [&mut Option<Operation>; 4] =
+                [&mut item.get, &mut item.put, &mut item.post, &mut item.delete];
+            for operation in operations.into_iter().flatten() {
+                if path == "/healthz" {
+                    // An empty requirement: no authentication.
+                    operation.security = Some(vec![SecurityRequirement::default()]);
+                } else {
+                    operation
+                        .responses
+                        .responses
+                        .insert("401".into(), unauthorized.clone().into());
+                }
+            }
+        }
+    }
 }
 
 #[derive(Debug, OpenApi)]
 #[openapi(
+    modifiers(&BearerSecurity),
     info(
         title = "chocmodal",
         description = "Modal multi-contact dynamics of slender beam bundles, run as asynchronous \
@@ -75,6 +149,7 @@ pub struct ProblemSchema {
     components(schemas(
         ProblemSchema,
         FieldErrorSchema,
+        ExcessSchema,
         JobStatus,
         models::Link,
         models::StatusInfo,

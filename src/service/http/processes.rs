@@ -3,7 +3,7 @@
 use std::sync::Arc;
 
 use axum::Json;
-use axum::extract::{Path, State};
+use axum::extract::{Extension, Path, State};
 use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 
@@ -13,6 +13,8 @@ use super::extract::ExecutionInputs;
 use super::models::{ExecuteRequest, Link, ProcessDescription, ProcessList, ProcessSummary, StatusInfo};
 use crate::problem::Problem;
 use crate::processes::Process;
+use crate::service::auth::Tenant;
+use crate::service::queue::Admission;
 
 fn summary(process: &dyn Process) -> ProcessSummary {
     let href = format!("/processes/{}", process.id());
@@ -72,7 +74,9 @@ pub async fn describe(
 ///
 /// Validates the inputs and queues a job: `201 Created`, `Location: /jobs/{jobId}` and the
 /// job's status. Invalid inputs never reach a worker: 422 with one `errors` entry per
-/// field, each with a JSON pointer into the request body (`/inputs/beam/modes`).
+/// field, each with a JSON pointer into the request body (`/inputs/beam/modes`). A run
+/// whose estimated cost is above this service's ceilings: 422 `too-costly`, pointing at
+/// the fields that drive the cost. Too many queued jobs already: 429 with `Retry-After`.
 #[utoipa::path(post, path = "/processes/{processId}/execution", operation_id = "execute", tag = "Processes",
     params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`")),
     request_body(content = ExecuteRequest, description = "`{\"inputs\": {...}}`, see the process description"),
@@ -83,9 +87,13 @@ pub async fn describe(
         (status = 404, description = "No such process", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 413, description = "Body over the size limit", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 415, description = "Body not declared as JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
-        (status = 422, description = "Invalid inputs, with `errors` pointers", body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
+        (status = 422, description = "Invalid inputs (`invalid-inputs`), or a run above the cost ceilings (`too-costly`), with `errors` pointers",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 429, description = "Too many queued jobs (`too-many-queued-jobs`)", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json", headers(("Retry-After" = String, description = "s")))))]
 pub async fn execute(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     Path(process_id): Path<String>,
     body: Result<ExecutionInputs, ApiError>,
 ) -> Result<Response, ApiError> {
@@ -103,10 +111,27 @@ pub async fn execute(
             .await
             .map_err(|e| ApiError::Internal(format!("validation panicked: {e}")))?
     };
-    validated.map_err(|invalid| Problem::invalid_inputs(&invalid))?;
-    let job = state.queue.enqueue(&process_id, &inputs).await?;
+    let estimate = validated.map_err(|invalid| Problem::invalid_inputs(&invalid))?;
+    state
+        .limits
+        .check(&estimate)
+        .map_err(|refused| Problem::too_costly(&refused))?;
+    let admission = state
+        .queue
+        .enqueue(tenant.as_str(), &process_id, &inputs, state.max_queued_jobs)
+        .await?;
+    let job = match admission {
+        Admission::Admitted(job) => job,
+        Admission::QueueFull { queued } => {
+            return Err(ApiError::queue_full(
+                queued,
+                1,
+                state.max_queued_jobs.unwrap_or(0),
+            ));
+        }
+    };
     state.wake.notify_one();
-    tracing::info!(job = %job.id, process = %process_id, "job queued");
+    tracing::info!(job = %job.id, process = %process_id, %tenant, "job queued");
     let mut headers = HeaderMap::new();
     headers.insert(
         header::LOCATION,

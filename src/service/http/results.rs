@@ -1,6 +1,6 @@
 //! `/jobs/{jobId}/results`: the results document, and each time history as CSV or JSON.
 
-use axum::extract::{Path, State};
+use axum::extract::{Extension, Path, State};
 use axum::http::{HeaderMap, HeaderValue, header};
 use axum::response::Response;
 
@@ -10,6 +10,7 @@ use super::error::ApiError;
 use super::extract::ApiQuery;
 use super::models::{HistoryDocument, Results, Series};
 use crate::problem::Problem;
+use crate::service::auth::Tenant;
 use crate::service::queue::JobStatus;
 use crate::service::queue::read::JobOutcome;
 use crate::service::{store, thinning};
@@ -26,7 +27,8 @@ pub struct HistoryQuery {
     /// End of the window (s), inclusive.
     pub t_end: Option<f64>,
     /// Thin the window to at most this many rows (at least 2 per series), keeping each
-    /// series' minimum and maximum of every bucket so that peaks survive.
+    /// series' minimum and maximum of every bucket so that peaks survive. The service
+    /// caps it (`--max-history-points`, default 500000): longer windows are always thinned.
     pub max_points: Option<usize>,
     /// Only these series, comma-separated and in this order (e.g. `c3,c17`); default: all.
     pub series: Option<String>,
@@ -85,12 +87,13 @@ pub(super) fn with_retry_after(result: Result<Response, ApiError>) -> Result<Res
             body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
 pub async fn results(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     Path(job_id): Path<String>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
     with_retry_after(
         async {
-            let outcome = successful(&job_id, state.queue.outcome(&job_id).await?)?;
+            let outcome = successful(&job_id, state.queue.outcome(tenant.as_str(), &job_id).await?)?;
             let body = outcome.results.unwrap_or_else(|| "{}".into()).into_bytes();
             Ok(tagged(&headers, "application/json", body, HeaderMap::new()))
         }
@@ -102,7 +105,9 @@ pub async fn results(
 ///
 /// CSV (`time,<series...>`, full precision) or JSON, optionally restricted to
 /// `t_start <= time <= t_end` (s), to the `series` named, and thinned to `max_points`
-/// rows with min/max buckets.
+/// rows with min/max buckets. A window longer than the service's cap
+/// (`--max-history-points`) is thinned to it: page through long histories with
+/// `t_start` and `t_end` for full resolution.
 #[utoipa::path(get, path = "/jobs/{jobId}/results/{output}", operation_id = "getResultOutput", tag = "Results",
     params(
         ("jobId" = String, Path, description = "Job id"),
@@ -123,8 +128,9 @@ pub async fn results(
             content_type = "application/problem+json")))]
 pub async fn output(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     Path((job_id, output)): Path<(String, String)>,
-    ApiQuery(query): ApiQuery<HistoryQuery>,
+    ApiQuery(mut query): ApiQuery<HistoryQuery>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
     let csv = match query.format.as_deref() {
@@ -145,12 +151,15 @@ pub async fn output(
     if query.max_points.is_some_and(|n| n < 2) {
         return Err(Problem::invalid_query("`max_points` must be at least 2").into());
     }
+    // However long the history, a response holds at most the service's cap.
+    let cap = state.max_history_points;
+    query.max_points = Some(query.max_points.map_or(cap, |n| n.min(cap)));
     with_retry_after(
         async {
-            successful(&job_id, state.queue.outcome(&job_id).await?)?;
+            successful(&job_id, state.queue.outcome(tenant.as_str(), &job_id).await?)?;
             let stored = state
                 .queue
-                .history(&job_id, &output)
+                .history(tenant.as_str(), &job_id, &output)
                 .await?
                 .ok_or_else(|| Problem::no_such_output(&job_id, &output))?;
             // Decompressing and thinning a long history is CPU work: keep it off the runtime.

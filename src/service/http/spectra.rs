@@ -2,6 +2,7 @@
 //! of a stored history (the periodogram of `physics::spectrum`), and the spectral error
 //! f_err between the first two series, the figure `cantilever-impact` reports.
 
+use axum::Extension;
 use axum::extract::{Path, State};
 use axum::http::HeaderMap;
 use axum::response::Response;
@@ -17,6 +18,7 @@ use super::results::{successful, with_retry_after};
 use crate::physics::spectrum::{periodogram, spectral_error};
 use crate::problem::Problem;
 use crate::processes::History;
+use crate::service::auth::Tenant;
 use crate::service::{store, thinning};
 
 /// Query of `GET /jobs/{jobId}/results/{output}/spectrum`.
@@ -106,6 +108,7 @@ pub struct SpectrumDocument {
 pub async fn spectrum(
     State(state): State<AppState>,
     Path((job_id, output)): Path<(String, String)>,
+    Extension(tenant): Extension<Tenant>,
     ApiQuery(query): ApiQuery<SpectrumQuery>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
@@ -128,10 +131,10 @@ pub async fn spectrum(
     }
     with_retry_after(
         async {
-            successful(&job_id, state.queue.outcome(&job_id).await?)?;
+            successful(&job_id, state.queue.outcome(tenant.as_str(), &job_id).await?)?;
             let stored = state
                 .queue
-                .history(&job_id, &output)
+                .history(tenant.as_str(), &job_id, &output)
                 .await?
                 .ok_or_else(|| Problem::no_such_output(&job_id, &output))?;
             // FFTs of long histories are CPU work: keep them off the runtime.

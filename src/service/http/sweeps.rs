@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use axum::Json;
-use axum::extract::{Path, State};
+use axum::extract::{Extension, Path, State};
 use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use serde_json::{Value, json};
@@ -17,9 +17,10 @@ use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
 use super::models::Link;
 use super::sweep_models::{SweepList, SweepResults, SweepStatus};
 use crate::problem::Problem;
-use crate::processes::{FieldError, InvalidInputs, Process};
-use crate::service::queue::SweepRecord;
+use crate::processes::{CostLimits, FieldError, InvalidInputs, Process, TooCostly};
+use crate::service::auth::Tenant;
 use crate::service::queue::sweep_create::{NewRun, NewSweep};
+use crate::service::queue::{Admission, SweepRecord};
 use crate::sweep::spec::{self, SweepError};
 use crate::sweep::table::{self, RunRecord};
 use crate::sweep::{Design, InvalidRuns, SweepSpec, aggregate};
@@ -34,6 +35,8 @@ const MAX_RUN_ERRORS: usize = 100;
 /// `201 Created`, `Location: /sweeps/{sweepId}`. Nothing is queued when anything is
 /// invalid: 422 with `errors` pointing into the request (`/axes/0/linspace`) or, for a
 /// generated run, `/runs/{run}/inputs/...` (the detail names the run's axis values).
+/// Every run must also be within the service's cost ceilings (422 `too-costly`, with
+/// the same run pointers), and the runs must fit in the tenant's queue (429).
 #[utoipa::path(post, path = "/sweeps", operation_id = "createSweep", tag = "Sweeps",
     request_body(content = super::sweep_models::SweepRequestSchema, description = "The process, base inputs and axes"),
     responses(
@@ -42,10 +45,15 @@ const MAX_RUN_ERRORS: usize = 100;
         (status = 400, description = "Malformed JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 404, description = "No such process", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 413, description = "Body over the size limit", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
-        (status = 422, description = "Invalid sweep or run inputs (`invalid-inputs`), or more runs than allowed (`sweep-too-large`)",
-            body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
+        (status = 415, description = "Body not declared as JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 422, description = "Invalid sweep or run inputs (`invalid-inputs`), more runs than allowed (`sweep-too-large`), or a run above the cost ceilings (`too-costly`)",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 429, description = "The runs would exceed the limit of queued jobs (`too-many-queued-jobs`)",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json",
+            headers(("Retry-After" = String, description = "s")))))]
 pub async fn create(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     body: Result<JsonBody, ApiError>,
 ) -> Result<Response, ApiError> {
     let JsonBody(body) = body?;
@@ -61,25 +69,41 @@ pub async fn create(
     // Expansion and validation of thousands of runs is CPU work: off the runtime.
     let runs = {
         let spec = spec.clone();
-        tokio::task::spawn_blocking(move || expand_and_validate(&spec, process.as_ref()))
+        let limits = state.limits;
+        tokio::task::spawn_blocking(move || expand_and_validate(&spec, process.as_ref(), &limits))
             .await
             .map_err(|e| ApiError::Internal(format!("sweep validation panicked: {e}")))?
     }?;
     let definition = definition(&spec, &body);
-    let record = state
+    let admission = state
         .queue
-        .create_sweep(&NewSweep {
-            process_id: &spec.process,
-            definition: &definition,
-            design: spec.design.as_str(),
-            policy: spec.policy.as_str(),
-            runs: &runs,
-        })
+        .create_sweep(
+            &NewSweep {
+                tenant: tenant.as_str(),
+                process_id: &spec.process,
+                definition: &definition,
+                design: spec.design.as_str(),
+                policy: spec.policy.as_str(),
+                runs: &runs,
+            },
+            state.max_queued_jobs,
+        )
         .await?;
+    let record = match admission {
+        Admission::Admitted(record) => record,
+        Admission::QueueFull { queued } => {
+            let adding = runs.iter().filter(|run| run.invalid.is_none()).count();
+            return Err(ApiError::queue_full(
+                queued,
+                adding,
+                state.max_queued_jobs.unwrap_or(0),
+            ));
+        }
+    };
     state.wake.notify_waiters();
     state.wake.notify_one();
-    tracing::info!(sweep = %record.id, process = %record.process_id, runs = record.runs, "sweep queued");
-    let status = sweep_status(&state, &record).await?;
+    tracing::info!(sweep = %record.id, process = %record.process_id, runs = record.runs, %tenant, "sweep queued");
+    let status = sweep_status(&state, &tenant, &record).await?;
     let mut headers = HeaderMap::new();
     headers.insert(
         header::LOCATION,
@@ -102,21 +126,39 @@ fn definition(spec: &SweepSpec, body: &Value) -> Value {
     })
 }
 
-/// Every run, or the 422 naming the invalid runs (unless they are to be recorded).
-/// Runs are validated in parallel, one chunk per core.
-fn expand_and_validate(spec: &SweepSpec, process: &dyn Process) -> Result<Vec<NewRun>, ApiError> {
+/// Why a generated run cannot be queued.
+#[derive(Debug)]
+enum Refusal {
+    Invalid(InvalidInputs),
+    TooCostly(TooCostly),
+}
+
+/// Every run, or the 422 naming the invalid runs (unless they are to be recorded) or
+/// the runs above the cost ceilings (always refused). Runs are validated in parallel,
+/// one chunk per core.
+fn expand_and_validate(
+    spec: &SweepSpec,
+    process: &dyn Process,
+    limits: &CostLimits,
+) -> Result<Vec<NewRun>, ApiError> {
     let runs = spec.expand();
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .min(runs.len().max(1));
     let chunk = runs.len().div_ceil(threads).max(1);
-    let mut failures: Vec<(usize, InvalidInputs)> = std::thread::scope(|scope| {
+    let refusals: Vec<(usize, Refusal)> = std::thread::scope(|scope| {
         let handles: Vec<_> = runs
             .chunks(chunk)
             .map(|runs| {
                 scope.spawn(move || {
                     runs.iter()
-                        .filter_map(|run| process.validate(&run.inputs).err().map(|e| (run.index, e)))
+                        .filter_map(|run| {
+                            let refusal = match process.validate(&run.inputs) {
+                                Err(invalid) => Refusal::Invalid(invalid),
+                                Ok(estimate) => Refusal::TooCostly(limits.check(&estimate).err()?),
+                            };
+                            Some((run.index, refusal))
+                        })
                         .collect::<Vec<_>>()
                 })
             })
@@ -128,6 +170,37 @@ fn expand_and_validate(spec: &SweepSpec, process: &dyn Process) -> Result<Vec<Ne
             .map(|chunks| chunks.into_iter().flatten().collect())
     })
     .map_err(|_| ApiError::Internal("a process's validation panicked".into()))?;
+    let mut failures: Vec<(usize, InvalidInputs)> = Vec::new();
+    let mut costly: Vec<(usize, TooCostly)> = Vec::new();
+    for (index, refusal) in refusals {
+        match refusal {
+            Refusal::Invalid(invalid) => failures.push((index, invalid)),
+            Refusal::TooCostly(refused) => costly.push((index, refused)),
+        }
+    }
+    if !costly.is_empty() {
+        costly.sort_by_key(|(index, _)| *index);
+        let errors = run_errors(
+            spec,
+            &runs,
+            costly
+                .iter()
+                .map(|(index, refused)| (*index, refused.errors.as_slice())),
+        );
+        let mut problem = Problem::too_costly(&TooCostly {
+            exceeded: costly[0].1.exceeded.clone(),
+            errors,
+        });
+        problem.detail = format!(
+            "{} of {} runs are above this service's cost ceilings (first run {}: {}); nothing was queued; \
+             see `errors` (at most {MAX_RUN_ERRORS})",
+            costly.len(),
+            runs.len(),
+            costly[0].0,
+            problem.detail
+        );
+        return Err(problem.into());
+    }
     if failures.is_empty() || spec.invalid_runs == InvalidRuns::Record {
         let mut failures = failures.into_iter().collect::<std::collections::HashMap<_, _>>();
         return Ok(runs
@@ -142,31 +215,13 @@ fn expand_and_validate(spec: &SweepSpec, process: &dyn Process) -> Result<Vec<Ne
     }
     failures.sort_by_key(|(index, _)| *index);
     let invalid_runs = failures.len();
-    let errors: Vec<FieldError> = failures
-        .iter()
-        .flat_map(|(index, invalid)| {
-            let values: Vec<String> = spec
-                .axes
-                .iter()
-                .map(|axis| {
-                    let value = runs[*index]
-                        .inputs
-                        .pointer(&axis.pointer)
-                        .cloned()
-                        .unwrap_or(Value::Null);
-                    format!("{} = {value}", axis.pointer)
-                })
-                .collect();
-            invalid.0.iter().map(move |error| {
-                let within = error.pointer.strip_prefix("/inputs").unwrap_or(&error.pointer);
-                FieldError::new(
-                    format!("/runs/{index}/inputs{within}"),
-                    format!("{} (run {index}: {})", error.detail, values.join(", ")),
-                )
-            })
-        })
-        .take(MAX_RUN_ERRORS)
-        .collect();
+    let errors = run_errors(
+        spec,
+        &runs,
+        failures
+            .iter()
+            .map(|(index, invalid)| (*index, invalid.0.as_slice())),
+    );
     let mut problem = Problem::invalid_inputs(&InvalidInputs(errors));
     problem.detail = format!(
         "{invalid_runs} of {} runs have invalid inputs (first run {}); nothing was queued; see `errors` (at most {MAX_RUN_ERRORS})",
@@ -176,18 +231,58 @@ fn expand_and_validate(spec: &SweepSpec, process: &dyn Process) -> Result<Vec<Ne
     Err(problem.into())
 }
 
-async fn sweep_status(state: &AppState, record: &SweepRecord) -> Result<SweepStatus, ApiError> {
-    let counts = state.queue.sweep_counts(std::slice::from_ref(&record.id)).await?;
+/// The errors of generated runs, re-pointed into the sweep (`/runs/{run}/inputs/...`)
+/// with each run's axis values in the detail; at most [`MAX_RUN_ERRORS`].
+fn run_errors<'a>(
+    spec: &SweepSpec,
+    runs: &[crate::sweep::Run],
+    refused: impl Iterator<Item = (usize, &'a [FieldError])>,
+) -> Vec<FieldError> {
+    refused
+        .flat_map(|(index, errors)| {
+            let values: Vec<String> = spec
+                .axes
+                .iter()
+                .map(|axis| {
+                    let value = runs[index]
+                        .inputs
+                        .pointer(&axis.pointer)
+                        .cloned()
+                        .unwrap_or(Value::Null);
+                    format!("{} = {value}", axis.pointer)
+                })
+                .collect();
+            errors.iter().map(move |error| {
+                let within = error.pointer.strip_prefix("/inputs").unwrap_or(&error.pointer);
+                FieldError::new(
+                    format!("/runs/{index}/inputs{within}"),
+                    format!("{} (run {index}: {})", error.detail, values.join(", ")),
+                )
+            })
+        })
+        .take(MAX_RUN_ERRORS)
+        .collect()
+}
+
+async fn sweep_status(
+    state: &AppState,
+    tenant: &Tenant,
+    record: &SweepRecord,
+) -> Result<SweepStatus, ApiError> {
+    let counts = state
+        .queue
+        .sweep_counts(tenant.as_str(), std::slice::from_ref(&record.id))
+        .await?;
     Ok(SweepStatus::new(
         record,
         &counts.get(&record.id).cloned().unwrap_or_default(),
     ))
 }
 
-async fn find(state: &AppState, sweep_id: &str) -> Result<SweepRecord, ApiError> {
+async fn find(state: &AppState, tenant: &Tenant, sweep_id: &str) -> Result<SweepRecord, ApiError> {
     Ok(state
         .queue
-        .get_sweep(sweep_id)
+        .get_sweep(tenant.as_str(), sweep_id)
         .await?
         .ok_or_else(|| Problem::no_such_sweep(sweep_id))?)
 }
@@ -205,11 +300,12 @@ async fn find(state: &AppState, sweep_id: &str) -> Result<SweepRecord, ApiError>
             content_type = "application/problem+json")))]
 pub async fn status(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     Path(sweep_id): Path<String>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
-    let record = find(&state, &sweep_id).await?;
-    let status = sweep_status(&state, &record).await?;
+    let record = find(&state, &tenant, &sweep_id).await?;
+    let status = sweep_status(&state, &tenant, &record).await?;
     let mut extra = HeaderMap::new();
     if !status.is_finished() {
         extra.insert(header::RETRY_AFTER, HeaderValue::from_static("1"));
@@ -242,6 +338,7 @@ pub struct SweepListQuery {
             content_type = "application/problem+json")))]
 pub async fn list(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     ApiQuery(query): ApiQuery<SweepListQuery>,
 ) -> Result<Response, ApiError> {
     let limit = query.limit.unwrap_or(DEFAULT_LIMIT);
@@ -250,11 +347,14 @@ pub async fn list(
             Problem::invalid_query(format!("`limit` must be an integer from 1 to {MAX_LIMIT}")).into(),
         );
     }
-    let mut sweeps = state.queue.list_sweeps(limit + 1, query.cursor).await?;
+    let mut sweeps = state
+        .queue
+        .list_sweeps(tenant.as_str(), limit + 1, query.cursor)
+        .await?;
     let more = sweeps.len() > limit as usize;
     sweeps.truncate(limit as usize);
     let ids: Vec<String> = sweeps.iter().map(|s| s.id.clone()).collect();
-    let counts = state.queue.sweep_counts(&ids).await?;
+    let counts = state.queue.sweep_counts(tenant.as_str(), &ids).await?;
     let href = |cursor: Option<i64>| match cursor {
         Some(cursor) => format!("/sweeps?limit={limit}&cursor={cursor}"),
         None => format!("/sweeps?limit={limit}"),
@@ -285,16 +385,17 @@ pub async fn list(
             content_type = "application/problem+json")))]
 pub async fn dismiss(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     Path(sweep_id): Path<String>,
 ) -> Result<Response, ApiError> {
     let (record, dismissed) = state
         .queue
-        .dismiss_sweep(&sweep_id)
+        .dismiss_sweep(tenant.as_str(), &sweep_id)
         .await?
         .ok_or_else(|| Problem::no_such_sweep(&sweep_id))?;
     let cancelled = dismissed.iter().filter(|id| state.running.cancel(id)).count();
     tracing::info!(sweep = %sweep_id, dismissed = dismissed.len(), cancelled, "sweep dismissed");
-    Ok(Json(sweep_status(&state, &record).await?).into_response())
+    Ok(Json(sweep_status(&state, &tenant, &record).await?).into_response())
 }
 
 /// Query of `GET /sweeps/{sweepId}/results`.
@@ -323,6 +424,7 @@ pub struct SweepResultsQuery {
             content_type = "application/problem+json")))]
 pub async fn results(
     State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
     Path(sweep_id): Path<String>,
     ApiQuery(query): ApiQuery<SweepResultsQuery>,
     headers: HeaderMap,
@@ -336,9 +438,9 @@ pub async fn results(
             );
         }
     };
-    let record = find(&state, &sweep_id).await?;
-    let status = sweep_status(&state, &record).await?;
-    let runs = state.queue.ended_sweep_runs(&sweep_id).await?;
+    let record = find(&state, &tenant, &sweep_id).await?;
+    let status = sweep_status(&state, &tenant, &record).await?;
+    let runs = state.queue.ended_sweep_runs(tenant.as_str(), &sweep_id).await?;
     let process = state.registry.get(&record.process_id);
     // Parsing thousands of results documents is CPU work: off the runtime.
     let body =

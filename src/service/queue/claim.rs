@@ -25,7 +25,7 @@ const CLAIM_SQLITE: &str = "\
     WHERE seq = COALESCE( \
         (SELECT seq FROM jobs WHERE status = 'accepted' AND sweep_id IS NULL ORDER BY seq LIMIT 1), \
         (SELECT seq FROM jobs WHERE status = 'accepted' ORDER BY seq LIMIT 1)) \
-    RETURNING id, process_id, inputs, attempt, created_at, content_hash";
+    RETURNING id, process_id, inputs, attempt, created_at, content_hash, tenant";
 
 const CLAIM_POSTGRES: &str = "\
     WITH next AS ( \
@@ -35,7 +35,8 @@ const CLAIM_POSTGRES: &str = "\
     UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = $1, \
         lease_expires_at = $2, started_at = $3, updated_at = $3, progress = 0, message = 'running' \
     FROM next WHERE jobs.seq = next.seq \
-    RETURNING jobs.id, jobs.process_id, jobs.inputs, jobs.attempt, jobs.created_at, jobs.content_hash";
+    RETURNING jobs.id, jobs.process_id, jobs.inputs, jobs.attempt, jobs.created_at, jobs.content_hash, \
+        jobs.tenant";
 
 impl JobQueue {
     /// Takes the next accepted job for `owner`, leased for `lease`; `None` if the queue is empty.
@@ -65,6 +66,7 @@ impl JobQueue {
                 },
                 process_id: row.try_get("process_id")?,
                 inputs,
+                tenant: row.try_get("tenant")?,
                 content_hash: row.try_get("content_hash")?,
                 created_at: row.try_get("created_at")?,
                 started_at: now,

@@ -8,8 +8,9 @@ use super::{JobQueue, JobRecord, record_columns};
 use crate::service::db::with_pool;
 
 impl JobQueue {
-    /// Dismisses job `id`; `None` if there is no such job. Dismissing twice is harmless.
-    pub async fn dismiss(&self, id: &str) -> Result<Option<JobRecord>, sqlx::Error> {
+    /// Dismisses job `id` of `tenant`; `None` if `tenant` has no such job. Dismissing
+    /// twice is harmless.
+    pub async fn dismiss(&self, tenant: &str, id: &str) -> Result<Option<JobRecord>, sqlx::Error> {
         let now = self.now();
         with_pool!(&self.db, pool => {
             let mut tx = pool.begin().await?;
@@ -17,11 +18,12 @@ impl JobQueue {
                 "UPDATE jobs SET status = 'dismissed', cancel_requested = TRUE, message = 'dismissed', \
                      finished_at = COALESCE(finished_at, $2), updated_at = $2, lease_owner = NULL, \
                      lease_expires_at = NULL, results = NULL \
-                 WHERE id = $1 AND status <> 'dismissed' RETURNING ",
+                 WHERE id = $1 AND tenant = $3 AND status <> 'dismissed' RETURNING ",
                 record_columns!()
             ))
             .bind(id)
             .bind(now)
+            .bind(tenant)
             .fetch_optional(&mut *tx)
             .await?;
             let record = match dismissed {
@@ -33,10 +35,15 @@ impl JobQueue {
                     Some(record)
                 }
                 None => {
-                    sqlx::query_as(concat!("SELECT ", record_columns!(), " FROM jobs WHERE id = $1"))
-                        .bind(id)
-                        .fetch_optional(&mut *tx)
-                        .await?
+                    sqlx::query_as(concat!(
+                        "SELECT ",
+                        record_columns!(),
+                        " FROM jobs WHERE id = $1 AND tenant = $2"
+                    ))
+                    .bind(id)
+                    .bind(tenant)
+                    .fetch_optional(&mut *tx)
+                    .await?
                 }
             };
             tx.commit().await?;

@@ -7,8 +7,11 @@
 //! worker that lost its lease (it stalled, the job was dismissed, recovery re-queued it)
 //! can never overwrite the row. No transaction is held while a job computes: each step
 //! is one short statement. Each operation runs the same Rust on either backend
-//! (`with_pool!`); where SQL differs, both texts sit side by side in its file. One
-//! operation per file:
+//! (`with_pool!`); where SQL differs, both texts sit side by side in its file.
+//!
+//! Every job and sweep belongs to a tenant (`tenant` column, `migrations/0003`). The
+//! reads and writes made for a request take the requesting tenant explicitly and match
+//! it in SQL, so another tenant's job is simply "no such job". One operation per file:
 //!
 //! - [`enqueue`]: insert an accepted job;
 //! - [`claim`]: atomically take the oldest accepted job;
@@ -168,6 +171,8 @@ pub struct ClaimedJob {
     pub process_id: String,
     /// The validated `inputs` object.
     pub inputs: serde_json::Value,
+    /// The tenant that owns the job.
+    pub tenant: String,
     /// Content hash of process and inputs (jobs queued before hashes existed have none).
     pub content_hash: Option<String>,
     /// When it was enqueued and claimed (ms since the Unix epoch).
@@ -198,6 +203,16 @@ impl JobQueue {
     fn now(&self) -> i64 {
         self.clock.now_ms()
     }
+}
+
+/// The outcome of a submission under the per-tenant limit on queued jobs.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Admission<T> {
+    /// Queued.
+    Admitted(T),
+    /// Nothing was queued: the tenant has `queued` accepted jobs, and the new ones would
+    /// take it over the limit.
+    QueueFull { queued: i64 },
 }
 
 /// A sweep as stored: its definition and bookkeeping (its runs are jobs).

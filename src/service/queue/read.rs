@@ -16,6 +16,7 @@ const LIST_SQLITE: &str = concat!(
        AND ($2 IS NULL OR process_id IN (SELECT value FROM json_each($2))) \
        AND ($3 IS NULL OR seq < $3) \
        AND ($5 IS NULL OR sweep_id IN (SELECT value FROM json_each($5))) \
+       AND tenant = $6 \
      ORDER BY seq DESC LIMIT $4"
 );
 const LIST_POSTGRES: &str = concat!(
@@ -26,6 +27,7 @@ const LIST_POSTGRES: &str = concat!(
        AND ($2 IS NULL OR process_id IN (SELECT json_array_elements_text(CAST($2 AS json)))) \
        AND ($3 IS NULL OR seq < $3) \
        AND ($5 IS NULL OR sweep_id IN (SELECT json_array_elements_text(CAST($5 AS json)))) \
+       AND tenant = $6 \
      ORDER BY seq DESC LIMIT $4"
 );
 
@@ -49,19 +51,26 @@ pub struct JobOutcome {
 }
 
 impl JobQueue {
-    pub async fn get(&self, id: &str) -> Result<Option<JobRecord>, sqlx::Error> {
+    /// Job `id` if `tenant` owns it.
+    pub async fn get(&self, tenant: &str, id: &str) -> Result<Option<JobRecord>, sqlx::Error> {
         with_pool!(&self.db, pool => {
-            sqlx::query_as(concat!("SELECT ", record_columns!(), " FROM jobs WHERE id = $1"))
-                .bind(id)
-                .fetch_optional(pool)
-                .await
+            sqlx::query_as(concat!(
+                "SELECT ",
+                record_columns!(),
+                " FROM jobs WHERE id = $1 AND tenant = $2"
+            ))
+            .bind(id)
+            .bind(tenant)
+            .fetch_optional(pool)
+            .await
         })
     }
 
-    /// Up to `limit` jobs matching `filter`, newest first, strictly older than the job
-    /// with sequence number `before` when given (keyset paging: stable under inserts).
+    /// Up to `limit` jobs of `tenant` matching `filter`, newest first, strictly older than
+    /// the job with sequence number `before` when given (keyset paging: stable under inserts).
     pub async fn list(
         &self,
+        tenant: &str,
         filter: &JobFilter,
         limit: u32,
         before: Option<i64>,
@@ -82,19 +91,22 @@ impl JobQueue {
                 .bind(before)
                 .bind(i64::from(limit))
                 .bind(&sweep_ids)
+                .bind(tenant)
                 .fetch_all(pool)
                 .await
         })
     }
 
-    pub async fn outcome(&self, id: &str) -> Result<Option<JobOutcome>, sqlx::Error> {
+    /// Job `id` with its results or error, if `tenant` owns it.
+    pub async fn outcome(&self, tenant: &str, id: &str) -> Result<Option<JobOutcome>, sqlx::Error> {
         with_pool!(&self.db, pool => {
             let row = sqlx::query(concat!(
                 "SELECT ",
                 record_columns!(),
-                ", results, error FROM jobs WHERE id = $1"
+                ", results, error FROM jobs WHERE id = $1 AND tenant = $2"
             ))
             .bind(id)
+            .bind(tenant)
             .fetch_optional(pool)
             .await?;
             row.map(|row| {
@@ -108,14 +120,21 @@ impl JobQueue {
         })
     }
 
-    /// The stored history `name` of job `id`.
-    pub async fn history(&self, id: &str, name: &str) -> Result<Option<StoredHistory>, sqlx::Error> {
+    /// The stored history `name` of job `id`, if `tenant` owns the job.
+    pub async fn history(
+        &self,
+        tenant: &str,
+        id: &str,
+        name: &str,
+    ) -> Result<Option<StoredHistory>, sqlx::Error> {
         let row = with_pool!(&self.db, pool => {
             sqlx::query_as::<_, (String, String, i64, Vec<u8>)>(
-                "SELECT name, series, samples, data FROM job_histories WHERE job_id = $1 AND name = $2",
+                "SELECT h.name, h.series, h.samples, h.data FROM job_histories h JOIN jobs j ON j.id = h.job_id \
+                 WHERE h.job_id = $1 AND h.name = $2 AND j.tenant = $3",
             )
             .bind(id)
             .bind(name)
+            .bind(tenant)
             .fetch_optional(pool)
             .await?
         });

@@ -4,6 +4,10 @@
 //!
 //! Checked at claim time rather than at submission, so that identical runs queued
 //! together (in one sweep, or while the first one computes) are computed once too.
+//! Only the same tenant's jobs are reused: another tenant must not learn, from a reuse
+//! message naming a job, that someone ran the same inputs.
+//! Only the same tenant's jobs are reused: another tenant must not learn, from a reuse
+//! message naming a job, that someone ran the same inputs.
 
 use super::{JobQueue, Lease};
 use crate::service::db::with_pool;
@@ -28,19 +32,26 @@ const TAKE_POSTGRES: &str = "\
             FOR SHARE OF source)";
 
 impl JobQueue {
-    /// If a successful job has `hash`, completes the leased job with a copy of its
-    /// results and histories and returns that job's id; `None` when nothing matches
-    /// (or the lease was lost).
-    pub async fn reuse(&self, lease: &Lease, hash: &str) -> Result<Option<String>, sqlx::Error> {
+    /// If a successful job of `tenant` has `hash`, completes the leased job with a copy
+    /// of its results and histories and returns that job's id; `None` when nothing
+    /// matches (or the lease was lost).
+    pub async fn reuse(
+        &self,
+        lease: &Lease,
+        tenant: &str,
+        hash: &str,
+    ) -> Result<Option<String>, sqlx::Error> {
         let take = self.db.choose(TAKE_SQLITE, TAKE_POSTGRES);
         with_pool!(&self.db, pool => {
             let source: Option<(String, String)> = sqlx::query_as(
                 "SELECT id, results FROM jobs \
                  WHERE content_hash = $1 AND status = 'successful' AND id <> $2 AND results IS NOT NULL \
+                     AND tenant = $3 \
                  ORDER BY seq LIMIT 1",
             )
             .bind(hash)
             .bind(&lease.job_id)
+            .bind(tenant)
             .fetch_optional(pool)
             .await?;
             let Some((source_id, results)) = source else {

@@ -1,5 +1,8 @@
-//! Create a sweep: the sweep row and all its runs, as `accepted` jobs, in one
-//! transaction (a sweep is queued whole or not at all).
+//! Create a sweep: the sweep row and all its runs, as `accepted` jobs of its tenant, in
+//! one transaction (a sweep is queued whole or not at all), unless its runs would take
+//! the tenant over its limit of queued jobs: checked by the first insert, after the
+//! tenant's queue lock ([`TenantQueueLock`]: SQLite's write lock, a PostgreSQL advisory
+//! lock), held until the runs are in.
 //!
 //! The runs go in with one `INSERT ... SELECT` over a JSON array parameter
 //! (`json_each` in SQLite, `jsonb_array_elements` in PostgreSQL): ten thousand runs are
@@ -8,37 +11,40 @@
 use serde_json::{Value, json};
 
 use super::content_hash::content_hash;
-use super::{JobQueue, SweepRecord, sweep_columns};
+use super::{Admission, JobQueue, SweepRecord, sweep_columns};
 use crate::problem::Problem;
-use crate::service::db::with_pool;
+use crate::service::db::{TenantQueueLock, with_pool};
 
-/// Inserts the runs of sweep $3 of process $1 at time $2 from $4, a JSON array of
-/// `{id, run, inputs, hash, error, message}` (an `error` makes the run `failed`).
+/// Inserts the runs of sweep $3 of process $1 of tenant $5 at time $2 from $4, a JSON
+/// array of `{id, run, inputs, hash, error, message}` (an `error` makes the run `failed`).
 const RUNS_SQLITE: &str = "\
     INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
-        finished_at, error, sweep_id, sweep_run, content_hash) \
+        finished_at, error, sweep_id, sweep_run, content_hash, tenant) \
     SELECT json_extract(value, '$.id'), $1, json_extract(value, '$.inputs'), \
         CASE WHEN json_extract(value, '$.error') IS NULL THEN 'accepted' ELSE 'failed' END, 0, \
         COALESCE(json_extract(value, '$.message'), \
             'queued (sweep run ' || json_extract(value, '$.run') || ')'), $2, $2, \
         CASE WHEN json_extract(value, '$.error') IS NULL THEN NULL ELSE $2 END, \
-        json_extract(value, '$.error'), $3, json_extract(value, '$.run'), json_extract(value, '$.hash') \
+        json_extract(value, '$.error'), $3, json_extract(value, '$.run'), json_extract(value, '$.hash'), \
+        $5 \
     FROM json_each($4) ORDER BY key";
 
 const RUNS_POSTGRES: &str = "\
     INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
-        finished_at, error, sweep_id, sweep_run, content_hash) \
+        finished_at, error, sweep_id, sweep_run, content_hash, tenant) \
     SELECT run->>'id', $1, run->>'inputs', \
         CASE WHEN run->>'error' IS NULL THEN 'accepted' ELSE 'failed' END, 0, \
         COALESCE(run->>'message', 'queued (sweep run ' || (run->>'run') || ')'), $2, $2, \
         CASE WHEN run->>'error' IS NULL THEN NULL ELSE $2 END, \
-        run->>'error', $3, CAST(run->>'run' AS BIGINT), run->>'hash' \
+        run->>'error', $3, CAST(run->>'run' AS BIGINT), run->>'hash', $5 \
     FROM jsonb_array_elements(CAST($4 AS jsonb)) WITH ORDINALITY AS runs (run, position) \
     ORDER BY position";
 
 /// What the queue stores of a new sweep.
 #[derive(Debug, Clone)]
 pub struct NewSweep<'a> {
+    /// The tenant that owns the sweep and its runs.
+    pub tenant: &'a str,
     pub process_id: &'a str,
     /// The normalized definition (JSON), served back by `GET /sweeps/{id}`.
     pub definition: &'a Value,
@@ -60,8 +66,15 @@ pub struct NewRun {
 }
 
 impl JobQueue {
-    /// Inserts the sweep and its runs (invalid runs directly as `failed`); returns the sweep.
-    pub async fn create_sweep(&self, sweep: &NewSweep<'_>) -> Result<SweepRecord, sqlx::Error> {
+    /// Inserts the sweep and its runs (invalid runs directly as `failed`); returns the
+    /// sweep, or nothing when its queued runs would give the tenant more than
+    /// `max_queued` accepted jobs.
+    pub async fn create_sweep(
+        &self,
+        sweep: &NewSweep<'_>,
+        max_queued: Option<u64>,
+    ) -> Result<Admission<SweepRecord>, sqlx::Error> {
+        let queued_runs = sweep.runs.iter().filter(|run| run.invalid.is_none()).count();
         let id = uuid::Uuid::new_v4().to_string();
         let now = self.now();
         let children: Vec<Value> = sweep
@@ -82,9 +95,14 @@ impl JobQueue {
         let runs = self.db.choose(RUNS_SQLITE, RUNS_POSTGRES);
         let record = with_pool!(&self.db, pool => {
             let mut tx = pool.begin().await?;
-            let record: SweepRecord = sqlx::query_as(concat!(
-                "INSERT INTO sweeps (id, process_id, definition, design, policy, runs, created_at, updated_at) \
-                 VALUES ($1, $2, $3, $4, $5, $6, $7, $7) RETURNING ",
+            tx.lock_tenant_queue(sweep.tenant).await?;
+            let record: Option<SweepRecord> = sqlx::query_as(concat!(
+                "INSERT INTO sweeps (id, tenant, process_id, definition, design, policy, runs, created_at, \
+                     updated_at) \
+                 SELECT $1, $8, $2, $3, $4, $5, $6, $7, $7 \
+                 WHERE $9 IS NULL \
+                    OR (SELECT COUNT(*) FROM jobs WHERE tenant = $8 AND status = 'accepted') + $10 <= $9 \
+                 RETURNING ",
                 sweep_columns!()
             ))
             .bind(&id)
@@ -94,19 +112,34 @@ impl JobQueue {
             .bind(sweep.policy)
             .bind(sweep.runs.len() as i64)
             .bind(now)
-            .fetch_one(&mut *tx)
+            .bind(sweep.tenant)
+            .bind(max_queued.map(|n| i64::try_from(n).unwrap_or(i64::MAX)))
+            .bind(queued_runs as i64)
+            .fetch_optional(&mut *tx)
             .await?;
-            sqlx::query(runs)
-                .bind(sweep.process_id)
-                .bind(now)
-                .bind(&id)
-                .bind(Value::Array(children).to_string())
-                .execute(&mut *tx)
-                .await?;
-            tx.commit().await?;
+            if record.is_some() {
+                sqlx::query(runs)
+                    .bind(sweep.process_id)
+                    .bind(now)
+                    .bind(&id)
+                    .bind(Value::Array(children).to_string())
+                    .bind(sweep.tenant)
+                    .execute(&mut *tx)
+                    .await?;
+                tx.commit().await?;
+            } else {
+                tx.rollback().await?;
+            }
             record
         });
-        self.announce_queued().await;
-        Ok(record)
+        match record {
+            Some(record) => {
+                self.announce_queued().await;
+                Ok(Admission::Admitted(record))
+            }
+            None => Ok(Admission::QueueFull {
+                queued: self.queued_count(sweep.tenant).await?,
+            }),
+        }
     }
 }

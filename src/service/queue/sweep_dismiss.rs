@@ -6,20 +6,25 @@ use super::{JobQueue, SweepRecord, sweep_columns};
 use crate::service::db::with_pool;
 
 impl JobQueue {
-    /// Dismisses sweep `id` and its unfinished runs; returns the sweep and the ids of
-    /// the runs dismissed now (to cancel the running ones at once), `None` if there is
-    /// no such sweep. Dismissing twice is harmless.
-    pub async fn dismiss_sweep(&self, id: &str) -> Result<Option<(SweepRecord, Vec<String>)>, sqlx::Error> {
+    /// Dismisses sweep `id` of `tenant` and its unfinished runs; returns the sweep and the
+    /// ids of the runs dismissed now (to cancel the running ones at once), `None` if
+    /// `tenant` has no such sweep. Dismissing twice is harmless.
+    pub async fn dismiss_sweep(
+        &self,
+        tenant: &str,
+        id: &str,
+    ) -> Result<Option<(SweepRecord, Vec<String>)>, sqlx::Error> {
         let now = self.now();
         with_pool!(&self.db, pool => {
             let mut tx = pool.begin().await?;
             let sweep: Option<SweepRecord> = sqlx::query_as(concat!(
                 "UPDATE sweeps SET dismissed = TRUE, updated_at = CASE WHEN dismissed THEN updated_at ELSE $2 END \
-                 WHERE id = $1 RETURNING ",
+                 WHERE id = $1 AND tenant = $3 RETURNING ",
                 sweep_columns!()
             ))
             .bind(id)
             .bind(now)
+            .bind(tenant)
             .fetch_optional(&mut *tx)
             .await?;
             let Some(sweep) = sweep else {

@@ -6,16 +6,17 @@ use std::collections::HashMap;
 use super::{JobQueue, JobStatus, SweepRecord, sweep_columns};
 use crate::service::db::with_pool;
 
-/// Counts of runs per sweep and status; $1 is a JSON array of sweep ids.
+/// Counts of runs per sweep and status; $1 is a JSON array of sweep ids, $2 the tenant.
 const COUNTS_SQLITE: &str = "\
     SELECT sweep_id, status, COUNT(*) AS n, CAST(SUM(progress) AS BIGINT) AS progress, \
         MAX(updated_at) AS updated, MAX(finished_at) AS finished \
-    FROM jobs WHERE sweep_id IN (SELECT value FROM json_each($1)) GROUP BY sweep_id, status";
+    FROM jobs WHERE sweep_id IN (SELECT value FROM json_each($1)) AND tenant = $2 \
+    GROUP BY sweep_id, status";
 
 const COUNTS_POSTGRES: &str = "\
     SELECT sweep_id, status, COUNT(*) AS n, CAST(SUM(progress) AS BIGINT) AS progress, \
         MAX(updated_at) AS updated, MAX(finished_at) AS finished \
-    FROM jobs WHERE sweep_id IN (SELECT json_array_elements_text(CAST($1 AS json))) \
+    FROM jobs WHERE sweep_id IN (SELECT json_array_elements_text(CAST($1 AS json))) AND tenant = $2 \
     GROUP BY sweep_id, status";
 
 /// How a sweep's runs stand.
@@ -70,18 +71,26 @@ pub struct SweepRun {
 }
 
 impl JobQueue {
-    pub async fn get_sweep(&self, id: &str) -> Result<Option<SweepRecord>, sqlx::Error> {
+    /// Sweep `id` if `tenant` owns it.
+    pub async fn get_sweep(&self, tenant: &str, id: &str) -> Result<Option<SweepRecord>, sqlx::Error> {
         with_pool!(&self.db, pool => {
-            sqlx::query_as(concat!("SELECT ", sweep_columns!(), " FROM sweeps WHERE id = $1"))
-                .bind(id)
-                .fetch_optional(pool)
-                .await
+            sqlx::query_as(concat!(
+                "SELECT ",
+                sweep_columns!(),
+                " FROM sweeps WHERE id = $1 AND tenant = $2"
+            ))
+            .bind(id)
+            .bind(tenant)
+            .fetch_optional(pool)
+            .await
         })
     }
 
-    /// Up to `limit` sweeps, newest first, strictly older than sequence `before` when given.
+    /// Up to `limit` sweeps of `tenant`, newest first, strictly older than sequence
+    /// `before` when given.
     pub async fn list_sweeps(
         &self,
+        tenant: &str,
         limit: u32,
         before: Option<i64>,
     ) -> Result<Vec<SweepRecord>, sqlx::Error> {
@@ -89,18 +98,20 @@ impl JobQueue {
             sqlx::query_as(concat!(
                 "SELECT ",
                 sweep_columns!(),
-                " FROM sweeps WHERE ($1 IS NULL OR seq < $1) ORDER BY seq DESC LIMIT $2"
+                " FROM sweeps WHERE ($1 IS NULL OR seq < $1) AND tenant = $3 ORDER BY seq DESC LIMIT $2"
             ))
             .bind(before)
             .bind(i64::from(limit))
+            .bind(tenant)
             .fetch_all(pool)
             .await
         })
     }
 
-    /// Counts of the runs of each of `sweep_ids` (every id present, zeros included).
+    /// Counts of the runs of each of `sweep_ids` of `tenant` (every id present, zeros included).
     pub async fn sweep_counts(
         &self,
+        tenant: &str,
         sweep_ids: &[String],
     ) -> Result<HashMap<String, SweepCounts>, sqlx::Error> {
         type Row = (String, String, i64, Option<i64>, Option<i64>, Option<i64>);
@@ -108,6 +119,7 @@ impl JobQueue {
         let rows: Vec<Row> = with_pool!(&self.db, pool => {
             sqlx::query_as(sql)
                 .bind(serde_json::to_string(sweep_ids).unwrap_or_default())
+                .bind(tenant)
                 .fetch_all(pool)
                 .await?
         });
@@ -124,15 +136,17 @@ impl JobQueue {
         Ok(counts)
     }
 
-    /// The runs of sweep `id` that ended (successful, failed, dismissed), in run order.
-    pub async fn ended_sweep_runs(&self, id: &str) -> Result<Vec<SweepRun>, sqlx::Error> {
+    /// The runs of sweep `id` of `tenant` that ended (successful, failed, dismissed), in run order.
+    pub async fn ended_sweep_runs(&self, tenant: &str, id: &str) -> Result<Vec<SweepRun>, sqlx::Error> {
         type Row = (String, Option<i64>, String, String, Option<String>);
         let rows: Vec<Row> = with_pool!(&self.db, pool => {
             sqlx::query_as(
                 "SELECT id, sweep_run, status, inputs, results FROM jobs \
-                 WHERE sweep_id = $1 AND status IN ('successful', 'failed', 'dismissed') ORDER BY sweep_run",
+                 WHERE sweep_id = $1 AND tenant = $2 AND status IN ('successful', 'failed', 'dismissed') \
+                 ORDER BY sweep_run",
             )
             .bind(id)
+            .bind(tenant)
             .fetch_all(pool)
             .await?
         });

@@ -38,6 +38,8 @@ pub struct WorkerContext {
     pub poll_interval: Duration,
     /// Period of progress and cancellation checks of a running job.
     pub progress_interval: Duration,
+    /// A run still computing after this long is stopped and fails.
+    pub max_job_time: Option<Duration>,
 }
 
 /// The running worker slots.

@@ -41,7 +41,7 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
     let started = Instant::now();
     // An identical run already succeeded: take its results instead of computing again.
     if let Some(hash) = &job.content_hash {
-        match ctx.queue.reuse(&lease, hash).await {
+        match ctx.queue.reuse(&lease, &job.tenant, hash).await {
             Ok(Some(source)) => {
                 ctx.metrics.observe_job(&process_id, "reused", started.elapsed());
                 tracing::info!(job = %lease.job_id, source = %source, "job reused the results of an identical job");
@@ -86,6 +86,15 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
     let renew_every = ctx.lease / 3;
     let (mut reported, mut renewed, mut checked) = (0u8, Instant::now(), Instant::now());
     let mut lost = false;
+    let mut timed_out = false;
+    // The wall-time limit: a run still computing then is cancelled and fails.
+    let over_time = async {
+        match ctx.max_job_time {
+            Some(limit) => tokio::time::sleep(limit).await,
+            None => std::future::pending().await,
+        }
+    };
+    tokio::pin!(over_time);
     let mut handing_back = *hand_back.borrow();
     if handing_back {
         control.cancel();
@@ -93,6 +102,11 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
     let outcome = loop {
         tokio::select! {
             outcome = &mut receiver => break outcome.unwrap_or_else(|_| Err("the compute thread vanished".into())),
+            () = &mut over_time, if !timed_out && !handing_back && !lost => {
+                tracing::warn!(job = %lease.job_id, limit = ?ctx.max_job_time, "job over its wall-time limit: stopping it");
+                timed_out = true;
+                control.cancel();
+            }
             changed = hand_back.changed(), if !handing_back => {
                 if changed.is_err() || *hand_back.borrow() {
                     handing_back = true;
@@ -128,20 +142,35 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
         }
     };
     ctx.running.remove(&lease.job_id);
-    let outcome_label = finish(ctx, &lease, outcome, lost, handing_back).await;
+    let ending = Ending {
+        lost,
+        handing_back,
+        timed_out: timed_out.then_some(ctx.max_job_time).flatten(),
+    };
+    let outcome_label = finish(ctx, &lease, outcome, ending).await;
     ctx.metrics
         .observe_job(&process_id, outcome_label, started.elapsed());
     tracing::info!(job = %lease.job_id, outcome = outcome_label, seconds = started.elapsed().as_secs_f64(), "job ended");
 }
 
-/// Writes the outcome of a run under its lease; returns the outcome's metric label.
-async fn finish(
-    ctx: &WorkerContext,
-    lease: &Lease,
-    outcome: ThreadOutcome,
+/// Why the supervisor may have cancelled a run.
+#[derive(Debug, Clone, Copy)]
+struct Ending {
+    /// The job is no longer ours (dismissed, lease lost).
     lost: bool,
+    /// The service is shutting down: the job goes back to the queue.
     handing_back: bool,
-) -> &'static str {
+    /// The run went over this wall-time limit.
+    timed_out: Option<Duration>,
+}
+
+/// Writes the outcome of a run under its lease; returns the outcome's metric label.
+async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, ending: Ending) -> &'static str {
+    let Ending {
+        lost,
+        handing_back,
+        timed_out,
+    } = ending;
     match outcome {
         Ok(Ok(_)) | Ok(Err(_)) if lost => "lost",
         Ok(Ok(output)) => {
@@ -181,6 +210,11 @@ async fn finish(
         Ok(Err(RunError::Cancelled)) if handing_back => {
             record(lease, "hand back", ctx.queue.hand_back(lease).await);
             "handed_back"
+        }
+        Ok(Err(RunError::Cancelled)) if timed_out.is_some() => {
+            let problem = Problem::job_time_limit(timed_out.unwrap_or_default());
+            record(lease, "fail", ctx.queue.fail(lease, &problem).await);
+            "timed_out"
         }
         // Stopped by a dismissal the supervisor has not noticed yet: the row says so already.
         Ok(Err(RunError::Cancelled)) => "dismissed",

@@ -1,0 +1,103 @@
+//! Request bodies as JSON values, for the HTTP API and the CLI alike.
+//!
+//! JSON's grammar allows numbers of any size, but a double cannot hold `1e400`: serde
+//! refuses it rather than turning it into infinity, and here that refusal names the
+//! member that holds it (`/inputs/beam/length`), as a 422 like any other bad input.
+//! Anything else that is not JSON, or nests deeper than serde_json's limit of 128
+//! levels, is a 400 `malformed-body`.
+
+use serde_json::Value;
+
+use crate::problem::Problem;
+use crate::processes::{FieldError, InvalidInputs};
+
+/// Deepest nesting of arrays and objects a body may have (serde_json's recursion limit).
+pub const MAX_DEPTH: usize = 128;
+
+/// Parses a request body; the errors are problem documents (400, or 422 with a pointer
+/// for a number out of range).
+pub fn parse(text: &str) -> Result<Value, Problem> {
+    let mut deserializer = serde_json::Deserializer::from_str(text);
+    let value: Value = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
+        let pointer = pointer_of(error.path());
+        let inner = error.into_inner();
+        let message = inner.to_string();
+        if message.starts_with("number out of range") {
+            Problem::invalid_inputs(&InvalidInputs(vec![FieldError::new(
+                pointer,
+                "is out of range: numbers must be finite doubles (magnitude below 1.8e308)",
+            )]))
+        } else if message.starts_with("recursion limit exceeded") {
+            Problem::malformed_body(format!(
+                "the body nests arrays and objects deeper than {MAX_DEPTH} levels ({message})"
+            ))
+        } else {
+            Problem::malformed_body(format!("the body is not valid JSON: {message}"))
+        }
+    })?;
+    deserializer
+        .end()
+        .map_err(|e| Problem::malformed_body(format!("the body is not valid JSON: {e}")))?;
+    Ok(value)
+}
+
+/// The JSON pointer of a serde path (`~` and `/` escaped).
+pub fn pointer_of(path: &serde_path_to_error::Path) -> String {
+    let mut pointer = String::new();
+    for segment in path.iter() {
+        match segment {
+            serde_path_to_error::Segment::Seq { index } => pointer.push_str(&format!("/{index}")),
+            serde_path_to_error::Segment::Map { key } => {
+                pointer.push('/');
+                pointer.push_str(&key.replace('~', "~0").replace('/', "~1"));
+            }
+            serde_path_to_error::Segment::Enum { .. } | serde_path_to_error::Segment::Unknown => {}
+        }
+    }
+    pointer
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_number_out_of_range_is_refused_at_its_member() {
+        let problem = parse(r#"{"inputs": {"beam": {"length": 1.0, "modes": [1, -1e400]}}}"#).unwrap_err();
+        assert_eq!(problem.status, 422);
+        assert_eq!(problem.errors[0].pointer, "/inputs/beam/modes/1");
+        let problem = parse(r#"{"a/b": 1e999}"#).unwrap_err();
+        assert_eq!(problem.errors[0].pointer, "/a~1b");
+    }
+
+    #[test]
+    fn large_but_finite_numbers_and_tiny_ones_parse() {
+        let value = parse(r#"{"x": 1.7e308, "y": 1e-400}"#).unwrap();
+        assert_eq!(value["x"], 1.7e308);
+        assert_eq!(value["y"], 0.0);
+    }
+
+    #[test]
+    fn nesting_beyond_the_limit_is_a_malformed_body() {
+        let deep = format!("{}{}", "[".repeat(MAX_DEPTH + 1), "]".repeat(MAX_DEPTH + 1));
+        let problem = parse(&deep).unwrap_err();
+        assert_eq!(problem.status, 400);
+        assert!(problem.detail.contains("deeper than 128"), "{}", problem.detail);
+        let fine = format!("{}{}", "[".repeat(MAX_DEPTH - 1), "]".repeat(MAX_DEPTH - 1));
+        assert!(parse(&fine).is_ok());
+    }
+
+    #[test]
+    fn syntax_errors_and_trailing_text_are_malformed_bodies() {
+        for text in [
+            "{",
+            "{\"a\": 1} x",
+            "",
+            "nul",
+            "{\"a\": NaN}",
+            "{\"a\": Infinity}",
+        ] {
+            assert_eq!(parse(text).unwrap_err().status, 400, "{text:?}");
+        }
+    }
+}

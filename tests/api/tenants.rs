@@ -1,0 +1,295 @@
+//! Bearer tokens and tenants: 401 without a valid token, `/healthz` open, `/metrics`
+//! open only when public, and each tenant's jobs and sweeps invisible to the others
+//! (404 for get, results, histories, dismissal; absent from lists).
+
+use std::time::Duration;
+
+use chocmodal::service::auth::TokenTable;
+use reqwest::{Response, StatusCode};
+use serde_json::{Value, json};
+
+use crate::counting;
+use crate::helpers::{Backend, TestApp, assert_problem, on_both_backends, spawn_app_on, spawn_app_with};
+
+on_both_backends!(
+    another_tenants_job_is_not_found_anywhere,
+    identical_inputs_of_another_tenant_are_computed_not_reused,
+    another_tenants_sweep_is_not_found_and_its_runs_are_not_listed
+);
+
+const ALPHA: &str = "alpha-token-0123456789";
+const BETA: &str = "beta-token-9876543210";
+
+fn tokens() -> TokenTable {
+    TokenTable::parse(&format!("# test tenants\nalpha {ALPHA}\nbeta {BETA}\n")).unwrap()
+}
+
+async fn spawn_with_tenants(backend: Backend) -> TestApp {
+    spawn_app_on(backend, |config| config.auth = Some(tokens())).await
+}
+
+/// Requests made with one tenant's token.
+struct As<'a> {
+    app: &'a TestApp,
+    token: &'a str,
+}
+
+impl As<'_> {
+    async fn get(&self, path: &str) -> Response {
+        self.app
+            .client
+            .get(self.app.url(path))
+            .bearer_auth(self.token)
+            .send()
+            .await
+            .unwrap()
+    }
+
+    async fn get_json(&self, path: &str) -> Value {
+        let response = self.get(path).await;
+        assert_eq!(response.status(), StatusCode::OK, "GET {path}");
+        response.json().await.unwrap()
+    }
+
+    async fn delete(&self, path: &str) -> Response {
+        self.app
+            .client
+            .delete(self.app.url(path))
+            .bearer_auth(self.token)
+            .send()
+            .await
+            .unwrap()
+    }
+
+    async fn post(&self, path: &str, body: &Value) -> Response {
+        self.app
+            .client
+            .post(self.app.url(path))
+            .bearer_auth(self.token)
+            .header("content-type", "application/json")
+            .body(body.to_string())
+            .send()
+            .await
+            .unwrap()
+    }
+
+    /// Submits `count-steps`; returns the job id.
+    async fn submit(&self, inputs: Value) -> String {
+        let response = self
+            .post(
+                &format!("/processes/{}/execution", counting::ID),
+                &json!({ "inputs": inputs }),
+            )
+            .await;
+        assert_eq!(response.status(), StatusCode::CREATED);
+        let status: Value = response.json().await.unwrap();
+        status["jobID"].as_str().unwrap().to_owned()
+    }
+
+    async fn wait_until_finished(&self, job: &str) -> Value {
+        for _ in 0..1000 {
+            let status = self.get_json(&format!("/jobs/{job}")).await;
+            if ["successful", "failed", "dismissed"].contains(&status["status"].as_str().unwrap()) {
+                return status;
+            }
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+        panic!("job {job} did not finish");
+    }
+}
+
+#[tokio::test]
+async fn without_a_token_every_route_but_the_health_check_is_a_401_problem() {
+    let app = spawn_with_tenants(Backend::Sqlite).await;
+    for path in [
+        "/",
+        "/processes",
+        "/jobs",
+        "/sweeps",
+        "/openapi.json",
+        "/metrics",
+        "/jobs/nope",
+    ] {
+        let response = app.get(path).await;
+        let challenge = response.headers()["www-authenticate"]
+            .to_str()
+            .unwrap()
+            .to_owned();
+        assert!(challenge.starts_with("Bearer"), "{path}: {challenge}");
+        assert_problem(response, StatusCode::UNAUTHORIZED, "/unauthorized").await;
+    }
+    // Before anything reads the body: no 413, 415 or 422 for an unauthenticated client.
+    let response = app.post_execution_raw(counting::ID, "not even json").await;
+    assert_problem(response, StatusCode::UNAUTHORIZED, "/unauthorized").await;
+    assert_eq!(app.get_json("/healthz").await, json!({"status": "ok"}));
+}
+
+#[tokio::test]
+async fn a_wrong_token_is_a_401_with_an_invalid_token_challenge() {
+    let app = spawn_with_tenants(Backend::Sqlite).await;
+    for header in [
+        "Bearer alpha-token-012345678".to_owned(),
+        format!("Bearer {ALPHA}x"),
+        format!("Basic {ALPHA}"),
+        ALPHA.to_owned(),
+    ] {
+        let response = app
+            .client
+            .get(app.url("/jobs"))
+            .header("authorization", &header)
+            .send()
+            .await
+            .unwrap();
+        let status = response.status();
+        let challenge = response.headers()["www-authenticate"]
+            .to_str()
+            .unwrap()
+            .to_owned();
+        assert_eq!(status, StatusCode::UNAUTHORIZED, "{header}");
+        assert!(challenge.contains("invalid_token"), "{header}: {challenge}");
+    }
+    let alpha = As {
+        app: &app,
+        token: ALPHA,
+    };
+    assert_eq!(alpha.get("/jobs").await.status(), StatusCode::OK);
+}
+
+#[tokio::test]
+async fn metrics_need_a_token_unless_public() {
+    let app = spawn_with_tenants(Backend::Sqlite).await;
+    assert_eq!(app.get("/metrics").await.status(), StatusCode::UNAUTHORIZED);
+    let alpha = As {
+        app: &app,
+        token: ALPHA,
+    };
+    assert_eq!(alpha.get("/metrics").await.status(), StatusCode::OK);
+
+    let public = spawn_app_with(|config| {
+        config.auth = Some(tokens());
+        config.metrics_public = true;
+    })
+    .await;
+    assert_eq!(public.get("/metrics").await.status(), StatusCode::OK);
+    assert_eq!(public.get("/jobs").await.status(), StatusCode::UNAUTHORIZED);
+}
+
+async fn another_tenants_job_is_not_found_anywhere(backend: Backend) {
+    let app = spawn_with_tenants(backend).await;
+    let alpha = As {
+        app: &app,
+        token: ALPHA,
+    };
+    let beta = As {
+        app: &app,
+        token: BETA,
+    };
+    let job = alpha.submit(json!({"steps": 5})).await;
+    assert_eq!(alpha.wait_until_finished(&job).await["status"], "successful");
+
+    for path in [
+        format!("/jobs/{job}"),
+        format!("/jobs/{job}/results"),
+        format!("/jobs/{job}/results/signal"),
+        format!("/jobs/{job}/results/signal?format=csv"),
+    ] {
+        assert_problem(beta.get(&path).await, StatusCode::NOT_FOUND, "/no-such-job").await;
+    }
+    assert_problem(
+        beta.delete(&format!("/jobs/{job}")).await,
+        StatusCode::NOT_FOUND,
+        "/no-such-job",
+    )
+    .await;
+    assert_eq!(beta.get_json("/jobs").await["jobs"], json!([]));
+    assert_eq!(
+        beta.get_json("/jobs?status=successful&processID=count-steps")
+            .await["jobs"],
+        json!([])
+    );
+
+    // Beta's attempts changed nothing for alpha.
+    let listed = alpha.get_json("/jobs").await;
+    assert_eq!(listed["jobs"][0]["jobID"], job.as_str());
+    assert_eq!(
+        alpha.get_json(&format!("/jobs/{job}")).await["status"],
+        "successful"
+    );
+    assert_eq!(alpha.get_json(&format!("/jobs/{job}/results")).await["sum"], 15);
+}
+
+async fn identical_inputs_of_another_tenant_are_computed_not_reused(backend: Backend) {
+    let app = spawn_with_tenants(backend).await;
+    let alpha = As {
+        app: &app,
+        token: ALPHA,
+    };
+    let beta = As {
+        app: &app,
+        token: BETA,
+    };
+    let first = alpha.submit(json!({"steps": 7})).await;
+    alpha.wait_until_finished(&first).await;
+    let second = beta.submit(json!({"steps": 7})).await;
+    let status = beta.wait_until_finished(&second).await;
+    assert_eq!(status["status"], "successful");
+    assert!(
+        !status["message"].as_str().unwrap().contains(&first),
+        "beta learnt of alpha's job: {status}"
+    );
+    assert_eq!(app.probe.started(), 2, "both runs computed");
+    // The same tenant does reuse.
+    let third = alpha.submit(json!({"steps": 7})).await;
+    let status = alpha.wait_until_finished(&third).await;
+    assert!(status["message"].as_str().unwrap().contains(&first), "{status}");
+}
+
+async fn another_tenants_sweep_is_not_found_and_its_runs_are_not_listed(backend: Backend) {
+    let app = spawn_with_tenants(backend).await;
+    let alpha = As {
+        app: &app,
+        token: ALPHA,
+    };
+    let beta = As {
+        app: &app,
+        token: BETA,
+    };
+    let response = alpha
+        .post(
+            "/sweeps",
+            &json!({"process": counting::ID, "inputs": {"steps": 3},
+                    "axes": [{"pointer": "/steps", "values": [3, 4]}]}),
+        )
+        .await;
+    assert_eq!(response.status(), StatusCode::CREATED);
+    let sweep: Value = response.json().await.unwrap();
+    let id = sweep["sweepID"].as_str().unwrap().to_owned();
+
+    for path in [
+        format!("/sweeps/{id}"),
+        format!("/sweeps/{id}/results"),
+        format!("/sweeps/{id}/results?format=csv"),
+    ] {
+        assert_problem(beta.get(&path).await, StatusCode::NOT_FOUND, "/no-such-sweep").await;
+    }
+    assert_problem(
+        beta.delete(&format!("/sweeps/{id}")).await,
+        StatusCode::NOT_FOUND,
+        "/no-such-sweep",
+    )
+    .await;
+    assert_eq!(beta.get_json("/sweeps").await["sweeps"], json!([]));
+    assert_eq!(
+        beta.get_json(&format!("/jobs?sweepID={id}")).await["jobs"],
+        json!([])
+    );
+
+    assert_eq!(
+        alpha.get_json("/sweeps").await["sweeps"][0]["sweepID"],
+        id.as_str()
+    );
+    let runs = alpha.get_json(&format!("/jobs?sweepID={id}")).await;
+    assert_eq!(runs["jobs"].as_array().unwrap().len(), 2);
+    let status = alpha.get_json(&format!("/sweeps/{id}")).await;
+    assert_ne!(status["status"], "dismissed", "{status}");
+}
