@@ -1,6 +1,10 @@
-# chocmodal service image: `docker build -t chocmodal .` then
-# `docker run -p 8080:8080 -v chocmodal-data:/data chocmodal` (API + workers on SQLite), or
-# with PostgreSQL, API and workers apart: `docker compose up` (compose.yaml).
+# chocmodal service image: `docker build -t chocmodal .` then (API + workers on SQLite)
+# `docker run -p 8080:8080 -v chocmodal-data:/data -v $PWD/tokens:/etc/chocmodal/tokens:ro \
+#      -e CHOCMODAL_AUTH_FILE=/etc/chocmodal/tokens chocmodal`
+# The image listens on 0.0.0.0, so it refuses to start without an auth file
+# (`<tenant> <token>` lines, see docs/service.md), unless CHOCMODAL_INSECURE=true
+# (behind a proxy that authenticates). With PostgreSQL, API and workers apart:
+# `docker compose up` (compose.yaml).
 FROM rust:1.95-bookworm AS build
 WORKDIR /src
 COPY Cargo.toml Cargo.lock ./

@@ -127,7 +127,7 @@ fn encode_component(text: &str) -> String {
         ("status" = Option<String>, Query, description = "Only jobs in these statuses, e.g. `running,accepted`"),
         ("processID" = Option<String>, Query, description = "Only jobs of these processes"),
         ("sweepID" = Option<String>, Query, description = "Only runs of these sweeps"),
-        ("limit" = Option<u32>, Query, description = "Jobs per page, 1 to 1000 (default 10)"),
+        ("limit" = Option<u32>, Query, description = "Jobs per page, 1 to 1000 (default 10)", minimum = 1, maximum = 1000),
         ("cursor" = Option<i64>, Query, description = "Opaque position from a `next` link"),
     ),
     responses(

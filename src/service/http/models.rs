@@ -154,6 +154,11 @@ pub struct ProcessDescription {
 
 /// An execution request.
 #[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"inputs": {
+    "beam": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
+             "section": {"type": "tube", "outer_diameter": 0.010, "inner_diameter": 0.009}},
+    "contact": {"rk": 1.0}, "release": {"tip_displacement": 0.001},
+    "solver": {"time_step": 1e-5, "duration": 0.02}}}))]
 pub struct ExecuteRequest {
     /// The process inputs (see the process description): `CantileverInputs` for
     /// `cantilever-impact`, `BundleInputs` for `bundle-dynamics`.

@@ -6,8 +6,12 @@
 //!
 //! Security: every operation but `/healthz` takes a bearer token (the `bearer` scheme)
 //! and may answer 401; [`BearerSecurity`] adds both to the generated document, so a
-//! new route is covered without annotating it.
+//! new route is covered without annotating it. [`ResourceLinks`] adds OpenAPI links
+//! (a created job's id to its status, results and dismissal, ...), which generic
+//! clients and stateful API fuzzers (`scripts/fuzz.sh`) follow.
 
+use utoipa::openapi::RefOr;
+use utoipa::openapi::link::LinkBuilder;
 use utoipa::openapi::path::Operation;
 use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityRequirement, SecurityScheme};
 use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
@@ -113,9 +117,134 @@ impl Modify for BearerSecurity {
     }
 }
 
+/// Links from the responses that name a resource to the operations on it.
+#[derive(Debug)]
+pub struct ResourceLinks;
+
+/// (path, method, status, link name, target operation id, parameter, runtime expression).
+const LINKS: &[(&str, &str, &str, &str, &str, &str, &str)] = &[
+    (
+        "/processes",
+        "get",
+        "200",
+        "describe",
+        "getProcessDescription",
+        "processId",
+        "$response.body#/processes/0/id",
+    ),
+    (
+        "/processes",
+        "get",
+        "200",
+        "execute",
+        "execute",
+        "processId",
+        "$response.body#/processes/0/id",
+    ),
+    (
+        "/processes/{processId}/execution",
+        "post",
+        "201",
+        "status",
+        "getStatus",
+        "jobId",
+        "$response.body#/jobID",
+    ),
+    (
+        "/processes/{processId}/execution",
+        "post",
+        "201",
+        "results",
+        "getResult",
+        "jobId",
+        "$response.body#/jobID",
+    ),
+    (
+        "/processes/{processId}/execution",
+        "post",
+        "201",
+        "history",
+        "getResultOutput",
+        "jobId",
+        "$response.body#/jobID",
+    ),
+    (
+        "/processes/{processId}/execution",
+        "post",
+        "201",
+        "dismiss",
+        "dismiss",
+        "jobId",
+        "$response.body#/jobID",
+    ),
+    (
+        "/sweeps",
+        "post",
+        "201",
+        "status",
+        "getSweep",
+        "sweepId",
+        "$response.body#/sweepID",
+    ),
+    (
+        "/sweeps",
+        "post",
+        "201",
+        "results",
+        "getSweepResults",
+        "sweepId",
+        "$response.body#/sweepID",
+    ),
+    (
+        "/sweeps",
+        "post",
+        "201",
+        "dismiss",
+        "dismissSweep",
+        "sweepId",
+        "$response.body#/sweepID",
+    ),
+    (
+        "/sweeps",
+        "post",
+        "201",
+        "runs",
+        "getJobs",
+        "sweepID",
+        "$response.body#/sweepID",
+    ),
+];
+
+impl Modify for ResourceLinks {
+    fn modify(&self, openapi: &mut utoipa::openapi::OpenApi) {
+        for (path, method, status, name, target, parameter, expression) in LINKS {
+            let Some(item) = openapi.paths.paths.get_mut(*path) else {
+                continue;
+            };
+            let operation = match *method {
+                "get" => item.get.as_mut(),
+                "post" => item.post.as_mut(),
+                _ => None,
+            };
+            let Some(RefOr::T(response)) = operation.and_then(|op| op.responses.responses.get_mut(*status))
+            else {
+                continue;
+            };
+            response.links.insert(
+                (*name).to_owned(),
+                LinkBuilder::new()
+                    .operation_id(*target)
+                    .parameter(*parameter, *expression)
+                    .build()
+                    .into(),
+            );
+        }
+    }
+}
+
 #[derive(Debug, OpenApi)]
 #[openapi(
-    modifiers(&BearerSecurity),
+    modifiers(&BearerSecurity, &ResourceLinks),
     info(
         title = "chocmodal",
         description = "Modal multi-contact dynamics of slender beam bundles, run as asynchronous \

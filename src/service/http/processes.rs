@@ -50,7 +50,7 @@ pub async fn list(State(state): State<AppState>) -> Json<ProcessList> {
 ///
 /// Its inputs (JSON Schema, with SI units in the descriptions) and outputs.
 #[utoipa::path(get, path = "/processes/{processId}", operation_id = "getProcessDescription", tag = "Processes",
-    params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`")),
+    params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`", example = "cantilever-impact")),
     responses(
         (status = 200, description = "The process description", body = ProcessDescription),
         (status = 404, description = "No such process (`no-such-process`)", body = super::openapi::ProblemSchema,
@@ -78,7 +78,7 @@ pub async fn describe(
 /// whose estimated cost is above this service's ceilings: 422 `too-costly`, pointing at
 /// the fields that drive the cost. Too many queued jobs already: 429 with `Retry-After`.
 #[utoipa::path(post, path = "/processes/{processId}/execution", operation_id = "execute", tag = "Processes",
-    params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`")),
+    params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`", example = "cantilever-impact")),
     request_body(content = ExecuteRequest, description = "`{\"inputs\": {...}}`, see the process description"),
     responses(
         (status = 201, description = "Job queued", body = StatusInfo,

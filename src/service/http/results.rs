@@ -21,6 +21,7 @@ use crate::service::{store, thinning};
 #[into_params(parameter_in = Query)]
 pub struct HistoryQuery {
     /// `csv` or `json` (default: JSON, or CSV when `Accept` prefers `text/csv`).
+    #[param(pattern = "^(csv|json)$")]
     pub format: Option<String>,
     /// Start of the window (s), inclusive.
     pub t_start: Option<f64>,
@@ -29,6 +30,7 @@ pub struct HistoryQuery {
     /// Thin the window to at most this many rows (at least 2 per series), keeping each
     /// series' minimum and maximum of every bucket so that peaks survive. The service
     /// caps it (`--max-history-points`, default 500000): longer windows are always thinned.
+    #[param(minimum = 2)]
     pub max_points: Option<usize>,
     /// Only these series, comma-separated and in this order (e.g. `c3,c17`); default: all.
     pub series: Option<String>,
@@ -111,7 +113,7 @@ pub async fn results(
 #[utoipa::path(get, path = "/jobs/{jobId}/results/{output}", operation_id = "getResultOutput", tag = "Results",
     params(
         ("jobId" = String, Path, description = "Job id"),
-        ("output" = String, Path, description = "Output name, e.g. `tip_displacement`"),
+        ("output" = String, Path, description = "Output name, e.g. `tip_displacement`", example = "tip_displacement"),
         HistoryQuery,
     ),
     responses(

@@ -178,7 +178,13 @@ pub struct SweepAxisSchema {
 /// A sweep request. Integer targets (an integer in the base inputs, or integer bounds)
 /// receive generated numbers rounded to integers.
 #[derive(Debug, ToSchema)]
-#[schema(as = SweepRequest)]
+#[schema(as = SweepRequest, example = json!({
+    "process": "cantilever-impact",
+    "inputs": {"beam": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
+                        "section": {"type": "tube", "outer_diameter": 0.010, "inner_diameter": 0.009}},
+               "release": {"tip_displacement": 0.001},
+               "solver": {"time_step": 1e-5, "duration": 0.02}},
+    "axes": [{"pointer": "/contact/rk", "values": [0.1, 10.0]}]}))]
 #[allow(dead_code)]
 pub struct SweepRequestSchema {
     /// Process id, e.g. `cantilever-impact`.

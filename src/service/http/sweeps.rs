@@ -320,6 +320,7 @@ pub async fn status(
 #[into_params(parameter_in = Query)]
 pub struct SweepListQuery {
     /// Sweeps per page, 1 to 1000 (default 10).
+    #[param(minimum = 1, maximum = 1000)]
     pub limit: Option<u32>,
     /// Opaque position from a `next` link.
     pub cursor: Option<i64>,
@@ -404,6 +405,7 @@ pub async fn dismiss(
 #[into_params(parameter_in = Query)]
 pub struct SweepResultsQuery {
     /// `json` (default: the table with aggregates) or `csv` (the table only).
+    #[param(pattern = "^(csv|json)$")]
     pub format: Option<String>,
 }
 
