@@ -85,6 +85,8 @@ pub(super) struct LevelShapes {
     data: Vec<f64>,
     /// Levels rounded up to whole blocks.
     pub levels: usize,
+    /// Levels.
+    level_count: usize,
 }
 
 impl LevelShapes {
@@ -111,6 +113,7 @@ impl LevelShapes {
         Self {
             data,
             levels: blocks * BLOCK,
+            level_count,
         }
     }
 }
@@ -132,13 +135,15 @@ pub(super) fn level_deflections<S: Simd>(
     }
     let (vectors, _) = S::as_simd_f64s(&shapes.data);
     let one_block_per_vector = vectors.len() * BLOCK == shapes.data.len();
-    for (coordinates, pin_levels) in q.chunks_exact(row).zip(out.chunks_exact_mut(levels)) {
+    let stride = out.len() / levels;
+    let mut pin_levels = [0.0; GROUP * BLOCK];
+    for (p, coordinates) in q.chunks_exact(row).enumerate() {
         let (mut first, mut offset) = (0, 0);
         while first < levels / BLOCK {
             let group = GROUP.min(levels / BLOCK - first);
             let size = group * BLOCK * row;
             let data = &shapes.data[offset..offset + size];
-            let out_group = &mut pin_levels[first * BLOCK..(first + group) * BLOCK];
+            let out_group = &mut pin_levels[..group * BLOCK];
             if one_block_per_vector {
                 let (group_vectors, _) = S::as_simd_f64s(data);
                 match group {
@@ -156,8 +161,77 @@ pub(super) fn level_deflections<S: Simd>(
                     }
                 }
             }
+            // Real levels only: the padded ones stay 0.
+            let mut slot = first * BLOCK * stride + 1 + p;
+            for w in &out_group[..out_group.len().min(shapes.level_count - first * BLOCK)] {
+                out[slot] = *w;
+                slot += stride;
+            }
             first += group;
             offset += size;
+        }
+    }
+}
+
+/// A run of consecutive contacts whose left and right sides are consecutive slots of
+/// the level-major deflections (a row of pins between two walls is one run per level):
+/// their penetrations are one vector subtraction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Run {
+    pub first_contact: usize,
+    pub len: usize,
+    pub left_slot: usize,
+    pub right_slot: usize,
+}
+
+impl Run {
+    /// Contacts (left slot, right slot) cut into maximal runs.
+    pub fn split(slots: impl IntoIterator<Item = (usize, usize)>) -> Vec<Run> {
+        let mut runs: Vec<Run> = Vec::new();
+        for (c, (left, right)) in slots.into_iter().enumerate() {
+            match runs.last_mut() {
+                Some(run) if run.left_slot + run.len == left && run.right_slot + run.len == right => {
+                    run.len += 1
+                }
+                _ => runs.push(Run {
+                    first_contact: c,
+                    len: 1,
+                    left_slot: left,
+                    right_slot: right,
+                }),
+            }
+        }
+        runs
+    }
+}
+
+/// For every contact of every run: δ = w_left − w_right − gap into `now`, and the
+/// running maximum `max`.
+#[inline(always)]
+pub(super) fn penetrations<S: Simd>(
+    simd: S,
+    runs: &[Run],
+    deflections: &[f64],
+    gaps: &[f64],
+    now: &mut [f64],
+    max: &mut [f64],
+) {
+    for run in runs {
+        let contacts = run.first_contact..run.first_contact + run.len;
+        let left = &deflections[run.left_slot..run.left_slot + run.len];
+        let right = &deflections[run.right_slot..run.right_slot + run.len];
+        let (l_head, l_tail) = S::as_simd_f64s(left);
+        let (r_head, r_tail) = S::as_simd_f64s(right);
+        let (g_head, g_tail) = S::as_simd_f64s(&gaps[contacts.clone()]);
+        let (n_head, n_tail) = S::as_mut_simd_f64s(&mut now[contacts.clone()]);
+        let (m_head, m_tail) = S::as_mut_simd_f64s(&mut max[contacts]);
+        for ((((l, r), g), n), m) in l_head.iter().zip(r_head).zip(g_head).zip(n_head).zip(m_head) {
+            *n = simd.sub_f64s(simd.sub_f64s(*l, *r), *g);
+            *m = simd.max_f64s(*m, *n);
+        }
+        for ((((l, r), g), n), m) in l_tail.iter().zip(r_tail).zip(g_tail).zip(n_tail).zip(m_tail) {
+            *n = l - r - g;
+            *m = m.max(*n);
         }
     }
 }
@@ -347,8 +421,15 @@ mod tests {
             let shapes = values(level_count * row, 0.37);
             let q = values(pins * row, 0.53);
             let grouped = LevelShapes::new(&shapes, row);
-            let mut out = vec![f64::NAN; pins * grouped.levels];
+            let stride = pins + 2;
+            let mut out = vec![0.0; stride * grouped.levels];
             level_deflections(simd, &grouped, row, &q, &mut out);
+            for l in 0..grouped.levels {
+                assert!(
+                    out[l * stride] == 0.0 && out[l * stride + pins + 1] == 0.0,
+                    "wall slots stay 0"
+                );
+            }
             for p in 0..pins {
                 for l in 0..grouped.levels {
                     let expected = if l < level_count {
@@ -356,12 +437,26 @@ mod tests {
                     } else {
                         0.0
                     };
-                    assert!(
-                        close(out[p * grouped.levels + l], expected),
-                        "level {l} of pin {p}"
-                    );
+                    assert!(close(out[l * stride + 1 + p], expected), "level {l} of pin {p}");
                 }
             }
+        }
+
+        // Two runs (4 + 7 contacts, one run with a tail) and a lone contact.
+        let slots: Vec<(usize, usize)> = (0..4)
+            .map(|k| (k, k + 1))
+            .chain((0..7).map(|k| (20 + k, 10 + k)))
+            .chain([(3, 3)])
+            .collect();
+        let runs = Run::split(slots.iter().copied());
+        assert_eq!(runs.len(), 3);
+        let deflections = values(40, 0.61);
+        let gaps = values(slots.len(), 0.67);
+        let (mut now, mut max) = (vec![0.0; slots.len()], vec![0.2; slots.len()]);
+        penetrations(simd, &runs, &deflections, &gaps, &mut now, &mut max);
+        for (c, (left, right)) in slots.iter().enumerate() {
+            let expected = deflections[*left] - deflections[*right] - gaps[c];
+            assert!(close(now[c], expected) && max[c] == expected.max(0.2));
         }
 
         let (stiffness, damping, factor, participation) = (

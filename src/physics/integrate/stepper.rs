@@ -22,8 +22,8 @@
 use pulp::Simd;
 
 use super::kernels::{
-    self, BLOCK, LevelShapes, ModalCoefficients, advance_positions, axpy, dot_ahead, level_deflections,
-    modal_update, scale_into,
+    self, BLOCK, LevelShapes, ModalCoefficients, Run, advance_positions, axpy, dot_ahead, level_deflections,
+    modal_update, penetrations, scale_into,
 };
 use super::{ContactStatistics, EnergyBalance, Model, PinExtreme, Settings, Simulation, SimulationError};
 use crate::physics::contact::Body;
@@ -61,10 +61,8 @@ pub(super) struct Integrator<'m> {
     contact_level: Vec<usize>,
     contact_left: Vec<usize>,
     contact_right: Vec<usize>,
-    /// Per contact: index into `level_deflections` of its left and right side (a wall
-    /// reads the always-zero block after the last pin).
-    left_slot: Vec<usize>,
-    right_slot: Vec<usize>,
+    /// The contacts cut in runs of consecutive slots of `level_deflections`.
+    runs: Vec<Run>,
     gaps: Vec<f64>,
     /// Per contact: penetration now, a step ago (the two buffers swap every step) and
     /// largest so far.
@@ -77,7 +75,8 @@ pub(super) struct Integrator<'m> {
     candidate_count: usize,
     /// Base acceleration at the current step (m/s²).
     base_now: f64,
-    /// w of every pin at every level (`(pins + 1) × levels`, the last block zero for walls).
+    /// w of every pin at every level (`levels × (pins + 2)`, level by level with a zero
+    /// slot for a wall on each side: `[wall, pin 0, …, pin n−1, wall]`).
     level_deflections: Vec<f64>,
     /// ψ at each point force's and each output height (padded to `row`).
     point_force_shapes: Vec<Vec<f64>>,
@@ -182,9 +181,17 @@ impl<'m> Integrator<'m> {
         let contact_left: Vec<usize> = model.contacts.iter().map(|c| pin_index(c.left)).collect();
         let contact_right: Vec<usize> = model.contacts.iter().map(|c| pin_index(c.right)).collect();
         let levels = heights.len().div_ceil(BLOCK) * BLOCK;
-        let slot = |c: usize, pin: usize| contact_level[c] + levels * if pin == WALL { pins } else { pin };
-        let left_slot = (0..contacts).map(|c| slot(c, contact_left[c])).collect();
-        let right_slot = (0..contacts).map(|c| slot(c, contact_right[c])).collect();
+        // A wall on the left reads the zero slot before the first pin, on the right the one
+        // after the last, so a row between two walls is one run per level.
+        let stride = pins + 2;
+        let slot =
+            |level: usize, pin: usize, wall: usize| level * stride + if pin == WALL { wall } else { 1 + pin };
+        let runs = Run::split((0..contacts).map(|c| {
+            (
+                slot(contact_level[c], contact_left[c], 0),
+                slot(contact_level[c], contact_right[c], pins + 1),
+            )
+        }));
         let level_shapes: Vec<f64> = heights.iter().flat_map(|h| shape_at(*h)).collect();
         let grouped_level_shapes = LevelShapes::new(&level_shapes, row);
         let r2 = (dt / critical).powi(2);
@@ -217,8 +224,7 @@ impl<'m> Integrator<'m> {
             contact_level,
             contact_left,
             contact_right,
-            left_slot,
-            right_slot,
+            runs,
             gaps: model.contacts.iter().map(|c| c.gap).collect(),
             penetration: vec![0.0; contacts],
             previous_penetration: vec![0.0; contacts],
@@ -226,7 +232,7 @@ impl<'m> Integrator<'m> {
             candidates: vec![0; contacts],
             candidate_count: 0,
             base_now: 0.0,
-            level_deflections: vec![0.0; (pins + 1) * levels],
+            level_deflections: vec![0.0; levels * stride],
             point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
             output_shapes: settings.output_heights.iter().map(|h| shape_at(*h)).collect(),
             node_shapes: (0..nodes)
@@ -310,26 +316,24 @@ impl<'m> Integrator<'m> {
         // Every contact, branch-free: penetration, its running maximum, and the
         // candidates (closed now or a step ago, a few percent of them).
         std::mem::swap(&mut self.penetration, &mut self.previous_penetration);
-        let contacts = self.gaps.len();
-        let deflections = self.level_deflections.as_slice();
-        let (now, previous, max, candidates) = (
-            &mut self.penetration[..contacts],
-            &self.previous_penetration[..contacts],
-            &mut self.max_penetration[..contacts],
-            &mut self.candidates[..contacts],
+        penetrations(
+            simd,
+            &self.runs,
+            &self.level_deflections,
+            &self.gaps,
+            &mut self.penetration,
+            &mut self.max_penetration,
         );
-        let (gaps, left, right) = (
-            &self.gaps[..contacts],
-            &self.left_slot[..contacts],
-            &self.right_slot[..contacts],
+        let contacts = self.gaps.len();
+        let (now, previous, candidates) = (
+            &self.penetration[..contacts],
+            &self.previous_penetration[..contacts],
+            &mut self.candidates[..contacts],
         );
         let mut count = 0;
         for c in 0..contacts {
-            let penetration = deflections[left[c]] - deflections[right[c]] - gaps[c];
-            now[c] = penetration;
-            max[c] = max[c].max(penetration);
             candidates[count] = c as u32;
-            count += usize::from((penetration > 0.0) | (previous[c] > 0.0));
+            count += usize::from((now[c] > 0.0) | (previous[c] > 0.0));
         }
         self.candidate_count = count;
 
