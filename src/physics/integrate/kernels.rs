@@ -255,6 +255,27 @@ fn accumulate_group<S: Simd, const G: usize>(
     out_vectors.copy_from_slice(&acc);
 }
 
+/// ½ Σ (v² + ωᵢ² q²) over every pin (`stiffness` = ωᵢ² per mode, one row).
+#[inline(always)]
+pub(super) fn modal_energy<S: Simd>(simd: S, stiffness: &[f64], q: &[f64], v: &[f64]) -> f64 {
+    let row = stiffness.len();
+    let (k_head, k_tail) = S::as_simd_f64s(stiffness);
+    let mut acc = simd.splat_f64s(0.0);
+    let mut tail = 0.0;
+    for (q, v) in q.chunks_exact(row).zip(v.chunks_exact(row)) {
+        let (q_head, q_tail) = S::as_simd_f64s(q);
+        let (v_head, v_tail) = S::as_simd_f64s(v);
+        for ((q, v), k) in q_head.iter().zip(v_head).zip(k_head) {
+            acc = simd.mul_add_e_f64s(*v, *v, acc);
+            acc = simd.mul_add_e_f64s(simd.mul_f64s(*k, *q), *q, acc);
+        }
+        for ((q, v), k) in q_tail.iter().zip(v_tail).zip(k_tail) {
+            tail += v * v + k * q * q;
+        }
+    }
+    0.5 * (simd.reduce_sum_f64s(acc) + tail)
+}
+
 /// Per-mode coefficients of the modal update (each padded to the row length).
 pub(super) struct ModalCoefficients<'a> {
     /// ωᵢ².
@@ -485,6 +506,10 @@ mod tests {
             participation_velocity += participation[i] * velocity;
         }
         assert!(close(sums.damping_power, damping_power));
+        let energy: f64 = (0..pins * row)
+            .map(|k| 0.5 * (v[k] * v[k] + stiffness[k % row] * q[k] * q[k]))
+            .sum();
+        assert!(close(modal_energy(simd, &stiffness, &q, &v), energy));
         assert!(close(sums.participation_velocity, participation_velocity));
 
         for (half, curvature) in [(0.5, 0.0), (1.0, 0.3)] {

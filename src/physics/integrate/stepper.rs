@@ -44,6 +44,7 @@ pub(super) struct Integrator<'m> {
     dt: f64,
     /// Length of one pin's row: the modes rounded up to whole blocks.
     row: usize,
+    pins: usize,
     /// Per mode (padded to `row`): ωᵢ², 2ξᵢωᵢ, and for central difference 1/(1 + ξᵢωᵢΔt).
     omega_squared: Vec<f64>,
     damping: Vec<f64>,
@@ -81,8 +82,10 @@ pub(super) struct Integrator<'m> {
     /// ψ at each point force's and each output height (padded to `row`).
     point_force_shapes: Vec<Vec<f64>>,
     output_shapes: Vec<Vec<f64>>,
-    /// Nodal deflection of each mode (`nodes × row`), for pin extremes.
-    node_shapes: Vec<f64>,
+    /// Nodal deflection of each mode, for pin extremes, and the nodal deflections of
+    /// every pin at the last sample (laid out as `level_deflections`).
+    node_shapes: LevelShapes,
+    node_deflections: Vec<f64>,
     /// Pin-major state (`pins × row`): coordinates, velocities, accelerations, loads.
     q: Vec<f64>,
     v: Vec<f64>,
@@ -103,13 +106,23 @@ pub(super) struct Integrator<'m> {
     pin_extremes: Vec<PinExtreme>,
 }
 
-/// One step (or, `initial`, the forces at t = 0) as a [`pulp::WithSimd`] operation:
-/// everything it inlines is compiled with the target features [`pulp::Arch`] detected
-/// at run time.
+/// What [`StepOp`] does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Operation {
+    /// The forces at t = 0.
+    Initial,
+    /// One step.
+    Step,
+    /// The deflection of every pin at every node, into `node_deflections`.
+    NodeDeflections,
+}
+
+/// An operation on the state as a [`pulp::WithSimd`] operation: everything it inlines
+/// is compiled with the target features [`pulp::Arch`] detected at run time.
 struct StepOp<'a, 'm> {
     integrator: &'a mut Integrator<'m>,
     t: f64,
-    initial: bool,
+    operation: Operation,
 }
 
 impl pulp::WithSimd for StepOp<'_, '_> {
@@ -117,11 +130,36 @@ impl pulp::WithSimd for StepOp<'_, '_> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
-        if self.initial {
-            self.integrator.contact_forces_and_statistics(simd, self.t, false);
-        } else {
-            self.integrator.step_body(simd, self.t);
+        let integrator = self.integrator;
+        match self.operation {
+            Operation::Initial => {
+                integrator.contact_forces_and_statistics(simd, self.t, false);
+            }
+            Operation::Step => integrator.step_body(simd, self.t),
+            Operation::NodeDeflections => level_deflections(
+                simd,
+                &integrator.node_shapes,
+                integrator.row,
+                &integrator.q,
+                &mut integrator.node_deflections,
+            ),
         }
+    }
+}
+
+/// ½ Σ (v² + ω² q²) as a [`pulp::WithSimd`] operation.
+struct ModalEnergyOp<'a> {
+    stiffness: &'a [f64],
+    q: &'a [f64],
+    v: &'a [f64],
+}
+
+impl pulp::WithSimd for ModalEnergyOp<'_> {
+    type Output = f64;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> f64 {
+        kernels::modal_energy(simd, self.stiffness, self.q, self.v)
     }
 }
 
@@ -194,6 +232,13 @@ impl<'m> Integrator<'m> {
         }));
         let level_shapes: Vec<f64> = heights.iter().flat_map(|h| shape_at(*h)).collect();
         let grouped_level_shapes = LevelShapes::new(&level_shapes, row);
+        let node_shapes = LevelShapes::new(
+            &(0..nodes)
+                .flat_map(|n| (0..row).map(move |i| if i < modes { basis.shape(i)[2 * n] } else { 0.0 }))
+                .collect::<Vec<_>>(),
+            row,
+        );
+        let node_levels = node_shapes.levels;
         let r2 = (dt / critical).powi(2);
         let mut integrator = Self {
             arch: pulp::Arch::new(),
@@ -201,6 +246,7 @@ impl<'m> Integrator<'m> {
             scheme: settings.scheme,
             dt,
             row,
+            pins,
             omega_squared: padded(&omega.iter().map(|w| w * w).collect::<Vec<_>>(), row, 0.0),
             implicit_damping_factor: padded(
                 &damping
@@ -235,9 +281,8 @@ impl<'m> Integrator<'m> {
             level_deflections: vec![0.0; levels * stride],
             point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
             output_shapes: settings.output_heights.iter().map(|h| shape_at(*h)).collect(),
-            node_shapes: (0..nodes)
-                .flat_map(|n| (0..row).map(move |i| if i < modes { basis.shape(i)[2 * n] } else { 0.0 }))
-                .collect(),
+            node_shapes,
+            node_deflections: vec![0.0; node_levels * stride],
             q,
             v: vec![0.0; pins * row],
             a: vec![0.0; pins * row],
@@ -260,7 +305,7 @@ impl<'m> Integrator<'m> {
         arch.dispatch(StepOp {
             integrator: &mut integrator,
             t: 0.0,
-            initial: true,
+            operation: Operation::Initial,
         });
         for (c, contact) in model.contacts.iter().enumerate() {
             let stats = &mut integrator.statistics[c];
@@ -400,7 +445,7 @@ impl<'m> Integrator<'m> {
         arch.dispatch(StepOp {
             integrator: self,
             t,
-            initial: false,
+            operation: Operation::Step,
         });
     }
 
@@ -451,14 +496,12 @@ impl<'m> Integrator<'m> {
     }
 
     fn mechanical_energy_now(&self) -> f64 {
-        let row = self.row;
-        let mut energy = 0.0;
-        for (q, v) in self.q.chunks_exact(row).zip(self.v.chunks_exact(row)) {
-            for k in 0..row {
-                energy += 0.5 * (v[k] * v[k] + self.omega_squared[k] * q[k] * q[k]);
-            }
-        }
-        energy + self.contact_energy_now()
+        let modal = self.arch.dispatch(ModalEnergyOp {
+            stiffness: &self.omega_squared,
+            q: &self.q,
+            v: &self.v,
+        });
+        modal + self.contact_energy_now()
     }
 
     fn contact_energy_now(&self) -> f64 {
@@ -509,9 +552,20 @@ impl<'m> Integrator<'m> {
         }
         self.mechanical_energy.push(self.mechanical_energy_now());
         let element_length = self.model.basis.model().element_length;
-        for (node, shape) in self.node_shapes.chunks_exact(row).enumerate() {
-            for (coordinates, extreme) in self.q.chunks_exact(row).zip(self.pin_extremes.iter_mut()) {
-                let w = dot(shape, coordinates);
+        let arch = self.arch;
+        arch.dispatch(StepOp {
+            integrator: self,
+            t,
+            operation: Operation::NodeDeflections,
+        });
+        let nodes = self.model.basis.model().elements + 1;
+        for (node, deflections) in self
+            .node_deflections
+            .chunks_exact(self.pins + 2)
+            .take(nodes)
+            .enumerate()
+        {
+            for (w, extreme) in deflections[1..].iter().zip(self.pin_extremes.iter_mut()) {
                 if w.abs() > extreme.max_abs_deflection {
                     *extreme = PinExtreme {
                         max_abs_deflection: w.abs(),
