@@ -205,17 +205,31 @@ impl Run {
     }
 }
 
-/// For every contact of every run: δ = w_left − w_right − gap into `now`, and the
-/// running maximum `max`.
+/// Per-contact state that [`penetrations`] updates (all indexed by contact).
+pub(super) struct ContactState<'a> {
+    /// Penetration δ = w_left − w_right − gap (m) now.
+    pub now: &'a mut [f64],
+    /// Largest penetration so far.
+    pub max: &'a mut [f64],
+    /// Contact force, set to 0 where the contact is open.
+    pub force: &'a mut [f64],
+    /// Receives the contacts closed now, in order.
+    pub closed: &'a mut [u32],
+}
+
+/// For every contact of every run: its penetration, running maximum, a zero force if it
+/// is open; returns how many contacts are closed (listed first in `state.closed`).
 #[inline(always)]
 pub(super) fn penetrations<S: Simd>(
     simd: S,
     runs: &[Run],
     deflections: &[f64],
     gaps: &[f64],
-    now: &mut [f64],
-    max: &mut [f64],
-) {
+    state: ContactState<'_>,
+) -> usize {
+    let zero = simd.splat_f64s(0.0);
+    let lanes = std::mem::size_of::<S::f64s>() / std::mem::size_of::<f64>();
+    let mut count = 0;
     for run in runs {
         let contacts = run.first_contact..run.first_contact + run.len;
         let left = &deflections[run.left_slot..run.left_slot + run.len];
@@ -223,17 +237,52 @@ pub(super) fn penetrations<S: Simd>(
         let (l_head, l_tail) = S::as_simd_f64s(left);
         let (r_head, r_tail) = S::as_simd_f64s(right);
         let (g_head, g_tail) = S::as_simd_f64s(&gaps[contacts.clone()]);
-        let (n_head, n_tail) = S::as_mut_simd_f64s(&mut now[contacts.clone()]);
-        let (m_head, m_tail) = S::as_mut_simd_f64s(&mut max[contacts]);
-        for ((((l, r), g), n), m) in l_head.iter().zip(r_head).zip(g_head).zip(n_head).zip(m_head) {
+        let (n_head, n_tail) = S::as_mut_simd_f64s(&mut state.now[contacts.clone()]);
+        let (m_head, m_tail) = S::as_mut_simd_f64s(&mut state.max[contacts.clone()]);
+        let (f_head, f_tail) = S::as_mut_simd_f64s(&mut state.force[contacts.clone()]);
+        for (((((l, r), g), n), m), f) in l_head
+            .iter()
+            .zip(r_head)
+            .zip(g_head)
+            .zip(n_head)
+            .zip(m_head)
+            .zip(f_head)
+        {
             *n = simd.sub_f64s(simd.sub_f64s(*l, *r), *g);
             *m = simd.max_f64s(*m, *n);
+            *f = simd.select_f64s(simd.greater_than_f64s(*n, zero), *f, zero);
         }
-        for ((((l, r), g), n), m) in l_tail.iter().zip(r_tail).zip(g_tail).zip(n_tail).zip(m_tail) {
+        for (((((l, r), g), n), m), f) in l_tail
+            .iter()
+            .zip(r_tail)
+            .zip(g_tail)
+            .zip(n_tail)
+            .zip(m_tail)
+            .zip(f_tail)
+        {
             *n = l - r - g;
             *m = m.max(*n);
+            if *n <= 0.0 {
+                *f = 0.0;
+            }
+        }
+        // Closed contacts: most vectors of a run hold none, one test each.
+        let now = &state.now[contacts];
+        let (n_head, _) = S::as_simd_f64s(now);
+        for (j, n) in n_head.iter().enumerate() {
+            if simd.reduce_max_f64s(*n) > 0.0 {
+                for k in j * lanes..(j + 1) * lanes {
+                    state.closed[count] = (run.first_contact + k) as u32;
+                    count += usize::from(now[k] > 0.0);
+                }
+            }
+        }
+        for (k, n) in now.iter().enumerate().skip(n_head.len() * lanes) {
+            state.closed[count] = (run.first_contact + k) as u32;
+            count += usize::from(*n > 0.0);
         }
     }
+    count
 }
 
 /// One group of `G` blocks of one pin's levels.
@@ -473,12 +522,32 @@ mod tests {
         assert_eq!(runs.len(), 3);
         let deflections = values(40, 0.61);
         let gaps = values(slots.len(), 0.67);
-        let (mut now, mut max) = (vec![0.0; slots.len()], vec![0.2; slots.len()]);
-        penetrations(simd, &runs, &deflections, &gaps, &mut now, &mut max);
+        let contacts = slots.len();
+        let (mut now, mut max) = (vec![0.0; contacts], vec![0.2; contacts]);
+        let (mut force, mut closed) = (vec![1.0; contacts], vec![0; contacts]);
+        let count = penetrations(
+            simd,
+            &runs,
+            &deflections,
+            &gaps,
+            ContactState {
+                now: &mut now,
+                max: &mut max,
+                force: &mut force,
+                closed: &mut closed,
+            },
+        );
+        let mut expected_closed = Vec::new();
         for (c, (left, right)) in slots.iter().enumerate() {
             let expected = deflections[*left] - deflections[*right] - gaps[c];
             assert!(close(now[c], expected) && max[c] == expected.max(0.2));
+            assert_eq!(force[c], if expected > 0.0 { 1.0 } else { 0.0 });
+            if expected > 0.0 {
+                expected_closed.push(c as u32);
+            }
         }
+        assert!(!expected_closed.is_empty() && expected_closed.len() < contacts);
+        assert_eq!(closed[..count], expected_closed[..]);
 
         let (stiffness, damping, factor, participation) = (
             values(row, 0.11),

@@ -10,9 +10,9 @@
 //! of them closed at a time):
 //! 1. the deflection of every pin at every contact level, levels × pins dot products of
 //!    length `row` ([`level_deflections`]);
-//! 2. a branch-free pass over every contact: penetration, its running maximum, and the
-//!    list of candidates (closed now or a step ago);
-//! 3. the candidates only: dashpot velocity, force, statistics, force projection;
+//! 2. a vector pass over every contact ([`penetrations`], contacts cut in runs of
+//!    consecutive slots): penetration, running maximum, and the list of closed ones;
+//! 3. the closed contacts only: dashpot velocity, force, statistics, force projection;
 //! 4. the modal update, which also accumulates the dissipated and external powers.
 //!
 //! The step is dispatched through `pulp` so that it is compiled for the SIMD level of
@@ -22,8 +22,8 @@
 use pulp::Simd;
 
 use super::kernels::{
-    self, BLOCK, LevelShapes, ModalCoefficients, Run, advance_positions, axpy, dot_ahead, level_deflections,
-    modal_update, penetrations, scale_into,
+    self, BLOCK, ContactState, LevelShapes, ModalCoefficients, Run, advance_positions, axpy, dot_ahead,
+    level_deflections, modal_update, penetrations, scale_into,
 };
 use super::{ContactStatistics, EnergyBalance, Model, PinExtreme, Settings, Simulation, SimulationError};
 use crate::physics::contact::Body;
@@ -70,10 +70,8 @@ pub(super) struct Integrator<'m> {
     penetration: Vec<f64>,
     previous_penetration: Vec<f64>,
     max_penetration: Vec<f64>,
-    /// Contacts closed now or a step ago (the only ones that need more than a
-    /// penetration); the first `candidate_count` are valid.
-    candidates: Vec<u32>,
-    candidate_count: usize,
+    /// Scratch: the contacts closed now (the only ones that need more than a penetration).
+    closed: Vec<u32>,
     /// Base acceleration at the current step (m/s²).
     base_now: f64,
     /// w of every pin at every level (`levels × (pins + 2)`, level by level with a zero
@@ -216,6 +214,10 @@ impl<'m> Integrator<'m> {
             }
         }
         let contacts = model.contacts.len();
+        assert!(
+            u32::try_from(contacts).is_ok(),
+            "contact indices are stored as u32"
+        );
         let contact_left: Vec<usize> = model.contacts.iter().map(|c| pin_index(c.left)).collect();
         let contact_right: Vec<usize> = model.contacts.iter().map(|c| pin_index(c.right)).collect();
         let levels = heights.len().div_ceil(BLOCK) * BLOCK;
@@ -275,8 +277,7 @@ impl<'m> Integrator<'m> {
             penetration: vec![0.0; contacts],
             previous_penetration: vec![0.0; contacts],
             max_penetration: vec![f64::NEG_INFINITY; contacts],
-            candidates: vec![0; contacts],
-            candidate_count: 0,
+            closed: vec![0; contacts],
             base_now: 0.0,
             level_deflections: vec![0.0; levels * stride],
             point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
@@ -358,42 +359,29 @@ impl<'m> Integrator<'m> {
             &self.q,
             &mut self.level_deflections,
         );
-        // Every contact, branch-free: penetration, its running maximum, and the
-        // candidates (closed now or a step ago, a few percent of them).
+        // Every contact, in vectors: penetration, its running maximum, a zero force
+        // where open, and the list of closed contacts (about one in seven).
         std::mem::swap(&mut self.penetration, &mut self.previous_penetration);
-        penetrations(
+        let count = penetrations(
             simd,
             &self.runs,
             &self.level_deflections,
             &self.gaps,
-            &mut self.penetration,
-            &mut self.max_penetration,
+            ContactState {
+                now: &mut self.penetration,
+                max: &mut self.max_penetration,
+                force: &mut self.contact_force,
+                closed: &mut self.closed,
+            },
         );
-        let contacts = self.gaps.len();
-        let (now, previous, candidates) = (
-            &self.penetration[..contacts],
-            &self.previous_penetration[..contacts],
-            &mut self.candidates[..contacts],
-        );
-        let mut count = 0;
-        for c in 0..contacts {
-            candidates[count] = c as u32;
-            count += usize::from((now[c] > 0.0) | (previous[c] > 0.0));
-        }
-        self.candidate_count = count;
 
         let mut dissipation_power = 0.0;
         let lookahead = self.dashpot_lookahead;
         let (v, a) = (self.v.as_slice(), self.a.as_slice());
         let loads = self.force.as_mut_slice();
-        for &candidate in &self.candidates[..count] {
-            let c = candidate as usize;
+        for &closed in &self.closed[..count] {
+            let c = closed as usize;
             let (penetration, previous) = (self.penetration[c], self.previous_penetration[c]);
-            if penetration <= 0.0 {
-                // Opened during this step.
-                self.contact_force[c] = 0.0;
-                continue;
-            }
             let contact = &self.model.contacts[c];
             let (left, right) = (self.contact_left[c], self.contact_right[c]);
             let shape = &self.level_shapes[self.contact_level[c] * row..][..row];
