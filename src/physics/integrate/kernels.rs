@@ -85,6 +85,8 @@ pub(super) struct LevelShapes {
     data: Vec<f64>,
     /// Levels rounded up to whole blocks.
     pub levels: usize,
+    /// Levels.
+    level_count: usize,
 }
 
 impl LevelShapes {
@@ -111,6 +113,7 @@ impl LevelShapes {
         Self {
             data,
             levels: blocks * BLOCK,
+            level_count,
         }
     }
 }
@@ -132,13 +135,15 @@ pub(super) fn level_deflections<S: Simd>(
     }
     let (vectors, _) = S::as_simd_f64s(&shapes.data);
     let one_block_per_vector = vectors.len() * BLOCK == shapes.data.len();
-    for (coordinates, pin_levels) in q.chunks_exact(row).zip(out.chunks_exact_mut(levels)) {
+    let stride = out.len() / levels;
+    let mut pin_levels = [0.0; GROUP * BLOCK];
+    for (p, coordinates) in q.chunks_exact(row).enumerate() {
         let (mut first, mut offset) = (0, 0);
         while first < levels / BLOCK {
             let group = GROUP.min(levels / BLOCK - first);
             let size = group * BLOCK * row;
             let data = &shapes.data[offset..offset + size];
-            let out_group = &mut pin_levels[first * BLOCK..(first + group) * BLOCK];
+            let out_group = &mut pin_levels[..group * BLOCK];
             if one_block_per_vector {
                 let (group_vectors, _) = S::as_simd_f64s(data);
                 match group {
@@ -156,10 +161,128 @@ pub(super) fn level_deflections<S: Simd>(
                     }
                 }
             }
+            // Real levels only: the padded ones stay 0.
+            let mut slot = first * BLOCK * stride + 1 + p;
+            for w in &out_group[..out_group.len().min(shapes.level_count - first * BLOCK)] {
+                out[slot] = *w;
+                slot += stride;
+            }
             first += group;
             offset += size;
         }
     }
+}
+
+/// A run of consecutive contacts whose left and right sides are consecutive slots of
+/// the level-major deflections (a row of pins between two walls is one run per level):
+/// their penetrations are one vector subtraction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Run {
+    pub first_contact: usize,
+    pub len: usize,
+    pub left_slot: usize,
+    pub right_slot: usize,
+}
+
+impl Run {
+    /// Contacts (left slot, right slot) cut into maximal runs.
+    pub fn split(slots: impl IntoIterator<Item = (usize, usize)>) -> Vec<Run> {
+        let mut runs: Vec<Run> = Vec::new();
+        for (c, (left, right)) in slots.into_iter().enumerate() {
+            match runs.last_mut() {
+                Some(run) if run.left_slot + run.len == left && run.right_slot + run.len == right => {
+                    run.len += 1
+                }
+                _ => runs.push(Run {
+                    first_contact: c,
+                    len: 1,
+                    left_slot: left,
+                    right_slot: right,
+                }),
+            }
+        }
+        runs
+    }
+}
+
+/// Per-contact state that [`penetrations`] updates (all indexed by contact).
+pub(super) struct ContactState<'a> {
+    /// Penetration δ = w_left − w_right − gap (m) now.
+    pub now: &'a mut [f64],
+    /// Largest penetration so far.
+    pub max: &'a mut [f64],
+    /// Contact force, set to 0 where the contact is open.
+    pub force: &'a mut [f64],
+    /// Receives the contacts closed now, in order.
+    pub closed: &'a mut [u32],
+}
+
+/// For every contact of every run: its penetration, running maximum, a zero force if it
+/// is open; returns how many contacts are closed (listed first in `state.closed`).
+#[inline(always)]
+pub(super) fn penetrations<S: Simd>(
+    simd: S,
+    runs: &[Run],
+    deflections: &[f64],
+    gaps: &[f64],
+    state: ContactState<'_>,
+) -> usize {
+    let zero = simd.splat_f64s(0.0);
+    let lanes = std::mem::size_of::<S::f64s>() / std::mem::size_of::<f64>();
+    let mut count = 0;
+    for run in runs {
+        let contacts = run.first_contact..run.first_contact + run.len;
+        let left = &deflections[run.left_slot..run.left_slot + run.len];
+        let right = &deflections[run.right_slot..run.right_slot + run.len];
+        let (l_head, l_tail) = S::as_simd_f64s(left);
+        let (r_head, r_tail) = S::as_simd_f64s(right);
+        let (g_head, g_tail) = S::as_simd_f64s(&gaps[contacts.clone()]);
+        let (n_head, n_tail) = S::as_mut_simd_f64s(&mut state.now[contacts.clone()]);
+        let (m_head, m_tail) = S::as_mut_simd_f64s(&mut state.max[contacts.clone()]);
+        let (f_head, f_tail) = S::as_mut_simd_f64s(&mut state.force[contacts.clone()]);
+        for (((((l, r), g), n), m), f) in l_head
+            .iter()
+            .zip(r_head)
+            .zip(g_head)
+            .zip(n_head)
+            .zip(m_head)
+            .zip(f_head)
+        {
+            *n = simd.sub_f64s(simd.sub_f64s(*l, *r), *g);
+            *m = simd.max_f64s(*m, *n);
+            *f = simd.select_f64s(simd.greater_than_f64s(*n, zero), *f, zero);
+        }
+        for (((((l, r), g), n), m), f) in l_tail
+            .iter()
+            .zip(r_tail)
+            .zip(g_tail)
+            .zip(n_tail)
+            .zip(m_tail)
+            .zip(f_tail)
+        {
+            *n = l - r - g;
+            *m = m.max(*n);
+            if *n <= 0.0 {
+                *f = 0.0;
+            }
+        }
+        // Closed contacts: most vectors of a run hold none, one test each.
+        let now = &state.now[contacts];
+        let (n_head, _) = S::as_simd_f64s(now);
+        for (j, n) in n_head.iter().enumerate() {
+            if simd.reduce_max_f64s(*n) > 0.0 {
+                for k in j * lanes..(j + 1) * lanes {
+                    state.closed[count] = (run.first_contact + k) as u32;
+                    count += usize::from(now[k] > 0.0);
+                }
+            }
+        }
+        for (k, n) in now.iter().enumerate().skip(n_head.len() * lanes) {
+            state.closed[count] = (run.first_contact + k) as u32;
+            count += usize::from(*n > 0.0);
+        }
+    }
+    count
 }
 
 /// One group of `G` blocks of one pin's levels.
@@ -179,6 +302,27 @@ fn accumulate_group<S: Simd, const G: usize>(
     }
     let (out_vectors, _) = S::as_mut_simd_f64s(out);
     out_vectors.copy_from_slice(&acc);
+}
+
+/// ½ Σ (v² + ωᵢ² q²) over every pin (`stiffness` = ωᵢ² per mode, one row).
+#[inline(always)]
+pub(super) fn modal_energy<S: Simd>(simd: S, stiffness: &[f64], q: &[f64], v: &[f64]) -> f64 {
+    let row = stiffness.len();
+    let (k_head, k_tail) = S::as_simd_f64s(stiffness);
+    let mut acc = simd.splat_f64s(0.0);
+    let mut tail = 0.0;
+    for (q, v) in q.chunks_exact(row).zip(v.chunks_exact(row)) {
+        let (q_head, q_tail) = S::as_simd_f64s(q);
+        let (v_head, v_tail) = S::as_simd_f64s(v);
+        for ((q, v), k) in q_head.iter().zip(v_head).zip(k_head) {
+            acc = simd.mul_add_e_f64s(*v, *v, acc);
+            acc = simd.mul_add_e_f64s(simd.mul_f64s(*k, *q), *q, acc);
+        }
+        for ((q, v), k) in q_tail.iter().zip(v_tail).zip(k_tail) {
+            tail += v * v + k * q * q;
+        }
+    }
+    0.5 * (simd.reduce_sum_f64s(acc) + tail)
 }
 
 /// Per-mode coefficients of the modal update (each padded to the row length).
@@ -347,8 +491,15 @@ mod tests {
             let shapes = values(level_count * row, 0.37);
             let q = values(pins * row, 0.53);
             let grouped = LevelShapes::new(&shapes, row);
-            let mut out = vec![f64::NAN; pins * grouped.levels];
+            let stride = pins + 2;
+            let mut out = vec![0.0; stride * grouped.levels];
             level_deflections(simd, &grouped, row, &q, &mut out);
+            for l in 0..grouped.levels {
+                assert!(
+                    out[l * stride] == 0.0 && out[l * stride + pins + 1] == 0.0,
+                    "wall slots stay 0"
+                );
+            }
             for p in 0..pins {
                 for l in 0..grouped.levels {
                     let expected = if l < level_count {
@@ -356,13 +507,47 @@ mod tests {
                     } else {
                         0.0
                     };
-                    assert!(
-                        close(out[p * grouped.levels + l], expected),
-                        "level {l} of pin {p}"
-                    );
+                    assert!(close(out[l * stride + 1 + p], expected), "level {l} of pin {p}");
                 }
             }
         }
+
+        // Two runs (4 + 7 contacts, one run with a tail) and a lone contact.
+        let slots: Vec<(usize, usize)> = (0..4)
+            .map(|k| (k, k + 1))
+            .chain((0..7).map(|k| (20 + k, 10 + k)))
+            .chain([(3, 3)])
+            .collect();
+        let runs = Run::split(slots.iter().copied());
+        assert_eq!(runs.len(), 3);
+        let deflections = values(40, 0.61);
+        let gaps = values(slots.len(), 0.67);
+        let contacts = slots.len();
+        let (mut now, mut max) = (vec![0.0; contacts], vec![0.2; contacts]);
+        let (mut force, mut closed) = (vec![1.0; contacts], vec![0; contacts]);
+        let count = penetrations(
+            simd,
+            &runs,
+            &deflections,
+            &gaps,
+            ContactState {
+                now: &mut now,
+                max: &mut max,
+                force: &mut force,
+                closed: &mut closed,
+            },
+        );
+        let mut expected_closed = Vec::new();
+        for (c, (left, right)) in slots.iter().enumerate() {
+            let expected = deflections[*left] - deflections[*right] - gaps[c];
+            assert!(close(now[c], expected) && max[c] == expected.max(0.2));
+            assert_eq!(force[c], if expected > 0.0 { 1.0 } else { 0.0 });
+            if expected > 0.0 {
+                expected_closed.push(c as u32);
+            }
+        }
+        assert!(!expected_closed.is_empty() && expected_closed.len() < contacts);
+        assert_eq!(closed[..count], expected_closed[..]);
 
         let (stiffness, damping, factor, participation) = (
             values(row, 0.11),
@@ -390,6 +575,10 @@ mod tests {
             participation_velocity += participation[i] * velocity;
         }
         assert!(close(sums.damping_power, damping_power));
+        let energy: f64 = (0..pins * row)
+            .map(|k| 0.5 * (v[k] * v[k] + stiffness[k % row] * q[k] * q[k]))
+            .sum();
+        assert!(close(modal_energy(simd, &stiffness, &q, &v), energy));
         assert!(close(sums.participation_velocity, participation_velocity));
 
         for (half, curvature) in [(0.5, 0.0), (1.0, 0.3)] {
