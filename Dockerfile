@@ -9,6 +9,8 @@ WORKDIR /src
 COPY Cargo.toml Cargo.lock ./
 COPY src src
 COPY migrations migrations
+# The dashboard embeds the shipped examples as templates of its submit page.
+COPY examples examples
 RUN cargo build --release --locked --bin chocmodal
 
 FROM debian:bookworm-slim

@@ -95,9 +95,8 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
         .ok_or_else(|| CliFailure::Problem(Problem::no_such_process(&args.process_id)))?;
     let text = read_body(&args.body).map_err(CliFailure::Failed)?;
     let inputs = parse_envelope(&text).map_err(CliFailure::Problem)?;
-    process
-        .validate(&inputs)
-        .map_err(|e| CliFailure::Problem(Problem::invalid_inputs(&e)))?;
+    // `run` validates too (invalid inputs come back as `RunError::Invalid`): validating
+    // first would do the modal analysis and the stability eigenproblem twice.
 
     let show_progress = args.progress;
     let mut last_percent = -1i64;

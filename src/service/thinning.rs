@@ -36,6 +36,34 @@ pub fn select(
     }
 }
 
+/// The columns of `history` named in `names` (comma-separated, in the order given), or
+/// all of them when `names` is `None`; `Err` names a column that does not exist.
+pub fn pick_series(history: History, names: Option<&str>) -> Result<History, String> {
+    let Some(names) = names else {
+        return Ok(history);
+    };
+    let mut picked = Vec::new();
+    for name in names.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        let (_, values) = history.series.iter().find(|(n, _)| n == name).ok_or_else(|| {
+            let available: Vec<&str> = history.series.iter().map(|(n, _)| n.as_str()).collect();
+            format!(
+                "`series`: `{}` has no series `{name}` (it has {})",
+                history.name,
+                available.join(", ")
+            )
+        })?;
+        picked.push((name.to_owned(), values.clone()));
+    }
+    if picked.is_empty() {
+        return Err("`series` must name at least one series".into());
+    }
+    Ok(History {
+        name: history.name,
+        time: history.time,
+        series: picked,
+    })
+}
+
 /// Row indices in `first..end` keeping each series' min and max per bucket, ascending.
 fn peak_rows(history: &History, first: usize, end: usize, max_points: usize) -> Vec<usize> {
     let per_bucket = 2 * history.series.len().max(1);
@@ -119,6 +147,20 @@ mod tests {
         let history = spiky(1_000);
         let window = select(&history, Some(0.0), Some(49.0), Some(100));
         assert_eq!(window.time.len(), 50);
+    }
+
+    #[test]
+    fn series_are_picked_by_name_in_the_order_given() {
+        let mut history = spiky(10);
+        history.series.push(("reference".into(), vec![1.0; 10]));
+        let picked = pick_series(history.clone(), Some("reference,numerical")).unwrap();
+        let names: Vec<&str> = picked.series.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["reference", "numerical"]);
+        assert_eq!(picked.series[0].1, vec![1.0; 10]);
+        assert_eq!(pick_series(history.clone(), None).unwrap().series.len(), 2);
+        let error = pick_series(history.clone(), Some("c7")).unwrap_err();
+        assert!(error.contains("numerical, reference"), "{error}");
+        assert!(pick_series(history, Some(",")).is_err());
     }
 
     #[test]

@@ -187,6 +187,8 @@ async fn another_tenants_job_is_not_found_anywhere() {
         format!("/jobs/{job}/results"),
         format!("/jobs/{job}/results/signal"),
         format!("/jobs/{job}/results/signal?format=csv"),
+        format!("/jobs/{job}/results/signal/spectrum"),
+        format!("/jobs/{job}/inputs"),
     ] {
         assert_problem(beta.get(&path).await, StatusCode::NOT_FOUND, "/no-such-job").await;
     }
@@ -211,6 +213,9 @@ async fn another_tenants_job_is_not_found_anywhere() {
         "successful"
     );
     assert_eq!(alpha.get_json(&format!("/jobs/{job}/results")).await["sum"], 15);
+    assert_eq!(alpha.get_json(&format!("/jobs/{job}/inputs")).await["inputs"]["steps"], 5);
+    let spectrum = alpha.get(&format!("/jobs/{job}/results/signal/spectrum")).await;
+    assert_eq!(spectrum.status(), StatusCode::OK);
 }
 
 #[tokio::test]

@@ -2,8 +2,8 @@
 //! with penalty point contacts, base excitation and point forces.
 //!
 //! Modal equations per pin p: q̈ᵢ + 2ξᵢωᵢ q̇ᵢ + ωᵢ² qᵢ = ψᵢ(z)·(contact and point forces)
-//! − Γᵢ a(t). Coordinates are stored mode-major (`q[i * pins + p]`) so that the
-//! deflection at every contact level, w = Ψ q, is a sweep of contiguous rows.
+//! − Γᵢ a(t). Coordinates are stored pin-major (`q[p * row + i]`, see `stepper`) so that
+//! a closed contact reads and writes whole contiguous rows.
 //!
 //! **Velocity-dependent forces.** Central difference (velocity form):
 //! v½ = vₙ + ½Δt aₙ, qₙ₊₁ = qₙ + Δt v½, vₙ₊₁ = v½ + ½Δt aₙ₊₁. Modal damping is diagonal,
@@ -215,6 +215,7 @@ fn integrate_with_step(
     Ok(run.finish(dt, critical, total_steps))
 }
 
+mod kernels;
 mod stepper;
 
 use stepper::Integrator;

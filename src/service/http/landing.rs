@@ -2,8 +2,8 @@
 
 use axum::Json;
 use axum::extract::State;
-use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
-use axum::response::{Html, IntoResponse, Response};
+use axum::http::{HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
 
 use super::AppState;
 use super::error::ApiError;
@@ -56,50 +56,18 @@ fn landing_links() -> Vec<Link> {
 
 /// Landing page
 ///
-/// Links to everything else. JSON, or HTML when the client prefers `text/html` (a browser).
+/// Links to everything else. JSON, or the dashboard's home page (HTML) when the client
+/// prefers `text/html` to `application/json` (a browser) or asks `?f=html`.
 #[utoipa::path(get, path = "/", operation_id = "getLandingPage", tag = "Capabilities",
     responses((status = 200, description = "Links to the API's resources",
         content((LandingPage = "application/json"), (String = "text/html")))))]
-pub async fn landing(headers: HeaderMap) -> Response {
+pub async fn landing() -> Response {
     let page = LandingPage {
         title: "chocmodal",
         description: "Modal multi-contact dynamics of slender beam bundles, as OGC API – Processes jobs",
         links: landing_links(),
     };
-    if prefers_html(&headers) {
-        let items: String = page
-            .links
-            .iter()
-            .map(|l| {
-                format!(
-                    "<li><a href=\"{}\">{}</a></li>",
-                    l.href,
-                    l.title.as_deref().unwrap_or(&l.href)
-                )
-            })
-            .collect();
-        return Html(format!(
-            "<!doctype html><html><head><meta charset=\"utf-8\"><title>{}</title></head>\
-             <body><h1>{}</h1><p>{}</p><ul>{items}</ul></body></html>",
-            page.title, page.title, page.description
-        ))
-        .into_response();
-    }
     Json(page).into_response()
-}
-
-fn prefers_html(headers: &HeaderMap) -> bool {
-    let accept = headers
-        .get(header::ACCEPT)
-        .and_then(|v| v.to_str().ok())
-        .unwrap_or_default();
-    let html = accept.find("text/html");
-    let json = accept.find("application/json");
-    match (html, json) {
-        (Some(h), Some(j)) => h < j,
-        (Some(_), None) => true,
-        _ => false,
-    }
 }
 
 /// Conformance classes

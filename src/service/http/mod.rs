@@ -4,14 +4,17 @@
 
 pub mod auth;
 pub mod conditional;
+pub mod dashboard;
 pub mod error;
 pub mod extract;
+pub mod job_inputs;
 pub mod jobs;
 pub mod landing;
 pub mod models;
 pub mod openapi;
 pub mod processes;
 pub mod results;
+pub mod spectra;
 pub mod sweep_models;
 pub mod sweeps;
 
@@ -90,11 +93,16 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/jobs", get(jobs::list))
         .route("/jobs/{jobId}", get(jobs::status).delete(jobs::dismiss))
         .route("/jobs/{jobId}/results", get(results::results))
+        .route("/jobs/{jobId}/inputs", get(job_inputs::inputs))
         .route("/jobs/{jobId}/results/{output}", get(results::output))
+        .route("/jobs/{jobId}/results/{output}/spectrum", get(spectra::spectrum))
         .route("/sweeps", get(sweeps::list).post(sweeps::create))
         .route("/sweeps/{sweepId}", get(sweeps::status).delete(sweeps::dismiss))
         .route("/sweeps/{sweepId}/results", get(sweeps::results))
+        .merge(dashboard::routes())
         .fallback(not_found)
+        // HTML for browsers on the routes that have a page (innermost: it sees the route).
+        .layer(middleware::from_fn(dashboard::negotiate))
         // Layers run outside-in from the last one added: trace and count every request,
         // turn any bare error below (timeout, panic, 405, 413) into a problem, and
         // authenticate before anything reads the body.
@@ -137,7 +145,12 @@ async fn problem_for_bare_errors(response: Response) -> Response {
         .headers()
         .get(header::CONTENT_TYPE)
         .is_some_and(|v| v.as_bytes().starts_with(PROBLEM_JSON.as_bytes()));
-    if !(status.is_client_error() || status.is_server_error()) || is_problem {
+    // The dashboard's pages carry the status of the resource they show (a 404 page).
+    let is_page = response
+        .headers()
+        .get(header::CONTENT_TYPE)
+        .is_some_and(|v| v.as_bytes().starts_with(b"text/html"));
+    if !(status.is_client_error() || status.is_server_error()) || is_problem || is_page {
         return response;
     }
     let title = status.canonical_reason().unwrap_or("Error");

@@ -17,7 +17,7 @@ use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityRequirement
 use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
 use utoipa::{Modify, OpenApi};
 
-use super::{jobs, landing, models, processes, results, sweep_models, sweeps};
+use super::{job_inputs, jobs, landing, models, processes, results, spectra, sweep_models, sweeps};
 use crate::service::queue::JobStatus;
 
 /// A field at fault in an execution request.
@@ -265,8 +265,10 @@ impl Modify for ResourceLinks {
         jobs::list,
         jobs::status,
         jobs::dismiss,
+        job_inputs::inputs,
         results::results,
         results::output,
+        spectra::spectrum,
         sweeps::create,
         sweeps::list,
         sweeps::status,
@@ -288,6 +290,8 @@ impl Modify for ResourceLinks {
         models::Results,
         models::HistoryDocument,
         models::Series,
+        spectra::SpectrumDocument,
+        spectra::SpectrumComparison,
         models::LandingPage,
         models::Conformance,
         models::Health,

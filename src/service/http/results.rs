@@ -32,10 +32,12 @@ pub struct HistoryQuery {
     /// caps it (`--max-history-points`, default 500000): longer windows are always thinned.
     #[param(minimum = 2)]
     pub max_points: Option<usize>,
+    /// Only these series, comma-separated and in this order (e.g. `c3,c17`); default: all.
+    pub series: Option<String>,
 }
 
 /// Why a finished-or-not job has no results to show; `Ok` carries the outcome of a successful one.
-fn successful(job_id: &str, outcome: Option<JobOutcome>) -> Result<JobOutcome, ApiError> {
+pub(super) fn successful(job_id: &str, outcome: Option<JobOutcome>) -> Result<JobOutcome, ApiError> {
     let outcome = outcome.ok_or_else(|| Problem::no_such_job(job_id))?;
     match outcome.record.status {
         JobStatus::Successful => Ok(outcome),
@@ -55,7 +57,7 @@ fn successful(job_id: &str, outcome: Option<JobOutcome>) -> Result<JobOutcome, A
 }
 
 /// Retry-After on "not ready" answers, so pollers back off.
-fn with_retry_after(result: Result<Response, ApiError>) -> Result<Response, ApiError> {
+pub(super) fn with_retry_after(result: Result<Response, ApiError>) -> Result<Response, ApiError> {
     match result {
         Err(ApiError::Problem(problem)) if problem.kind.ends_with("/result-not-ready") => {
             let mut response = axum::response::IntoResponse::into_response(ApiError::Problem(problem));
@@ -104,9 +106,10 @@ pub async fn results(
 /// One time history
 ///
 /// CSV (`time,<series...>`, full precision) or JSON, optionally restricted to
-/// `t_start <= time <= t_end` (s) and thinned to `max_points` rows with min/max buckets.
-/// A window longer than the service's cap (`--max-history-points`) is thinned to it:
-/// page through long histories with `t_start` and `t_end` for full resolution.
+/// `t_start <= time <= t_end` (s), to the `series` named, and thinned to `max_points`
+/// rows with min/max buckets. A window longer than the service's cap
+/// (`--max-history-points`) is thinned to it: page through long histories with
+/// `t_start` and `t_end` for full resolution.
 #[utoipa::path(get, path = "/jobs/{jobId}/results/{output}", operation_id = "getResultOutput", tag = "Results",
     params(
         ("jobId" = String, Path, description = "Job id"),
@@ -178,6 +181,7 @@ pub async fn output(
 
 fn render(stored: &store::StoredHistory, query: &HistoryQuery, csv: bool) -> Result<Vec<u8>, ApiError> {
     let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
+    let history = thinning::pick_series(history, query.series.as_deref()).map_err(Problem::invalid_query)?;
     let selected = thinning::select(&history, query.t_start, query.t_end, query.max_points);
     if csv {
         return Ok(selected.to_csv().into_bytes());

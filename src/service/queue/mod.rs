@@ -19,6 +19,7 @@
 //! - [`recovery`]: re-queue (or fail) jobs whose lease expired;
 //! - [`retention`]: delete old finished jobs;
 //! - [`read`]: status, listing with keyset paging, results and histories;
+//! - [`inputs`]: the inputs a job was submitted with;
 //! - [`reuse`]: complete a claimed job with the results of an identical one
 //!   ([`content_hash`]);
 //! - [`sweep_create`], [`sweep_read`], [`sweep_dismiss`]: sweeps, whose runs are jobs.
@@ -29,6 +30,7 @@ pub mod dismiss;
 pub mod enqueue;
 pub mod finish;
 pub mod heartbeat;
+pub mod inputs;
 pub mod read;
 pub mod recovery;
 pub mod retention;

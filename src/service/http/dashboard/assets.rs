@@ -1,0 +1,129 @@
+//! The dashboard's files, embedded in the binary: scripts, style sheet, and the shipped
+//! examples (`examples/*.json`) offered as templates by the submit page.
+
+use std::sync::OnceLock;
+
+/// One embedded file.
+#[derive(Debug, Clone, Copy)]
+pub struct Asset {
+    pub name: &'static str,
+    pub content_type: &'static str,
+    pub bytes: &'static [u8],
+}
+
+const JS: &str = "text/javascript; charset=utf-8";
+
+macro_rules! asset {
+    ($name:literal, $content_type:expr) => {
+        Asset {
+            name: $name,
+            content_type: $content_type,
+            bytes: include_bytes!(concat!("assets/", $name)),
+        }
+    };
+}
+
+/// Every file served under `/ui/assets/`.
+pub const ASSETS: &[Asset] = &[
+    asset!("app.js", JS),
+    asset!("util.js", JS),
+    asset!("plot.js", JS),
+    asset!("lists.js", JS),
+    asset!("job.js", JS),
+    asset!("sweep.js", JS),
+    asset!("submit.js", JS),
+    asset!("style.css", "text/css; charset=utf-8"),
+];
+
+/// The embedded file called `name`.
+pub fn find(name: &str) -> Option<&'static Asset> {
+    ASSETS.iter().find(|a| a.name == name)
+}
+
+/// A shipped example: its file name, the process it runs (`None` for a sweep request,
+/// which names its process itself), and the request body.
+#[derive(Debug, Clone, Copy)]
+pub struct Example {
+    pub file: &'static str,
+    pub process: Option<&'static str>,
+    pub body: &'static str,
+}
+
+macro_rules! example {
+    ($file:literal, $process:expr) => {
+        Example {
+            file: $file,
+            process: $process,
+            body: include_str!(concat!("../../../../examples/", $file)),
+        }
+    };
+}
+
+/// Every file of `examples/` (a test checks none is missing).
+pub const EXAMPLES: &[Example] = &[
+    example!("cantilever-impact.json", Some("cantilever-impact")),
+    example!("bundle-row17.json", Some("bundle-dynamics")),
+    example!("bundle-random-gaps.json", Some("bundle-dynamics")),
+    example!("bundle-local-closure.json", Some("bundle-dynamics")),
+    example!("sweep-calibration.json", None),
+    example!("sweep-gaps.json", None),
+];
+
+/// `[{"file", "process", "kind": "job" | "sweep", "body"}]`, the bodies verbatim (their
+/// members keep the order of the files).
+pub fn examples_json() -> &'static str {
+    static JSON: OnceLock<String> = OnceLock::new();
+    JSON.get_or_init(|| {
+        let items: Vec<String> = EXAMPLES
+            .iter()
+            .map(|e| {
+                format!(
+                    r#"{{"file":{},"process":{},"kind":"{}","body":{}}}"#,
+                    serde_json::Value::from(e.file),
+                    e.process.map_or(serde_json::Value::Null, serde_json::Value::from),
+                    if e.process.is_some() { "job" } else { "sweep" },
+                    e.body.trim()
+                )
+            })
+            .collect();
+        format!("[{}]", items.join(","))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_shipped_example_is_embedded_and_valid_json() {
+        let directory = concat!(env!("CARGO_MANIFEST_DIR"), "/examples");
+        let mut files: Vec<String> = std::fs::read_dir(directory)
+            .unwrap()
+            .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|name| name.ends_with(".json"))
+            .collect();
+        files.sort();
+        let mut embedded: Vec<String> = EXAMPLES.iter().map(|e| e.file.to_owned()).collect();
+        embedded.sort();
+        assert_eq!(embedded, files, "examples/ and the dashboard's templates differ");
+        let parsed: serde_json::Value = serde_json::from_str(examples_json()).unwrap();
+        assert_eq!(parsed.as_array().map(Vec::len), Some(EXAMPLES.len()));
+        for example in parsed.as_array().unwrap() {
+            let body = &example["body"];
+            match example["kind"].as_str() {
+                Some("job") => assert!(body["inputs"].is_object(), "{example}"),
+                _ => assert!(
+                    body["process"].is_string() && body["axes"].is_array(),
+                    "{example}"
+                ),
+            }
+        }
+    }
+
+    #[test]
+    fn assets_are_found_by_name_only() {
+        assert!(find("app.js").is_some());
+        assert!(find("../mod.rs").is_none());
+        assert!(ASSETS.iter().all(|a| !a.bytes.is_empty()));
+    }
+}

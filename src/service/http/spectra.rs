@@ -1,0 +1,231 @@
+//! `/jobs/{jobId}/results/{output}/spectrum`: the power spectral density of each series
+//! of a stored history (the periodogram of `physics::spectrum`), and the spectral error
+//! f_err between the first two series, the figure `cantilever-impact` reports.
+
+use axum::extract::{Extension, Path, State};
+use axum::http::HeaderMap;
+use axum::response::Response;
+use serde::Serialize;
+use utoipa::ToSchema;
+
+use super::AppState;
+use super::conditional::tagged;
+use super::error::ApiError;
+use super::extract::ApiQuery;
+use super::models::Series;
+use super::results::{successful, with_retry_after};
+use crate::physics::spectrum::{periodogram, spectral_error};
+use crate::problem::Problem;
+use crate::processes::History;
+use crate::service::auth::Tenant;
+use crate::service::{store, thinning};
+
+/// Query of `GET /jobs/{jobId}/results/{output}/spectrum`.
+#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct SpectrumQuery {
+    /// `csv` (`frequency,<series...>`) or `json` (default).
+    pub format: Option<String>,
+    /// Lowest frequency kept (Hz), inclusive.
+    pub f_min: Option<f64>,
+    /// Highest frequency kept (Hz), inclusive.
+    pub f_max: Option<f64>,
+    /// Thin the kept bins to at most this many rows (at least 2 per series), keeping each
+    /// series' minimum and maximum of every bucket so that peaks survive.
+    pub max_points: Option<usize>,
+    /// Only these series, comma-separated and in this order; default: all.
+    pub series: Option<String>,
+}
+
+/// f_err between the first two series of a spectrum.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct SpectrumComparison {
+    /// The two series compared, e.g. `["numerical", "reference"]`.
+    pub series: [String; 2],
+    /// f_err = max_f |Γ_a − Γ_b| / max(max_f Γ_a, max_f Γ_b) over every bin of the whole
+    /// history (dimensionless, 0 to 1; below 0.2 the paper calls the signals identical).
+    pub f_err: f64,
+    /// Frequency of the bin where |Γ_a − Γ_b| is largest (Hz).
+    pub frequency: f64,
+}
+
+/// The one-sided power spectral density of each series of a history.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct SpectrumDocument {
+    /// Output name, e.g. `tip_displacement`.
+    pub output: String,
+    /// Sample interval of the history Δt (s).
+    pub sample_interval: f64,
+    /// Samples of the history the spectrum is computed from.
+    pub samples: usize,
+    /// Bins in this document.
+    pub points: usize,
+    /// Bins of the whole spectrum, f_k = k/(nΔt) for k = 0..=n/2.
+    pub total_points: usize,
+    /// Whether min/max thinning was applied (`max_points`).
+    pub thinned: bool,
+    /// Bin frequencies (Hz), increasing.
+    pub frequency: Vec<f64>,
+    /// Γ(f) of each series (the output's unit² per Hz, e.g. m²/Hz): rectangular window
+    /// after removing the mean, scaled so that Σ Γ Δf is the variance (Parseval).
+    pub series: Vec<Series>,
+    /// f_err between the first two series (absent with fewer than two).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub comparison: Option<SpectrumComparison>,
+}
+
+/// Spectrum of a history
+///
+/// The power spectral density Γ(f) of each series of a history (one-sided periodogram,
+/// mean removed, rectangular window), computed from the full-resolution history, and
+/// f_err between its first two series (`comparison`): for `cantilever-impact`'s
+/// `tip_displacement`, the numerical and reference spectra and the f_err of the results
+/// document. Optionally restricted to `f_min <= f <= f_max` (Hz), to the `series`
+/// named, and thinned to `max_points` rows with min/max buckets.
+#[utoipa::path(get, path = "/jobs/{jobId}/results/{output}/spectrum", operation_id = "getResultSpectrum",
+    tag = "Results",
+    params(
+        ("jobId" = String, Path, description = "Job id"),
+        ("output" = String, Path, description = "Output name, e.g. `tip_displacement`"),
+        SpectrumQuery,
+    ),
+    responses(
+        (status = 200, description = "The spectrum (frequency in Hz; Γ in the output's unit² per Hz)",
+            content(
+                (SpectrumDocument = "application/json"),
+                (String = "text/csv")
+            ),
+            headers(("ETag" = String))),
+        (status = 304, description = "Unchanged since the `If-None-Match` tag"),
+        (status = 400, description = "Invalid query parameter", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json"),
+        (status = 404, description = "No such job or output, or results not ready", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json"),
+        (status = 422, description = "The history has fewer than 2 samples or a non-finite value",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
+pub async fn spectrum(
+    State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
+    Path((job_id, output)): Path<(String, String)>,
+    ApiQuery(mut query): ApiQuery<SpectrumQuery>,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let csv = match query.format.as_deref() {
+        Some("csv") => true,
+        None | Some("json") => false,
+        Some(other) => {
+            return Err(
+                Problem::invalid_query(format!("`format` must be `csv` or `json`, not `{other}`")).into(),
+            );
+        }
+    };
+    for (name, value) in [("f_min", query.f_min), ("f_max", query.f_max)] {
+        if value.is_some_and(|f| !f.is_finite()) {
+            return Err(Problem::invalid_query(format!("`{name}` must be a finite number (Hz)")).into());
+        }
+    }
+    if query.max_points.is_some_and(|n| n < 2) {
+        return Err(Problem::invalid_query("`max_points` must be at least 2").into());
+    }
+    // A response holds at most the service's cap of rows, as for histories.
+    let cap = state.max_history_points;
+    query.max_points = Some(query.max_points.map_or(cap, |n| n.min(cap)));
+    with_retry_after(
+        async {
+            successful(&job_id, state.queue.outcome(tenant.as_str(), &job_id).await?)?;
+            let stored = state
+                .queue
+                .history(tenant.as_str(), &job_id, &output)
+                .await?
+                .ok_or_else(|| Problem::no_such_output(&job_id, &output))?;
+            // FFTs of long histories are CPU work: keep them off the runtime.
+            let rendered = tokio::task::spawn_blocking(move || render(&stored, &query, csv))
+                .await
+                .map_err(|e| ApiError::Internal(format!("computing a spectrum panicked: {e}")))??;
+            let content_type = if csv {
+                "text/csv; charset=utf-8"
+            } else {
+                "application/json"
+            };
+            Ok(tagged(&headers, content_type, rendered, HeaderMap::new()))
+        }
+        .await,
+    )
+}
+
+/// Histories are uniformly sampled (every process records at a fixed output interval).
+fn sample_interval(time: &[f64]) -> f64 {
+    match (time.first(), time.last()) {
+        (Some(first), Some(last)) if time.len() > 1 => (last - first) / (time.len() - 1) as f64,
+        _ => f64::NAN,
+    }
+}
+
+fn unprocessable(detail: String) -> ApiError {
+    Problem::from_status(422, "Unprocessable Content", detail).into()
+}
+
+fn render(stored: &store::StoredHistory, query: &SpectrumQuery, csv: bool) -> Result<Vec<u8>, ApiError> {
+    let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
+    let history = thinning::pick_series(history, query.series.as_deref()).map_err(Problem::invalid_query)?;
+    let dt = sample_interval(&history.time);
+    let mut spectra = History {
+        name: history.name.clone(),
+        time: Vec::new(),
+        series: Vec::with_capacity(history.series.len()),
+    };
+    for (name, values) in &history.series {
+        let psd = periodogram(values, dt)
+            .map_err(|e| unprocessable(format!("`{}`, series `{name}`: {e}", history.name)))?;
+        spectra.time = psd.frequencies;
+        spectra.series.push((name.clone(), psd.power_density));
+    }
+    let comparison = match history.series.as_slice() {
+        [(a, first), (b, second), ..] => {
+            let f_err = spectral_error(first, second)
+                .map_err(|e| unprocessable(format!("`{}`: {e}", history.name)))?;
+            let (gamma_a, gamma_b) = (&spectra.series[0].1, &spectra.series[1].1);
+            let worst = (0..gamma_a.len())
+                .max_by(|&i, &j| {
+                    (gamma_a[i] - gamma_b[i])
+                        .abs()
+                        .total_cmp(&(gamma_a[j] - gamma_b[j]).abs())
+                })
+                .unwrap_or(0);
+            Some(SpectrumComparison {
+                series: [a.clone(), b.clone()],
+                f_err,
+                frequency: spectra.time.get(worst).copied().unwrap_or(0.0),
+            })
+        }
+        _ => None,
+    };
+    let selected = thinning::select(&spectra, query.f_min, query.f_max, query.max_points);
+    if csv {
+        // The shared CSV writer names its first column `time`; here it holds frequencies.
+        let text = selected.to_csv();
+        return Ok(format!("frequency{}", text.strip_prefix("time").unwrap_or(&text)).into_bytes());
+    }
+    let in_window = {
+        let f0 = query.f_min.unwrap_or(f64::NEG_INFINITY);
+        let f1 = query.f_max.unwrap_or(f64::INFINITY);
+        spectra.time.iter().filter(|f| (f0..=f1).contains(*f)).count()
+    };
+    let document = SpectrumDocument {
+        output: selected.name,
+        sample_interval: dt,
+        samples: history.time.len(),
+        points: selected.time.len(),
+        total_points: spectra.time.len(),
+        thinned: selected.time.len() < in_window,
+        frequency: selected.time,
+        series: selected
+            .series
+            .into_iter()
+            .map(|(name, values)| Series { name, values })
+            .collect(),
+        comparison,
+    };
+    serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
+}

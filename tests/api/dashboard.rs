@@ -1,0 +1,414 @@
+//! The dashboard in a real browser: headless Chromium loads each page from a real
+//! server (real processes, fresh database), runs its scripts against the JSON API, and
+//! the DOM it ends with must hold what the page promises: the running job's progress
+//! bar, the finished cantilever's numerical and reference curves (the very extremes of
+//! the served histories) and their spectra with the f_err of the results, the bundle's
+//! peak-force grid, the calibration map with its f_err = 0.2 contour, the Monte Carlo
+//! histogram, and refused inputs marked next to their field.
+//!
+//! Screenshots go to `target/dashboard-screenshots/<page>.png`. Chromium is required:
+//! without it the test fails (set `CHOCMODAL_SKIP_BROWSER_TESTS=1` to skip it).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Duration;
+
+use chocmodal::processes::bundle_dynamics::BundleDynamics;
+use chocmodal::processes::cantilever_impact::CantileverImpact;
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use crate::helpers::{TestApp, spawn_app_with_processes};
+
+/// Headless Chromium, or `None` when browser tests are explicitly skipped.
+fn chromium() -> Option<PathBuf> {
+    if std::env::var("CHOCMODAL_SKIP_BROWSER_TESTS").as_deref() == Ok("1") {
+        eprintln!("CHOCMODAL_SKIP_BROWSER_TESTS=1: the dashboard's browser test is skipped");
+        return None;
+    }
+    let candidates = std::env::var_os("CHOCMODAL_CHROMIUM")
+        .map(PathBuf::from)
+        .into_iter()
+        .chain(
+            [
+                "/usr/bin/chromium",
+                "/usr/bin/chromium-browser",
+                "/usr/bin/google-chrome",
+            ]
+            .map(PathBuf::from),
+        );
+    let found = candidates.into_iter().find(|path| path.is_file());
+    Some(found.unwrap_or_else(|| {
+        panic!(
+            "the dashboard tests need headless Chromium: install Debian's `chromium` package \
+             (`apt-get install chromium`; .ci/run does it), point CHOCMODAL_CHROMIUM at a \
+             Chromium binary, or set CHOCMODAL_SKIP_BROWSER_TESTS=1 to skip them"
+        )
+    }))
+}
+
+fn screenshot_dir() -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"));
+    let dir = target.join("dashboard-screenshots");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Loads `url`, lets its scripts run for `budget_ms` of virtual time (the clock jumps
+/// ahead while nothing is pending; network fetches are awaited), saves a screenshot and
+/// returns the DOM.
+async fn load(browser: &Path, url: &str, page: &str, height: u32, budget_ms: u32) -> String {
+    let profile = tempfile::TempDir::new().unwrap();
+    let screenshot = screenshot_dir().join(format!("{page}.png"));
+    let run = tokio::process::Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-dev-shm-usage",
+            "--no-first-run",
+            "--hide-scrollbars",
+            "--enable-logging=stderr",
+            "--v=0",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .arg(format!("--virtual-time-budget={budget_ms}"))
+        .arg(format!("--window-size=1280,{height}"))
+        .arg(format!("--screenshot={}", screenshot.display()))
+        .arg("--dump-dom")
+        .arg(url)
+        .kill_on_drop(true)
+        .output();
+    let output = tokio::time::timeout(Duration::from_secs(90), run)
+        .await
+        .unwrap_or_else(|_| panic!("Chromium did not finish loading {url} within 90 s"))
+        .expect("Chromium starts");
+    let log = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "Chromium failed on {url}: {log}");
+    // Uncaught exceptions in the page's scripts show up in the console log.
+    let errors: Vec<&str> = log.lines().filter(|l| l.contains("Uncaught")).collect();
+    assert!(errors.is_empty(), "script errors on {url}: {errors:#?}");
+    let dom = String::from_utf8(output.stdout).unwrap();
+    assert!(dom.contains("</html>"), "no DOM from {url}: {dom}");
+    dom
+}
+
+/// The opening tags of the elements whose opening tag contains `marker`.
+fn tags<'a>(dom: &'a str, marker: &str) -> Vec<&'a str> {
+    dom.match_indices(marker)
+        .map(|(at, _)| {
+            let start = dom[..at].rfind('<').unwrap();
+            let end = at + dom[at..].find('>').unwrap();
+            &dom[start..=end]
+        })
+        .collect()
+}
+
+fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let key = format!(" {name}=\"");
+    let start = tag.find(&key)? + key.len();
+    Some(&tag[start..start + tag[start..].find('"')?])
+}
+
+fn number(tag: &str, name: &str) -> f64 {
+    attribute(tag, name)
+        .unwrap_or_else(|| panic!("no {name} in {tag}"))
+        .parse()
+        .unwrap_or_else(|e| panic!("{name} of {tag}: {e}"))
+}
+
+/// The markup of the element starting at the first tag containing `marker`, up to `</closing>`.
+fn element<'a>(dom: &'a str, marker: &str, closing: &str) -> &'a str {
+    let at = dom
+        .find(marker)
+        .unwrap_or_else(|| panic!("no {marker} on the page"));
+    let start = dom[..at].rfind('<').unwrap();
+    let end = at
+        + dom[at..]
+            .find(closing)
+            .unwrap_or_else(|| panic!("{marker} is not closed"));
+    &dom[start..end + closing.len()]
+}
+
+/// Equal up to the last bit or two: serde_json's default float parsing may be one ulp off.
+fn same(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-15 * b.abs()
+}
+
+fn values(document: &Value, name: &str) -> Vec<f64> {
+    document["series"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == name)
+        .unwrap()["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}
+
+fn example(name: &str) -> Value {
+    let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+async fn execute(app: &TestApp, process: &str, body: &Value) -> String {
+    let response = app.post_execution(process, body).await;
+    assert_eq!(response.status(), StatusCode::CREATED);
+    response.json::<Value>().await.unwrap()["jobID"]
+        .as_str()
+        .unwrap()
+        .to_owned()
+}
+
+#[tokio::test]
+async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_browser() {
+    let Some(browser) = chromium() else { return };
+    let app =
+        spawn_app_with_processes(vec![Arc::new(CantileverImpact), Arc::new(BundleDynamics)], |_| {}).await;
+    let within = Duration::from_secs(60);
+
+    // A slow job holds one worker (about 30 s, dismissed at the end); the other computes the rest.
+    let slow = app.submit(json!({"steps": 600, "step_ms": 50.0})).await;
+    let mut cantilever = example("cantilever-impact.json");
+    cantilever["inputs"]["solver"]["duration"] = json!(0.1);
+    let cantilever = execute(&app, "cantilever-impact", &cantilever).await;
+    let mut bundle = example("bundle-random-gaps.json");
+    bundle["inputs"]["pin"]["modes"] = json!(8);
+    bundle["inputs"]["solver"]["duration"] = json!(0.03);
+    let bundle = execute(&app, "bundle-dynamics", &bundle).await;
+    let mut calibration = example("sweep-calibration.json");
+    calibration["inputs"]["solver"]["duration"] = json!(0.05);
+    calibration["inputs"]["beam"]["elements"] = json!(10);
+    calibration["inputs"]["beam"]["modes"] = json!(6);
+    calibration["inputs"]["reference"]["modes"] = json!(10);
+    calibration["axes"] = json!([
+        {"pointer": "/contact/rk", "logspace": [1.0, 1e6, 3]},
+        {"pointer": "/solver/time_step", "values": [1e-5, 3e-5, 1e-4]}
+    ]);
+    let calibration = app.create_sweep(calibration).await;
+    let mut gaps = example("sweep-gaps.json");
+    gaps["samples"] = json!(8);
+    gaps["inputs"]["solver"]["duration"] = json!(0.02);
+    let gaps = app.create_sweep(gaps).await;
+    for job in [&cantilever, &bundle] {
+        assert_eq!(
+            app.wait_for(job, &["successful"], within).await["status"],
+            "successful"
+        );
+    }
+    for sweep in [&calibration, &gaps] {
+        app.wait_for_sweep(sweep, &["successful"], within).await;
+    }
+    let deadline = std::time::Instant::now() + within;
+    let progress = loop {
+        let progress = app.status(&slow).await["progress"].as_u64().unwrap();
+        if progress >= 1 {
+            break progress as f64 / 100.0;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the slow job does not progress"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    };
+
+    // The job list: the slow job's progress bar, between 0 and 1, as far as the job got.
+    let dom = load(&browser, &app.url("/jobs?limit=20"), "jobs", 900, 3000).await;
+    let row = element(&dom, &format!("data-job=\"{slow}\""), "</tr>");
+    let bar = tags(row, "role=\"progressbar\"");
+    assert_eq!(bar.len(), 1, "{row}");
+    let fraction = number(bar[0], "data-value");
+    assert!(
+        fraction >= progress && fraction < 1.0,
+        "progress {fraction} drawn, {progress} before loading"
+    );
+    let row = element(&dom, &format!("data-job=\"{cantilever}\""), "</tr>");
+    assert!(row.contains("data-status=\"successful\""), "{row}");
+
+    // The cantilever: both curves are the served histories, extremes included.
+    let dom = load(
+        &browser,
+        &app.url(&format!("/jobs/{cantilever}")),
+        "job-cantilever",
+        2600,
+        6000,
+    )
+    .await;
+    let history = app
+        .get_json(&format!("/jobs/{cantilever}/results/tip_displacement"))
+        .await;
+    let figure = element(&dom, "data-plot=\"tip_displacement\"", "</figure>");
+    for name in ["numerical", "reference"] {
+        let path = tags(figure, &format!("data-series=\"{name}\""));
+        assert_eq!(path.len(), 1, "one {name} curve");
+        let served = values(&history, name);
+        let (min, max) = served
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+        assert!(
+            same(number(path[0], "data-min"), min),
+            "{name} minimum drawn: {}, served {min}",
+            path[0]
+        );
+        assert!(
+            same(number(path[0], "data-max"), max),
+            "{name} maximum drawn: {}, served {max}",
+            path[0]
+        );
+        assert!(number(path[0], "data-points") > 500.0, "{}", path[0]);
+        assert!(
+            attribute(path[0], "d").unwrap().matches('L').count() > 500,
+            "{name} path"
+        );
+    }
+    let results = app.get_json(&format!("/jobs/{cantilever}/results")).await;
+    let f_err = results["comparison"]["f_err"].as_f64().unwrap();
+    let spectrum = element(&dom, "data-plot=\"tip_displacement-spectrum\"", "</figure>");
+    assert!(
+        spectrum.contains("data-log-y=\"true\""),
+        "{}",
+        &spectrum[..spectrum.len().min(600)]
+    );
+    for name in ["numerical", "reference"] {
+        let path = tags(spectrum, &format!("data-series=\"{name}\""));
+        assert_eq!(path.len(), 1, "one {name} spectrum");
+        assert!(number(path[0], "data-points") >= 5.0, "{}", path[0]);
+    }
+    let shown = number(tags(spectrum, "data-spectrum-f-err")[0], "data-spectrum-f-err");
+    assert!(same(shown, f_err), "f_err {shown} shown, {f_err} in the results");
+    assert!(same(number(tags(&dom, "data-f-err")[0], "data-f-err"), f_err));
+    assert!(dom.contains("tip_displacement.csv") && dom.contains("contact_force-spectrum.csv"));
+
+    // The bundle: one grid cell per contact, the strongest contact's history drawn.
+    let dom = load(
+        &browser,
+        &app.url(&format!("/jobs/{bundle}")),
+        "job-bundle",
+        2000,
+        6000,
+    )
+    .await;
+    let results = app.get_json(&format!("/jobs/{bundle}/results")).await;
+    let contacts = results["contacts"].as_array().unwrap();
+    let grid = element(&dom, "data-plot=\"max-force-grid\"", "</figure>");
+    assert_eq!(tags(grid, "data-contact=").len(), contacts.len());
+    let strongest = results["max_contact_force"]["contact"].as_u64().unwrap();
+    let cell = tags(grid, &format!("data-contact=\"{strongest}\""))[0];
+    assert!(same(
+        number(cell, "data-value"),
+        contacts[strongest as usize]["max_force"].as_f64().unwrap()
+    ));
+    let figure = element(&dom, "data-plot=\"contact_forces\"", "</figure>");
+    let path = tags(figure, &format!("data-series=\"c{strongest}\""));
+    assert_eq!(path.len(), 1, "{figure}");
+    assert!(number(path[0], "data-max") > 0.0);
+
+    // The calibration map: every run a cell, validity as aggregated, and the contour.
+    let dom = load(
+        &browser,
+        &app.url(&format!("/sweeps/{calibration}")),
+        "sweep-calibration",
+        1700,
+        4000,
+    )
+    .await;
+    let aggregate = app.sweep_results(&calibration).await;
+    let cells = aggregate["aggregates"]["calibration"]["cells"]
+        .as_array()
+        .unwrap();
+    let map = element(&dom, "data-plot=\"calibration\"", "</figure>");
+    assert_eq!(tags(map, "data-cell=").len(), 9);
+    let valid = cells.iter().filter(|c| c["valid"] == true).count();
+    assert!(
+        valid > 0 && valid < 9,
+        "the grid crosses the threshold: {valid} valid"
+    );
+    assert_eq!(tags(map, "data-valid=\"true\"").len(), valid);
+    let contour = tags(map, "data-contour=\"0.2\"");
+    assert_eq!(contour.len(), 1, "{map}");
+    assert!(
+        attribute(contour[0], "d").unwrap().starts_with('M'),
+        "{}",
+        contour[0]
+    );
+    assert!(dom.contains("data-results=\"9\""));
+
+    // The Monte Carlo campaign: a histogram of all eight runs.
+    let dom = load(
+        &browser,
+        &app.url(&format!("/sweeps/{gaps}")),
+        "sweep-gaps",
+        1400,
+        4000,
+    )
+    .await;
+    let figure = element(&dom, "data-plot=\"histogram\"", "</figure>");
+    assert!(figure.contains("data-values=\"8\""), "{figure}");
+    let counted: f64 = tags(figure, "data-count=")
+        .iter()
+        .map(|t| number(t, "data-count"))
+        .sum();
+    assert_eq!(counted, 8.0);
+
+    // A run refused for its time step: the submit form marks that very field.
+    let refused = aggregate["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|row| row["status"] == "failed")
+        .expect("a recorded invalid run")["job"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    let dom = load(
+        &browser,
+        &app.url(&format!("/ui/submit?from={refused}")),
+        "submit",
+        1400,
+        3000,
+    )
+    .await;
+    let field = element(&dom, "data-pointer=\"/inputs/solver/time_step\"", "</label>");
+    assert!(field.contains("class=\"invalid\""), "{field}");
+    let note = tags(field, "data-error-for=\"/inputs/solver/time_step\"");
+    assert_eq!(note.len(), 1, "{field}");
+    assert!(field.contains("critical"), "{field}");
+
+    assert_eq!(
+        app.delete(&format!("/jobs/{slow}")).await.status(),
+        StatusCode::OK
+    );
+}
+
+/// With an auth file the dashboard still loads (its static files are public, a page
+/// asked for without a token is its shell with a 401), and the page's scripts, refused
+/// by the API, ask for the team's token instead of showing empty tables.
+#[tokio::test]
+async fn with_tokens_the_dashboard_asks_for_one() {
+    let Some(browser) = chromium() else { return };
+    let tokens = chocmodal::service::auth::TokenTable::parse("alpha alpha-token-0123456789\n").unwrap();
+    let app = crate::helpers::spawn_app_with(|config| config.auth = Some(tokens)).await;
+
+    let page = app
+        .client
+        .get(app.url("/jobs"))
+        .header("accept", "text/html")
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(page.status(), StatusCode::UNAUTHORIZED);
+    assert!(page.text().await.unwrap().contains("data-page=\"jobs\""));
+    assert_eq!(app.get("/ui/assets/app.js").await.status(), StatusCode::OK);
+    assert_eq!(app.get("/jobs").await.status(), StatusCode::UNAUTHORIZED);
+
+    let dom = load(&browser, &app.url("/jobs"), "token-prompt", 600, 3000).await;
+    assert!(dom.contains("id=\"token-form\""), "no token form in {dom}");
+    assert!(dom.contains("id=\"token-input\""), "{dom}");
+}
