@@ -213,7 +213,10 @@ async fn another_tenants_job_is_not_found_anywhere() {
         "successful"
     );
     assert_eq!(alpha.get_json(&format!("/jobs/{job}/results")).await["sum"], 15);
-    assert_eq!(alpha.get_json(&format!("/jobs/{job}/inputs")).await["inputs"]["steps"], 5);
+    assert_eq!(
+        alpha.get_json(&format!("/jobs/{job}/inputs")).await["inputs"]["steps"],
+        5
+    );
     let spectrum = alpha.get(&format!("/jobs/{job}/results/signal/spectrum")).await;
     assert_eq!(spectrum.status(), StatusCode::OK);
 }

@@ -87,7 +87,7 @@ pub struct SpectrumDocument {
     tag = "Results",
     params(
         ("jobId" = String, Path, description = "Job id"),
-        ("output" = String, Path, description = "Output name, e.g. `tip_displacement`"),
+        ("output" = String, Path, description = "Output name, e.g. `tip_displacement`", example = "tip_displacement"),
         SpectrumQuery,
     ),
     responses(
