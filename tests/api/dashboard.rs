@@ -386,3 +386,29 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
         StatusCode::OK
     );
 }
+
+/// With an auth file the dashboard still loads (its static files are public, a page
+/// asked for without a token is its shell with a 401), and the page's scripts, refused
+/// by the API, ask for the team's token instead of showing empty tables.
+#[tokio::test]
+async fn with_tokens_the_dashboard_asks_for_one() {
+    let Some(browser) = chromium() else { return };
+    let tokens = chocmodal::service::auth::TokenTable::parse("alpha alpha-token-0123456789\n").unwrap();
+    let app = crate::helpers::spawn_app_with(|config| config.auth = Some(tokens)).await;
+
+    let page = app
+        .client
+        .get(app.url("/jobs"))
+        .header("accept", "text/html")
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(page.status(), StatusCode::UNAUTHORIZED);
+    assert!(page.text().await.unwrap().contains("data-page=\"jobs\""));
+    assert_eq!(app.get("/ui/assets/app.js").await.status(), StatusCode::OK);
+    assert_eq!(app.get("/jobs").await.status(), StatusCode::UNAUTHORIZED);
+
+    let dom = load(&browser, &app.url("/jobs"), "token-prompt", 600, 3000).await;
+    assert!(dom.contains("id=\"token-form\""), "no token form in {dom}");
+    assert!(dom.contains("id=\"token-input\""), "{dom}");
+}

@@ -192,6 +192,8 @@ async fn another_tenants_job_is_not_found_anywhere(backend: Backend) {
         format!("/jobs/{job}/results"),
         format!("/jobs/{job}/results/signal"),
         format!("/jobs/{job}/results/signal?format=csv"),
+        format!("/jobs/{job}/results/signal/spectrum"),
+        format!("/jobs/{job}/inputs"),
     ] {
         assert_problem(beta.get(&path).await, StatusCode::NOT_FOUND, "/no-such-job").await;
     }
@@ -216,6 +218,12 @@ async fn another_tenants_job_is_not_found_anywhere(backend: Backend) {
         "successful"
     );
     assert_eq!(alpha.get_json(&format!("/jobs/{job}/results")).await["sum"], 15);
+    assert_eq!(
+        alpha.get_json(&format!("/jobs/{job}/inputs")).await["inputs"]["steps"],
+        5
+    );
+    let spectrum = alpha.get(&format!("/jobs/{job}/results/signal/spectrum")).await;
+    assert_eq!(spectrum.status(), StatusCode::OK);
 }
 
 async fn identical_inputs_of_another_tenant_are_computed_not_reused(backend: Backend) {

@@ -4,14 +4,21 @@
 //! needs `Authorization: Bearer <token>`; the token's tenant owns what the request
 //! creates and is the only one that sees it. Without an auth file every request is the
 //! implicit tenant.
+//!
+//! The dashboard works with tokens too: its static files (`/ui/...`: scripts, style,
+//! the submit form, the shipped examples) hold no tenant's data and are served to
+//! anyone, and a browser asking for a page (`/jobs` as HTML) without a token gets the
+//! page's shell with a 401. The page's scripts then ask for a token, keep it in the
+//! tab's session storage and send it with every API call.
 
 use std::sync::Arc;
 
-use axum::extract::{Request, State};
-use axum::http::{HeaderValue, header};
+use axum::extract::{MatchedPath, Request, State};
+use axum::http::{HeaderValue, Method, StatusCode, header};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 
+use super::dashboard::{self, Page};
 use crate::problem::Problem;
 use crate::service::auth::{Tenant, TokenTable};
 
@@ -26,7 +33,16 @@ pub struct AuthPolicy {
 
 /// Routes that answer without a token.
 fn is_open(policy: &AuthPolicy, path: &str) -> bool {
-    path == "/healthz" || (policy.metrics_public && path == "/metrics")
+    path == "/healthz" || path.starts_with("/ui/") || (policy.metrics_public && path == "/metrics")
+}
+
+/// The dashboard page a browser asks for, if the request is one.
+fn page_asked(request: &Request) -> Option<Page> {
+    if !matches!(*request.method(), Method::GET | Method::HEAD) {
+        return None;
+    }
+    let page = Page::for_route(request.extensions().get::<MatchedPath>()?.as_str())?;
+    dashboard::negotiation::wants_html(request.headers(), request.uri().query()).then_some(page)
 }
 
 /// The bearer token of an `Authorization` header (scheme case-insensitive).
@@ -39,8 +55,16 @@ fn bearer_token(value: &HeaderValue) -> Option<&str> {
         .filter(|t| !t.is_empty())
 }
 
-fn unauthorized(detail: &str, challenge: &'static str) -> Response {
-    let mut response = Problem::unauthorized(detail).into_response();
+fn unauthorized(request: &Request, detail: &str, challenge: &'static str) -> Response {
+    let mut response = match page_asked(request) {
+        Some(page) => {
+            let mut page = dashboard::html_page(page, StatusCode::UNAUTHORIZED);
+            page.headers_mut()
+                .append(header::VARY, HeaderValue::from_static("accept"));
+            page
+        }
+        None => Problem::unauthorized(detail).into_response(),
+    };
     response
         .headers_mut()
         .insert(header::WWW_AUTHENTICATE, HeaderValue::from_static(challenge));
@@ -59,6 +83,7 @@ pub async fn authenticate(
         Some(tokens) => match request.headers().get(header::AUTHORIZATION) {
             None => {
                 return unauthorized(
+                    &request,
                     "this service needs `Authorization: Bearer <token>`",
                     "Bearer realm=\"chocmodal\"",
                 );
@@ -68,6 +93,7 @@ pub async fn authenticate(
                 None => {
                     tracing::info!(path = %request.uri().path(), "request with an invalid bearer token");
                     return unauthorized(
+                        &request,
                         "the bearer token is not valid",
                         "Bearer realm=\"chocmodal\", error=\"invalid_token\"",
                     );

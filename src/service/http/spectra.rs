@@ -2,8 +2,7 @@
 //! of a stored history (the periodogram of `physics::spectrum`), and the spectral error
 //! f_err between the first two series, the figure `cantilever-impact` reports.
 
-use axum::Extension;
-use axum::extract::{Path, State};
+use axum::extract::{Extension, Path, State};
 use axum::http::HeaderMap;
 use axum::response::Response;
 use serde::Serialize;
@@ -88,7 +87,7 @@ pub struct SpectrumDocument {
     tag = "Results",
     params(
         ("jobId" = String, Path, description = "Job id"),
-        ("output" = String, Path, description = "Output name, e.g. `tip_displacement`"),
+        ("output" = String, Path, description = "Output name, e.g. `tip_displacement`", example = "tip_displacement"),
         SpectrumQuery,
     ),
     responses(
@@ -107,9 +106,9 @@ pub struct SpectrumDocument {
             body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
 pub async fn spectrum(
     State(state): State<AppState>,
-    Path((job_id, output)): Path<(String, String)>,
     Extension(tenant): Extension<Tenant>,
-    ApiQuery(query): ApiQuery<SpectrumQuery>,
+    Path((job_id, output)): Path<(String, String)>,
+    ApiQuery(mut query): ApiQuery<SpectrumQuery>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
     let csv = match query.format.as_deref() {
@@ -129,6 +128,9 @@ pub async fn spectrum(
     if query.max_points.is_some_and(|n| n < 2) {
         return Err(Problem::invalid_query("`max_points` must be at least 2").into());
     }
+    // A response holds at most the service's cap of rows, as for histories.
+    let cap = state.max_history_points;
+    query.max_points = Some(query.max_points.map_or(cap, |n| n.min(cap)));
     with_retry_after(
         async {
             successful(&job_id, state.queue.outcome(tenant.as_str(), &job_id).await?)?;

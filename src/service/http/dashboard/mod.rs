@@ -105,7 +105,8 @@ to any client that does not ask for HTML (see <a href="/openapi.json">the API</a
     )
 }
 
-fn html_page(page: Page, status: StatusCode) -> Response {
+/// The page `page` with `status` (and `Cache-Control: no-cache`).
+pub fn html_page(page: Page, status: StatusCode) -> Response {
     let mut response = (status, Html(shell(page))).into_response();
     response
         .headers_mut()

@@ -47,12 +47,56 @@ export class ApiProblem extends Error {
   }
 }
 
+const TOKEN_KEY = 'chocmodal-token';
+
+/** The bearer token given in this tab (a service with an auth file), or null. */
+export function token() {
+  try {
+    return sessionStorage.getItem(TOKEN_KEY);
+  } catch {
+    return null;
+  }
+}
+
+function authHeaders() {
+  const value = token();
+  return value ? {Authorization: `Bearer ${value}`} : {};
+}
+
+/**
+ * After a 401: a form at the top of the page asks for the team's token, keeps it in
+ * this tab's session storage (never in a URL, never in a cookie) and reloads.
+ */
+function askForToken() {
+  if (document.getElementById('token-form')) return;
+  const input = h('input', {type: 'password', id: 'token-input', autocomplete: 'off', size: 40,
+    placeholder: 'bearer token', 'aria-label': 'bearer token'});
+  const form = h('form', {id: 'token-form', class: 'card token', onsubmit: (event) => {
+    event.preventDefault();
+    const value = input.value.trim();
+    if (!value) return;
+    try {
+      sessionStorage.setItem(TOKEN_KEY, value);
+    } catch {
+      return;
+    }
+    location.reload();
+  }},
+  h('h2', {}, 'This service needs a token'),
+  h('p', {}, token() ? 'The token of this tab is not valid. ' : '',
+    'Paste your team\'s bearer token: it is kept in this tab only, and sent with every request.'),
+  input, ' ', h('button', {type: 'submit'}, 'Use it'));
+  (document.getElementById('main') || document.body).prepend(form);
+  input.focus();
+}
+
 /** GET (or any method) on the JSON API; resolves to the parsed body, rejects with ApiProblem. */
 export async function api(path, options = {}) {
   const response = await fetch(path, {
     ...options,
-    headers: {Accept: 'application/json', ...(options.headers || {})},
+    headers: {Accept: 'application/json', ...authHeaders(), ...(options.headers || {})},
   });
+  if (response.status === 401) askForToken();
   const text = await response.text();
   let body = null;
   try {
@@ -68,9 +112,10 @@ export async function api(path, options = {}) {
 export async function post(path, body) {
   const response = await fetch(path, {
     method: 'POST',
-    headers: {Accept: 'application/json', 'Content-Type': 'application/json'},
+    headers: {Accept: 'application/json', 'Content-Type': 'application/json', ...authHeaders()},
     body: typeof body === 'string' ? body : JSON.stringify(body),
   });
+  if (response.status === 401) askForToken();
   const text = await response.text();
   let parsed = null;
   try {
@@ -204,5 +249,24 @@ export function errorBox(error) {
 
 /** A download link, saved as `filename`. */
 export function download(href, filename) {
-  return h('a', {class: 'download', href, download: filename}, filename);
+  // With a token, a plain link would go without it: fetch, then save the bytes.
+  const save = (event) => {
+    if (!token()) return;
+    event.preventDefault();
+    fetch(href, {headers: authHeaders()})
+      .then((response) => {
+        if (!response.ok) throw new ApiProblem(response.status, null);
+        return response.blob();
+      })
+      .then((blob) => {
+        const url = URL.createObjectURL(blob);
+        const link = h('a', {href: url, download: filename});
+        document.body.append(link);
+        link.click();
+        link.remove();
+        setTimeout(() => URL.revokeObjectURL(url), 10000);
+      })
+      .catch((error) => window.alert(`Download failed: ${error.message}`));
+  };
+  return h('a', {class: 'download', href, download: filename, onclick: save}, filename);
 }
