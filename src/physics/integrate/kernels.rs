@@ -1,18 +1,39 @@
 //! The dense kernels of a step, written on `pulp`'s portable SIMD vectors so that they
 //! vectorize whatever the optimizer decides (AVX2 + FMA on x86-64-v3, NEON on aarch64,
-//! scalar elsewhere). Every slice handed to them is a whole number of [`BLOCK`]s, so on
-//! AVX2 there is no scalar tail; other vector widths fall back to a tail loop.
+//! scalar elsewhere).
+//!
+//! Every row of the state is padded to a whole number of vectors, so the kernels of the
+//! hot loop have no scalar tail. They take the row length in vectors as a plain
+//! argument: the stepper calls them with a constant for the usual row lengths, so that
+//! every per-row loop is unrolled with no bounds checks (see `stepper`).
 //!
 //! Products and sums use `mul_add_e`: fused where the CPU has FMA, plain otherwise.
 //! A run is therefore bitwise reproducible on one machine, and agrees to rounding
 //! across machines of different SIMD levels.
 
+use std::collections::HashMap;
+
 use pulp::Simd;
 
-/// Values per block: every row is padded to a multiple of this (4 × f64 = 256 bits).
-pub(super) const BLOCK: usize = 4;
+/// f64 values per SIMD vector of `S`.
+#[inline(always)]
+pub(super) fn lanes<S: Simd>() -> usize {
+    std::mem::size_of::<S::f64s>() / std::mem::size_of::<f64>()
+}
 
-/// Σ x·y.
+/// [`lanes`] of the SIMD level an [`pulp::Arch`] dispatches to.
+pub(super) struct Lanes;
+
+impl pulp::WithSimd for Lanes {
+    type Output = usize;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) -> usize {
+        lanes::<S>()
+    }
+}
+
+/// Σ x·y (any length).
 #[inline(always)]
 pub(super) fn dot<S: Simd>(simd: S, x: &[f64], y: &[f64]) -> f64 {
     let (x_head, x_tail) = S::as_simd_f64s(x);
@@ -28,25 +49,7 @@ pub(super) fn dot<S: Simd>(simd: S, x: &[f64], y: &[f64]) -> f64 {
     sum
 }
 
-/// Σ ψ·(v + lookahead·a): the dashpot velocity of one pin at one height.
-#[inline(always)]
-pub(super) fn dot_ahead<S: Simd>(simd: S, shape: &[f64], v: &[f64], a: &[f64], lookahead: f64) -> f64 {
-    let (s_head, s_tail) = S::as_simd_f64s(shape);
-    let (v_head, v_tail) = S::as_simd_f64s(v);
-    let (a_head, a_tail) = S::as_simd_f64s(a);
-    let ahead = simd.splat_f64s(lookahead);
-    let mut acc = simd.splat_f64s(0.0);
-    for ((s, v), a) in s_head.iter().zip(v_head).zip(a_head) {
-        acc = simd.mul_add_e_f64s(*s, simd.mul_add_e_f64s(ahead, *a, *v), acc);
-    }
-    let mut sum = simd.reduce_sum_f64s(acc);
-    for ((s, v), a) in s_tail.iter().zip(v_tail).zip(a_tail) {
-        sum += s * (v + lookahead * a);
-    }
-    sum
-}
-
-/// y += α x.
+/// y += α x (any length).
 #[inline(always)]
 pub(super) fn axpy<S: Simd>(simd: S, alpha: f64, x: &[f64], y: &mut [f64]) {
     let (x_head, x_tail) = S::as_simd_f64s(x);
@@ -60,49 +63,68 @@ pub(super) fn axpy<S: Simd>(simd: S, alpha: f64, x: &[f64], y: &mut [f64]) {
     }
 }
 
-/// y = α x.
+/// Σ ψ·((v_L + h·a_L) − (v_R + h·a_R)) over one row of vectors, h = `lookahead`: the
+/// rate of a contact's penetration between the pins of rows L and R (a wall reads a row
+/// of zeros). Two accumulators halve the dependency chain.
 #[inline(always)]
-pub(super) fn scale_into<S: Simd>(simd: S, alpha: f64, x: &[f64], y: &mut [f64]) {
-    let (x_head, x_tail) = S::as_simd_f64s(x);
-    let (y_head, y_tail) = S::as_mut_simd_f64s(y);
-    let scale = simd.splat_f64s(alpha);
-    for (y, x) in y_head.iter_mut().zip(x_head) {
-        *y = simd.mul_f64s(scale, *x);
+pub(super) fn penetration_rate<S: Simd>(
+    simd: S,
+    shape: &[S::f64s],
+    (v_left, a_left): (&[S::f64s], &[S::f64s]),
+    (v_right, a_right): (&[S::f64s], &[S::f64s]),
+    lookahead: f64,
+) -> f64 {
+    let n = shape.len();
+    let (v_left, a_left, v_right, a_right) = (&v_left[..n], &a_left[..n], &v_right[..n], &a_right[..n]);
+    let ahead = simd.splat_f64s(lookahead);
+    let mut acc = [simd.splat_f64s(0.0); 2];
+    for k in 0..n {
+        let dv = simd.sub_f64s(v_left[k], v_right[k]);
+        let da = simd.sub_f64s(a_left[k], a_right[k]);
+        acc[k % 2] = simd.mul_add_e_f64s(shape[k], simd.mul_add_e_f64s(ahead, da, dv), acc[k % 2]);
     }
-    for (y, x) in y_tail.iter_mut().zip(x_tail) {
-        *y = alpha * x;
+    simd.reduce_sum_f64s(simd.add_f64s(acc[0], acc[1]))
+}
+
+/// y += α x over one row of vectors.
+#[inline(always)]
+pub(super) fn row_axpy<S: Simd>(simd: S, alpha: f64, x: &[S::f64s], y: &mut [S::f64s]) {
+    let n = x.len();
+    let y = &mut y[..n];
+    let scale = simd.splat_f64s(alpha);
+    for k in 0..n {
+        y[k] = simd.mul_add_e_f64s(scale, x[k], y[k]);
     }
 }
 
-/// Most blocks of levels accumulated at once (registers held: this many, plus one).
+/// Most blocks of heights accumulated at once (registers held: this many, plus one).
 const GROUP: usize = 4;
 
-/// Ψ at the contact levels laid out for [`level_deflections`]: levels padded to whole
-/// blocks, blocks gathered in groups of up to [`GROUP`], and within a group, mode after
-/// mode, the group's blocks side by side:
-/// `data[group_start + (i·G + j)·BLOCK + k] = ψᵢ(z_{(first_block + j)·BLOCK + k})`.
+/// Ψ at a set of heights, laid out for [`level_deflections`]. Heights are cut into
+/// blocks of one vector (`lanes` heights, the last block padded with ψ = 0); blocks are
+/// gathered in groups of up to [`GROUP`], and within a group, mode after mode, the
+/// group's blocks side by side:
+/// `data[group_start + (i·G + j)·lanes + k] = ψᵢ(z_{(first_block + j)·lanes + k})`.
 pub(super) struct LevelShapes {
     data: Vec<f64>,
-    /// Levels rounded up to whole blocks.
-    pub levels: usize,
-    /// Levels.
-    level_count: usize,
+    /// Blocks of `lanes` heights.
+    pub blocks: usize,
 }
 
 impl LevelShapes {
-    /// From Ψ stored level by level (`level_shapes[l·row + i]`).
-    pub fn new(level_shapes: &[f64], row: usize) -> Self {
-        let level_count = level_shapes.len() / row;
-        let blocks = level_count.div_ceil(BLOCK);
-        let mut data = Vec::with_capacity(blocks * BLOCK * row);
+    /// From Ψ stored height by height (`shapes[l·row + i]`), for vectors of `lanes`.
+    pub fn new(shapes: &[f64], row: usize, lanes: usize) -> Self {
+        let count = shapes.len() / row;
+        let blocks = count.div_ceil(lanes);
+        let mut data = Vec::with_capacity(blocks * lanes * row);
         for first in (0..blocks).step_by(GROUP) {
             let group = GROUP.min(blocks - first);
             for i in 0..row {
                 for j in 0..group {
-                    for k in 0..BLOCK {
-                        let level = (first + j) * BLOCK + k;
-                        data.push(if level < level_count {
-                            level_shapes[level * row + i]
+                    for k in 0..lanes {
+                        let level = (first + j) * lanes + k;
+                        data.push(if level < count {
+                            shapes[level * row + i]
                         } else {
                             0.0
                         });
@@ -110,231 +132,260 @@ impl LevelShapes {
                 }
             }
         }
-        Self {
-            data,
-            levels: blocks * BLOCK,
-            level_count,
-        }
+        Self { data, blocks }
     }
 }
 
-/// Deflection of every pin at every contact level:
-/// `out[p·levels + l] = Σᵢ ψᵢ(zₗ) q[p·row + i]`. Each group of blocks of a pin's levels
-/// is accumulated in registers, each coordinate broadcast once per group.
+/// Deflection of every pin at every height of `shapes`, block-major: the vector
+/// `out[b·stride + 1 + p]` holds pin p's deflections at the heights of block b,
+/// `w(z_l) = Σᵢ ψᵢ(z_l) q[p·row + i]`. Slots 0 and `pins + 1` of each block (the walls)
+/// are left alone. Two pins and a group of blocks are accumulated at once in registers:
+/// each shape vector is loaded once for both pins, and the independent accumulators
+/// hide the latency of the FMAs.
 #[inline(always)]
 pub(super) fn level_deflections<S: Simd>(
     simd: S,
     shapes: &LevelShapes,
     row: usize,
     q: &[f64],
-    out: &mut [f64],
+    out: &mut [S::f64s],
+    stride: usize,
 ) {
-    let levels = shapes.levels;
-    if levels == 0 {
-        return;
-    }
-    let (vectors, _) = S::as_simd_f64s(&shapes.data);
-    let one_block_per_vector = vectors.len() * BLOCK == shapes.data.len();
-    let stride = out.len() / levels;
-    let mut pin_levels = [0.0; GROUP * BLOCK];
-    for (p, coordinates) in q.chunks_exact(row).enumerate() {
+    let (data, _) = S::as_simd_f64s(&shapes.data);
+    let blocks = shapes.blocks;
+    let pins = q.len() / row;
+    assert!(data.len() == blocks * row && out.len() >= blocks * stride && pins < stride);
+    let mut p = 0;
+    while p < pins {
+        let pair = pins - p >= 2;
+        let rows = &q[p * row..];
         let (mut first, mut offset) = (0, 0);
-        while first < levels / BLOCK {
-            let group = GROUP.min(levels / BLOCK - first);
-            let size = group * BLOCK * row;
-            let data = &shapes.data[offset..offset + size];
-            let out_group = &mut pin_levels[..group * BLOCK];
-            if one_block_per_vector {
-                let (group_vectors, _) = S::as_simd_f64s(data);
-                match group {
-                    1 => accumulate_group::<S, 1>(simd, coordinates, group_vectors, out_group),
-                    2 => accumulate_group::<S, 2>(simd, coordinates, group_vectors, out_group),
-                    3 => accumulate_group::<S, 3>(simd, coordinates, group_vectors, out_group),
-                    _ => accumulate_group::<S, GROUP>(simd, coordinates, group_vectors, out_group),
-                }
-            } else {
-                // The SIMD width is not one block (scalar fallback, wider vectors).
-                out_group.fill(0.0);
-                for (x, values) in coordinates.iter().zip(data.chunks_exact(group * BLOCK)) {
-                    for (out, s) in out_group.iter_mut().zip(values) {
-                        *out += x * s;
-                    }
-                }
-            }
-            // Real levels only: the padded ones stay 0.
-            let mut slot = first * BLOCK * stride + 1 + p;
-            for w in &out_group[..out_group.len().min(shapes.level_count - first * BLOCK)] {
-                out[slot] = *w;
-                slot += stride;
+        while first < blocks {
+            let group = GROUP.min(blocks - first);
+            let (shapes, slot) = (&data[offset..], first * stride + 1 + p);
+            let at = Destination { out, slot, stride };
+            match (group, pair) {
+                (1, false) => accumulate::<S, 1, 1>(simd, rows, row, shapes, at),
+                (2, false) => accumulate::<S, 2, 1>(simd, rows, row, shapes, at),
+                (3, false) => accumulate::<S, 3, 1>(simd, rows, row, shapes, at),
+                (_, false) => accumulate::<S, GROUP, 1>(simd, rows, row, shapes, at),
+                (1, true) => accumulate::<S, 1, 2>(simd, rows, row, shapes, at),
+                (2, true) => accumulate::<S, 2, 2>(simd, rows, row, shapes, at),
+                (3, true) => accumulate::<S, 3, 2>(simd, rows, row, shapes, at),
+                (_, true) => accumulate::<S, GROUP, 2>(simd, rows, row, shapes, at),
             }
             first += group;
-            offset += size;
+            offset += group * row;
         }
+        p += if pair { 2 } else { 1 };
     }
 }
 
-/// A run of consecutive contacts whose left and right sides are consecutive slots of
-/// the level-major deflections (a row of pins between two walls is one run per level):
-/// their penetrations are one vector subtraction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) struct Run {
-    pub first_contact: usize,
-    pub len: usize,
-    pub left_slot: usize,
-    pub right_slot: usize,
+/// Where [`accumulate`] stores: `out[slot + r + j·stride]` for pin r of the set and
+/// block j of the group.
+struct Destination<'a, V> {
+    out: &'a mut [V],
+    slot: usize,
+    stride: usize,
 }
 
-impl Run {
-    /// Contacts (left slot, right slot) cut into maximal runs.
-    pub fn split(slots: impl IntoIterator<Item = (usize, usize)>) -> Vec<Run> {
-        let mut runs: Vec<Run> = Vec::new();
-        for (c, (left, right)) in slots.into_iter().enumerate() {
-            match runs.last_mut() {
-                Some(run) if run.left_slot + run.len == left && run.right_slot + run.len == right => {
-                    run.len += 1
-                }
-                _ => runs.push(Run {
-                    first_contact: c,
-                    len: 1,
-                    left_slot: left,
-                    right_slot: right,
-                }),
+/// One group of `G` blocks of `P` consecutive pins' heights (`rows`: their coordinates,
+/// `row` each).
+#[inline(always)]
+fn accumulate<S: Simd, const G: usize, const P: usize>(
+    simd: S,
+    rows: &[f64],
+    row: usize,
+    shapes: &[S::f64s],
+    at: Destination<'_, S::f64s>,
+) {
+    let rows = &rows[..P * row];
+    let shapes = &shapes[..G * row];
+    let mut acc = [[simd.splat_f64s(0.0); G]; P];
+    for i in 0..row {
+        let x: [S::f64s; P] = std::array::from_fn(|r| simd.splat_f64s(rows[r * row + i]));
+        for j in 0..G {
+            let shape = shapes[i * G + j];
+            for r in 0..P {
+                acc[r][j] = simd.mul_add_e_f64s(x[r], shape, acc[r][j]);
             }
         }
-        runs
+    }
+    for (r, blocks) in acc.into_iter().enumerate() {
+        for (j, value) in blocks.into_iter().enumerate() {
+            at.out[at.slot + r + j * at.stride] = value;
+        }
     }
 }
 
-/// Per-contact state that [`penetrations`] updates (all indexed by contact).
+/// The contacts laid out by lanes of the block-major deflections of
+/// [`level_deflections`]: contacts at the heights of one block between the same two
+/// slots share one vector (a group), one lane per height. In a regular bundle a group is
+/// a pair of neighbours at `lanes` consecutive levels, so the penetrations of every
+/// contact are one vector subtraction per group. Lanes without a contact get an
+/// infinite gap and never close.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) struct ContactLanes {
+    lanes: usize,
+    /// Per group: the deflection vector (block·stride + slot) of its left and right body.
+    pub left: Vec<u32>,
+    pub right: Vec<u32>,
+    /// Per lane (group·lanes + k): the contact there, or [`ContactLanes::EMPTY`].
+    pub contact: Vec<u32>,
+    /// Per contact: its lane.
+    pub lane: Vec<u32>,
+}
+
+impl ContactLanes {
+    pub const EMPTY: u32 = u32::MAX;
+
+    /// From each contact's (level, left slot, right slot) in a block-major layout of
+    /// `stride` slots per block.
+    pub fn new(
+        contacts: impl IntoIterator<Item = (usize, usize, usize)>,
+        lanes: usize,
+        stride: usize,
+    ) -> Self {
+        let mut layout = Self {
+            lanes,
+            left: Vec::new(),
+            right: Vec::new(),
+            contact: Vec::new(),
+            lane: Vec::new(),
+        };
+        let mut groups: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+        for (c, (level, left, right)) in contacts.into_iter().enumerate() {
+            let (block, k) = (level / lanes, level % lanes);
+            let vectors = (block * stride + left, block * stride + right);
+            let candidates = groups.entry(vectors).or_default();
+            let group = match candidates
+                .iter()
+                .find(|g| layout.contact[**g * lanes + k] == Self::EMPTY)
+            {
+                Some(g) => *g,
+                None => {
+                    let g = layout.left.len();
+                    layout
+                        .left
+                        .push(u32::try_from(vectors.0).expect("deflection index fits u32"));
+                    layout
+                        .right
+                        .push(u32::try_from(vectors.1).expect("deflection index fits u32"));
+                    layout.contact.resize((g + 1) * lanes, Self::EMPTY);
+                    candidates.push(g);
+                    g
+                }
+            };
+            let lane = group * lanes + k;
+            layout.contact[lane] = u32::try_from(c).expect("contact index fits u32");
+            layout.lane.push(lane as u32);
+        }
+        layout
+    }
+
+    /// Number of lanes (groups × lanes).
+    pub fn len(&self) -> usize {
+        self.contact.len()
+    }
+
+    /// Per-contact values laid out by lane, `fill` in the empty lanes.
+    pub fn by_lane<T: Copy>(&self, per_contact: &[T], fill: T) -> Vec<T> {
+        self.contact
+            .iter()
+            .map(|c| {
+                if *c == Self::EMPTY {
+                    fill
+                } else {
+                    per_contact[*c as usize]
+                }
+            })
+            .collect()
+    }
+
+    /// Lane-ordered values back in contact order.
+    pub fn by_contact<T: Clone>(&self, per_lane: &[T]) -> Vec<T> {
+        self.lane.iter().map(|l| per_lane[*l as usize].clone()).collect()
+    }
+}
+
+/// Per-lane contact state that [`penetrations`] updates.
 pub(super) struct ContactState<'a> {
     /// Penetration δ = w_left − w_right − gap (m) now.
     pub now: &'a mut [f64],
     /// Largest penetration so far.
     pub max: &'a mut [f64],
-    /// Contact force, set to 0 where the contact is open.
-    pub force: &'a mut [f64],
-    /// Receives the contacts closed now, in order.
+    /// Receives the closed lanes, in order.
     pub closed: &'a mut [u32],
+    /// Scratch: the groups with a closed lane (one per group).
+    pub closed_groups: &'a mut [u32],
 }
 
-/// For every contact of every run: its penetration, running maximum, a zero force if it
-/// is open; returns how many contacts are closed (listed first in `state.closed`).
+/// For every group: penetrations and running maxima; returns how many lanes are closed
+/// (listed first in `state.closed`). `gaps` are per lane. Forces are left alone: a
+/// masked store of zeros where open would cost more (microcoded on some CPUs) than
+/// reading a force only where the penetration is positive.
 #[inline(always)]
 pub(super) fn penetrations<S: Simd>(
     simd: S,
-    runs: &[Run],
-    deflections: &[f64],
+    layout: &ContactLanes,
+    deflections: &[S::f64s],
     gaps: &[f64],
     state: ContactState<'_>,
 ) -> usize {
-    let zero = simd.splat_f64s(0.0);
-    let lanes = std::mem::size_of::<S::f64s>() / std::mem::size_of::<f64>();
+    let groups = layout.left.len();
+    let (gaps, _) = S::as_simd_f64s(gaps);
+    let (now, _) = S::as_mut_simd_f64s(state.now);
+    let (max, _) = S::as_mut_simd_f64s(state.max);
+    let (left, right) = (&layout.left[..groups], &layout.right[..groups]);
+    let (gaps, now, max) = (&gaps[..groups], &mut now[..groups], &mut max[..groups]);
+    let closed_groups = &mut state.closed_groups[..groups];
+    let mut any = 0;
+    for g in 0..groups {
+        let n = simd.sub_f64s(
+            simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize]),
+            gaps[g],
+        );
+        now[g] = n;
+        max[g] = simd.max_f64s(max[g], n);
+        // Most groups hold no closed contact: one test each, no branch.
+        closed_groups[any] = g as u32;
+        any += usize::from(simd.reduce_max_f64s(n) > 0.0);
+    }
+    let lanes = layout.lanes;
     let mut count = 0;
-    for run in runs {
-        let contacts = run.first_contact..run.first_contact + run.len;
-        let left = &deflections[run.left_slot..run.left_slot + run.len];
-        let right = &deflections[run.right_slot..run.right_slot + run.len];
-        let (l_head, l_tail) = S::as_simd_f64s(left);
-        let (r_head, r_tail) = S::as_simd_f64s(right);
-        let (g_head, g_tail) = S::as_simd_f64s(&gaps[contacts.clone()]);
-        let (n_head, n_tail) = S::as_mut_simd_f64s(&mut state.now[contacts.clone()]);
-        let (m_head, m_tail) = S::as_mut_simd_f64s(&mut state.max[contacts.clone()]);
-        let (f_head, f_tail) = S::as_mut_simd_f64s(&mut state.force[contacts.clone()]);
-        for (((((l, r), g), n), m), f) in l_head
-            .iter()
-            .zip(r_head)
-            .zip(g_head)
-            .zip(n_head)
-            .zip(m_head)
-            .zip(f_head)
-        {
-            *n = simd.sub_f64s(simd.sub_f64s(*l, *r), *g);
-            *m = simd.max_f64s(*m, *n);
-            *f = simd.select_f64s(simd.greater_than_f64s(*n, zero), *f, zero);
-        }
-        for (((((l, r), g), n), m), f) in l_tail
-            .iter()
-            .zip(r_tail)
-            .zip(g_tail)
-            .zip(n_tail)
-            .zip(m_tail)
-            .zip(f_tail)
-        {
-            *n = l - r - g;
-            *m = m.max(*n);
-            if *n <= 0.0 {
-                *f = 0.0;
-            }
-        }
-        // Closed contacts: most vectors of a run hold none, one test each.
-        let now = &state.now[contacts];
-        let (n_head, _) = S::as_simd_f64s(now);
-        for (j, n) in n_head.iter().enumerate() {
-            if simd.reduce_max_f64s(*n) > 0.0 {
-                for k in j * lanes..(j + 1) * lanes {
-                    state.closed[count] = (run.first_contact + k) as u32;
-                    count += usize::from(now[k] > 0.0);
-                }
-            }
-        }
-        for (k, n) in now.iter().enumerate().skip(n_head.len() * lanes) {
-            state.closed[count] = (run.first_contact + k) as u32;
-            count += usize::from(*n > 0.0);
+    for &g in &closed_groups[..any] {
+        for lane in g as usize * lanes..(g as usize + 1) * lanes {
+            state.closed[count] = lane as u32;
+            count += usize::from(state.now[lane] > 0.0);
         }
     }
     count
 }
 
-/// One group of `G` blocks of one pin's levels.
+/// ½ Σ (v² + ωᵢ² q²) over every pin (`stiffness` = ωᵢ² per mode: one row of vectors).
 #[inline(always)]
-fn accumulate_group<S: Simd, const G: usize>(
-    simd: S,
-    coordinates: &[f64],
-    shapes: &[S::f64s],
-    out: &mut [f64],
-) {
-    let mut acc = [simd.splat_f64s(0.0); G];
-    for (x, vectors) in coordinates.iter().zip(shapes.chunks_exact(G)) {
-        let x = simd.splat_f64s(*x);
-        for j in 0..G {
-            acc[j] = simd.mul_add_e_f64s(x, vectors[j], acc[j]);
-        }
-    }
-    let (out_vectors, _) = S::as_mut_simd_f64s(out);
-    out_vectors.copy_from_slice(&acc);
-}
-
-/// ½ Σ (v² + ωᵢ² q²) over every pin (`stiffness` = ωᵢ² per mode, one row).
-#[inline(always)]
-pub(super) fn modal_energy<S: Simd>(simd: S, stiffness: &[f64], q: &[f64], v: &[f64]) -> f64 {
-    let row = stiffness.len();
-    let (k_head, k_tail) = S::as_simd_f64s(stiffness);
+pub(super) fn modal_energy<S: Simd>(simd: S, stiffness: &[S::f64s], q: &[S::f64s], v: &[S::f64s]) -> f64 {
+    let n = stiffness.len();
     let mut acc = simd.splat_f64s(0.0);
-    let mut tail = 0.0;
-    for (q, v) in q.chunks_exact(row).zip(v.chunks_exact(row)) {
-        let (q_head, q_tail) = S::as_simd_f64s(q);
-        let (v_head, v_tail) = S::as_simd_f64s(v);
-        for ((q, v), k) in q_head.iter().zip(v_head).zip(k_head) {
-            acc = simd.mul_add_e_f64s(*v, *v, acc);
-            acc = simd.mul_add_e_f64s(simd.mul_f64s(*k, *q), *q, acc);
-        }
-        for ((q, v), k) in q_tail.iter().zip(v_tail).zip(k_tail) {
-            tail += v * v + k * q * q;
+    for (q, v) in q.chunks_exact(n).zip(v.chunks_exact(n)) {
+        for k in 0..n {
+            acc = simd.mul_add_e_f64s(v[k], v[k], acc);
+            acc = simd.mul_add_e_f64s(simd.mul_f64s(stiffness[k], q[k]), q[k], acc);
         }
     }
-    0.5 * (simd.reduce_sum_f64s(acc) + tail)
+    0.5 * simd.reduce_sum_f64s(acc)
 }
 
-/// Per-mode coefficients of the modal update (each padded to the row length).
-pub(super) struct ModalCoefficients<'a> {
+/// Per-mode coefficients of the modal update (each one row of vectors).
+pub(super) struct ModalCoefficients<'a, S: Simd> {
     /// ωᵢ².
-    pub stiffness: &'a [f64],
+    pub stiffness: &'a [S::f64s],
     /// 2ξᵢωᵢ.
-    pub damping: &'a [f64],
+    pub damping: &'a [S::f64s],
     /// Central difference: 1/(1 + ξᵢωᵢΔt); Tchamwa: 1.
-    pub factor: &'a [f64],
+    pub factor: &'a [S::f64s],
     /// Γᵢ.
-    pub participation: &'a [f64],
+    pub participation: &'a [S::f64s],
 }
 
 /// Sums the modal update accumulates: Σ 2ξω v² and Σ Γ v over every pin and mode.
@@ -344,114 +395,90 @@ pub(super) struct UpdateSums {
     pub participation_velocity: f64,
 }
 
-/// a = (f − ω² q − 2ξω v)·factor, then v += `half_step`·a (0 for Tchamwa, whose velocity
-/// was advanced before the forces), row by row; returns the power sums at the new v.
+/// q, v, a and the loads f of every pin, as [`modal_update`] reads and writes them.
+pub(super) type ModalState<'a, V> = (&'a [V], &'a mut [V], &'a mut [V], &'a mut [V]);
+
+/// Accumulators of the power sums (independent dependency chains).
+const SUMS: usize = 4;
+
+/// With f the contact and point loads: a = (f − Γ·base − ω² q − 2ξω v)·factor, then
+/// v += `half_step`·a (0 for Tchamwa, whose velocity was advanced before the forces),
+/// and f is zeroed for the next step; returns the power sums at the new v.
 #[inline(always)]
 pub(super) fn modal_update<S: Simd>(
     simd: S,
-    coefficients: &ModalCoefficients<'_>,
+    coefficients: &ModalCoefficients<'_, S>,
+    base: f64,
     half_step: f64,
-    (q, v, a, f): (&[f64], &mut [f64], &mut [f64], &[f64]),
+    (q, v, a, f): ModalState<'_, S::f64s>,
 ) -> UpdateSums {
-    let row = coefficients.stiffness.len();
-    let (k_head, k_tail) = S::as_simd_f64s(coefficients.stiffness);
-    let (c_head, c_tail) = S::as_simd_f64s(coefficients.damping);
-    let (x_head, x_tail) = S::as_simd_f64s(coefficients.factor);
-    let (g_head, g_tail) = S::as_simd_f64s(coefficients.participation);
-    let half = simd.splat_f64s(half_step);
-    let mut damping_power = simd.splat_f64s(0.0);
-    let mut participation_velocity = simd.splat_f64s(0.0);
-    let mut tail_sums = UpdateSums::default();
+    let n = coefficients.stiffness.len();
+    let (k, c) = (coefficients.stiffness, &coefficients.damping[..n]);
+    let (x, g) = (&coefficients.factor[..n], &coefficients.participation[..n]);
+    let (half, load, zero) = (
+        simd.splat_f64s(half_step),
+        simd.splat_f64s(-base),
+        simd.splat_f64s(0.0),
+    );
+    let mut damping_power = [zero; SUMS];
+    let mut participation_velocity = [zero; SUMS];
     for (((q, v), a), f) in q
-        .chunks_exact(row)
-        .zip(v.chunks_exact_mut(row))
-        .zip(a.chunks_exact_mut(row))
-        .zip(f.chunks_exact(row))
+        .chunks_exact(n)
+        .zip(v.chunks_exact_mut(n))
+        .zip(a.chunks_exact_mut(n))
+        .zip(f.chunks_exact_mut(n))
     {
-        let (q_head, q_tail) = S::as_simd_f64s(q);
-        let (v_head, v_tail) = S::as_mut_simd_f64s(v);
-        let (a_head, a_tail) = S::as_mut_simd_f64s(a);
-        let (f_head, f_tail) = S::as_simd_f64s(f);
-        for (((((q, v), a), f), (k, c)), (x, g)) in q_head
-            .iter()
-            .zip(v_head.iter_mut())
-            .zip(a_head.iter_mut())
-            .zip(f_head)
-            .zip(k_head.iter().zip(c_head))
-            .zip(x_head.iter().zip(g_head))
-        {
-            let elastic = simd.mul_f64s(*k, *q);
-            let viscous = simd.mul_f64s(*c, *v);
-            *a = simd.mul_f64s(simd.sub_f64s(simd.sub_f64s(*f, elastic), viscous), *x);
-            *v = simd.mul_add_e_f64s(half, *a, *v);
-            damping_power = simd.mul_add_e_f64s(simd.mul_f64s(*c, *v), *v, damping_power);
-            participation_velocity = simd.mul_add_e_f64s(*g, *v, participation_velocity);
-        }
-        for (((((q, v), a), f), (k, c)), (x, g)) in q_tail
-            .iter()
-            .zip(v_tail.iter_mut())
-            .zip(a_tail.iter_mut())
-            .zip(f_tail)
-            .zip(k_tail.iter().zip(c_tail))
-            .zip(x_tail.iter().zip(g_tail))
-        {
-            *a = (f - k * q - c * *v) * x;
-            *v += half_step * *a;
-            tail_sums.damping_power += c * *v * *v;
-            tail_sums.participation_velocity += g * *v;
+        for i in 0..n {
+            let force = simd.mul_add_e_f64s(load, g[i], f[i]);
+            f[i] = zero;
+            let elastic = simd.mul_f64s(k[i], q[i]);
+            let viscous = simd.mul_f64s(c[i], v[i]);
+            a[i] = simd.mul_f64s(simd.sub_f64s(simd.sub_f64s(force, elastic), viscous), x[i]);
+            v[i] = simd.mul_add_e_f64s(half, a[i], v[i]);
+            let s = i % SUMS;
+            damping_power[s] = simd.mul_add_e_f64s(simd.mul_f64s(c[i], v[i]), v[i], damping_power[s]);
+            participation_velocity[s] = simd.mul_add_e_f64s(g[i], v[i], participation_velocity[s]);
         }
     }
     UpdateSums {
-        damping_power: simd.reduce_sum_f64s(damping_power) + tail_sums.damping_power,
-        participation_velocity: simd.reduce_sum_f64s(participation_velocity)
-            + tail_sums.participation_velocity,
+        damping_power: total(simd, damping_power),
+        participation_velocity: total(simd, participation_velocity),
     }
 }
 
-/// First half of a step over the whole state. Central difference (`curvature` = 0):
-/// v += ½Δt a, q += Δt v. Tchamwa (`half_step` = Δt, `curvature` = φΔt²):
-/// q += Δt v + φΔt² a, then v += Δt a.
+/// Σ of the lanes of [`SUMS`] accumulators, pairwise.
+#[inline(always)]
+fn total<S: Simd>(simd: S, sums: [S::f64s; SUMS]) -> f64 {
+    let pairs = [simd.add_f64s(sums[0], sums[1]), simd.add_f64s(sums[2], sums[3])];
+    simd.reduce_sum_f64s(simd.add_f64s(pairs[0], pairs[1]))
+}
+
+/// First half of a step over the whole state: q += Δt v + `curvature`·a, then
+/// v += `half_step`·a. Central difference: half_step = ½Δt and curvature = ½Δt², so
+/// that q ends at qₙ + Δt v½; Tchamwa: half_step = Δt, curvature = φΔt².
 #[inline(always)]
 pub(super) fn advance_positions<S: Simd>(
     simd: S,
     (dt, half_step, curvature): (f64, f64, f64),
-    q: &mut [f64],
-    v: &mut [f64],
-    a: &[f64],
+    q: &mut [S::f64s],
+    v: &mut [S::f64s],
+    a: &[S::f64s],
 ) {
-    let (q_head, q_tail) = S::as_mut_simd_f64s(q);
-    let (v_head, v_tail) = S::as_mut_simd_f64s(v);
-    let (a_head, a_tail) = S::as_simd_f64s(a);
     let (step, half, curve) = (
         simd.splat_f64s(dt),
         simd.splat_f64s(half_step),
         simd.splat_f64s(curvature),
     );
-    if curvature == 0.0 {
-        for ((q, v), a) in q_head.iter_mut().zip(v_head.iter_mut()).zip(a_head) {
-            *v = simd.mul_add_e_f64s(half, *a, *v);
-            *q = simd.mul_add_e_f64s(step, *v, *q);
-        }
-        for ((q, v), a) in q_tail.iter_mut().zip(v_tail.iter_mut()).zip(a_tail) {
-            *v += half_step * a;
-            *q += dt * *v;
-        }
-    } else {
-        for ((q, v), a) in q_head.iter_mut().zip(v_head.iter_mut()).zip(a_head) {
-            *q = simd.mul_add_e_f64s(curve, *a, simd.mul_add_e_f64s(step, *v, *q));
-            *v = simd.mul_add_e_f64s(half, *a, *v);
-        }
-        for ((q, v), a) in q_tail.iter_mut().zip(v_tail.iter_mut()).zip(a_tail) {
-            *q += dt * *v + curvature * a;
-            *v += half_step * a;
-        }
+    for ((q, v), a) in q.iter_mut().zip(v.iter_mut()).zip(a) {
+        *q = simd.mul_add_e_f64s(curve, *a, simd.mul_add_e_f64s(step, *v, *q));
+        *v = simd.mul_add_e_f64s(half, *a, *v);
     }
 }
 
 #[cfg(test)]
 mod tests {
     //! Every kernel against its plain formula, on the SIMD level of this CPU and on the
-    //! scalar fallback (which also covers the tail loops and the non-vector branch).
+    //! scalar fallback (one lane per vector, so other layouts of the same contacts).
 
     use super::*;
 
@@ -473,80 +500,114 @@ mod tests {
         }
     }
 
+    /// `values` as SIMD vectors (its length is a whole number of vectors).
+    fn vectors<S: Simd>(values: &[f64]) -> &[S::f64s] {
+        let (head, tail) = S::as_simd_f64s(values);
+        assert!(tail.is_empty());
+        head
+    }
+
     fn check<S: Simd>(simd: S) {
-        let (pins, row) = (3, 8);
+        let lanes = lanes::<S>();
+        let (pins, row) = (3, 2 * lanes.max(4));
         let (x, y, z) = (values(row, 0.7), values(row, 1.3), values(row, 2.9));
         let plain: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
-        assert!(close(dot(simd, &x, &y), plain));
-        let ahead: f64 = (0..row).map(|i| x[i] * (y[i] + 0.25 * z[i])).sum();
-        assert!(close(dot_ahead(simd, &x, &y, &z, 0.25), ahead));
+        assert!(close(
+            dot(simd, &x[..row - 1], &y[..row - 1]),
+            plain - x[row - 1] * y[row - 1]
+        ));
+        let u = values(row, 3.1);
+        let rate: f64 = (0..row)
+            .map(|i| x[i] * ((y[i] - u[i]) + 0.25 * (z[i] - x[i])))
+            .sum();
+        let (left, right) = (
+            (vectors::<S>(&y), vectors::<S>(&z)),
+            (vectors::<S>(&u), vectors::<S>(&x)),
+        );
+        assert!(close(
+            penetration_rate(simd, vectors::<S>(&x), left, right, 0.25),
+            rate
+        ));
         let mut w = z.clone();
-        axpy(simd, -1.5, &x, &mut w);
-        assert!((0..row).all(|i| close(w[i], z[i] - 1.5 * x[i])));
-        scale_into(simd, 2.0, &x, &mut w);
-        assert!((0..row).all(|i| close(w[i], 2.0 * x[i])));
+        axpy(simd, -1.5, &x[..row - 1], &mut w[..row - 1]);
+        assert!((0..row - 1).all(|i| close(w[i], z[i] - 1.5 * x[i])) && w[row - 1] == z[row - 1]);
+        let mut w = z.clone();
+        row_axpy(simd, 2.0, vectors::<S>(&x), S::as_mut_simd_f64s(&mut w).0);
+        assert!((0..row).all(|i| close(w[i], z[i] + 2.0 * x[i])));
 
-        // 9 levels: three blocks, the last one padded.
-        for level_count in [1, 4, 9, 21] {
-            let shapes = values(level_count * row, 0.37);
+        // Heights in 1 to 6 blocks: groups of every size, the last block padded.
+        for count in [1, 4, 9, 21] {
+            let shapes = values(count * row, 0.37);
             let q = values(pins * row, 0.53);
-            let grouped = LevelShapes::new(&shapes, row);
+            let grouped = LevelShapes::new(&shapes, row, lanes);
             let stride = pins + 2;
-            let mut out = vec![0.0; stride * grouped.levels];
-            level_deflections(simd, &grouped, row, &q, &mut out);
-            for l in 0..grouped.levels {
-                assert!(
-                    out[l * stride] == 0.0 && out[l * stride + pins + 1] == 0.0,
-                    "wall slots stay 0"
-                );
-            }
-            for p in 0..pins {
-                for l in 0..grouped.levels {
-                    let expected = if l < level_count {
+            let mut out = vec![7.0; stride * grouped.blocks * lanes];
+            level_deflections(simd, &grouped, row, &q, S::as_mut_simd_f64s(&mut out).0, stride);
+            for l in 0..grouped.blocks * lanes {
+                let at = |slot: usize| out[((l / lanes) * stride + slot) * lanes + l % lanes];
+                assert!(at(0) == 7.0 && at(pins + 1) == 7.0, "wall slots are left alone");
+                for p in 0..pins {
+                    let expected = if l < count {
                         (0..row).map(|i| shapes[l * row + i] * q[p * row + i]).sum()
                     } else {
                         0.0
                     };
-                    assert!(close(out[l * stride + 1 + p], expected), "level {l} of pin {p}");
+                    assert!(close(at(1 + p), expected), "level {l} of pin {p}");
                 }
             }
         }
 
-        // Two runs (4 + 7 contacts, one run with a tail) and a lone contact.
-        let slots: Vec<(usize, usize)> = (0..4)
-            .map(|k| (k, k + 1))
-            .chain((0..7).map(|k| (20 + k, 10 + k)))
-            .chain([(3, 3)])
+        // Contacts (level, left slot, right slot) in 3 blocks of a 5-slot layout: a row of
+        // neighbours at 6 levels, a lone wall contact, and two contacts on the same slots
+        // and level (they cannot share a lane).
+        let stride = 5;
+        let contacts: Vec<(usize, usize, usize)> = (0..6)
+            .flat_map(|level| (0..4).map(move |s| (level, s, s + 1)))
+            .chain([(9, 0, 2), (1, 1, 2)])
             .collect();
-        let runs = Run::split(slots.iter().copied());
-        assert_eq!(runs.len(), 3);
-        let deflections = values(40, 0.61);
-        let gaps = values(slots.len(), 0.67);
-        let contacts = slots.len();
-        let (mut now, mut max) = (vec![0.0; contacts], vec![0.2; contacts]);
-        let (mut force, mut closed) = (vec![1.0; contacts], vec![0; contacts]);
+        let layout = ContactLanes::new(contacts.iter().copied(), lanes, stride);
+        assert_eq!(
+            layout.by_contact(&layout.contact),
+            (0..contacts.len() as u32).collect::<Vec<_>>()
+        );
+        let groups = layout.left.len();
+        assert_eq!(layout.len(), groups * lanes);
+        if lanes == 4 {
+            // 4 pairs in the blocks of levels 0–3 and 4–5, the lone one, the duplicate.
+            assert_eq!(groups, 10);
+        }
+        let blocks = 10usize.div_ceil(lanes);
+        let deflections = values(blocks * stride * lanes, 0.61);
+        let gaps_by_contact = values(contacts.len(), 0.67);
+        let gaps = layout.by_lane(&gaps_by_contact, f64::INFINITY);
+        let lanes_total = layout.len();
+        let (mut now, mut max) = (vec![0.0; lanes_total], vec![0.2; lanes_total]);
+        let mut closed = vec![0; lanes_total];
+        let mut closed_groups = vec![0; groups];
         let count = penetrations(
             simd,
-            &runs,
-            &deflections,
+            &layout,
+            vectors::<S>(&deflections),
             &gaps,
             ContactState {
                 now: &mut now,
                 max: &mut max,
-                force: &mut force,
                 closed: &mut closed,
+                closed_groups: &mut closed_groups,
             },
         );
         let mut expected_closed = Vec::new();
-        for (c, (left, right)) in slots.iter().enumerate() {
-            let expected = deflections[*left] - deflections[*right] - gaps[c];
-            assert!(close(now[c], expected) && max[c] == expected.max(0.2));
-            assert_eq!(force[c], if expected > 0.0 { 1.0 } else { 0.0 });
+        for (c, (level, left, right)) in contacts.iter().enumerate() {
+            let w = |slot: usize| deflections[((level / lanes) * stride + slot) * lanes + level % lanes];
+            let expected = w(*left) - w(*right) - gaps_by_contact[c];
+            let lane = layout.lane[c] as usize;
+            assert!(close(now[lane], expected) && max[lane] == expected.max(0.2));
             if expected > 0.0 {
-                expected_closed.push(c as u32);
+                expected_closed.push(lane as u32);
             }
         }
-        assert!(!expected_closed.is_empty() && expected_closed.len() < contacts);
+        expected_closed.sort_unstable();
+        assert!(!expected_closed.is_empty() && expected_closed.len() < contacts.len());
         assert_eq!(closed[..count], expected_closed[..]);
 
         let (stiffness, damping, factor, participation) = (
@@ -555,44 +616,60 @@ mod tests {
             values(row, 0.19),
             values(row, 0.23),
         );
-        let coefficients = ModalCoefficients {
-            stiffness: &stiffness,
-            damping: &damping,
-            factor: &factor,
-            participation: &participation,
+        let coefficients = ModalCoefficients::<S> {
+            stiffness: vectors::<S>(&stiffness),
+            damping: vectors::<S>(&damping),
+            factor: vectors::<S>(&factor),
+            participation: vectors::<S>(&participation),
         };
-        let (q, f) = (values(pins * row, 0.29), values(pins * row, 0.31));
-        let (mut v, mut a) = (values(pins * row, 0.41), vec![0.0; pins * row]);
+        let (q, f0) = (values(pins * row, 0.29), values(pins * row, 0.31));
+        let (mut v, mut a, mut f) = (values(pins * row, 0.41), vec![0.0; pins * row], f0.clone());
         let v0 = v.clone();
-        let sums = modal_update(simd, &coefficients, 0.5, (&q, &mut v, &mut a, &f));
+        let sums = modal_update(
+            simd,
+            &coefficients,
+            0.7,
+            0.5,
+            (
+                vectors::<S>(&q),
+                S::as_mut_simd_f64s(&mut v).0,
+                S::as_mut_simd_f64s(&mut a).0,
+                S::as_mut_simd_f64s(&mut f).0,
+            ),
+        );
         let (mut damping_power, mut participation_velocity) = (0.0, 0.0);
         for k in 0..pins * row {
             let i = k % row;
-            let acceleration = (f[k] - stiffness[i] * q[k] - damping[i] * v0[k]) * factor[i];
+            let load = f0[k] - 0.7 * participation[i];
+            let acceleration = (load - stiffness[i] * q[k] - damping[i] * v0[k]) * factor[i];
             let velocity = v0[k] + 0.5 * acceleration;
-            assert!(close(a[k], acceleration) && close(v[k], velocity));
+            assert!(close(a[k], acceleration) && close(v[k], velocity) && f[k] == 0.0);
             damping_power += damping[i] * velocity * velocity;
             participation_velocity += participation[i] * velocity;
         }
         assert!(close(sums.damping_power, damping_power));
+        assert!(close(sums.participation_velocity, participation_velocity));
         let energy: f64 = (0..pins * row)
             .map(|k| 0.5 * (v[k] * v[k] + stiffness[k % row] * q[k] * q[k]))
             .sum();
-        assert!(close(modal_energy(simd, &stiffness, &q, &v), energy));
-        assert!(close(sums.participation_velocity, participation_velocity));
+        assert!(close(
+            modal_energy(simd, vectors::<S>(&stiffness), vectors::<S>(&q), vectors::<S>(&v)),
+            energy
+        ));
 
-        for (half, curvature) in [(0.5, 0.0), (1.0, 0.3)] {
-            let (mut q, mut v, a) = (values(10, 0.43), values(10, 0.47), values(10, 0.59));
+        for (half, curvature) in [(0.5, 0.25), (1.0, 0.3)] {
+            let (mut q, mut v, a) = (values(row, 0.43), values(row, 0.47), values(row, 0.59));
             let (q0, v0) = (q.clone(), v.clone());
-            advance_positions(simd, (1.0, half, curvature), &mut q, &mut v, &a);
-            for k in 0..10 {
-                let (position, velocity) = if curvature == 0.0 {
-                    let velocity = v0[k] + half * a[k];
-                    (q0[k] + velocity, velocity)
-                } else {
-                    (q0[k] + v0[k] + curvature * a[k], v0[k] + half * a[k])
-                };
-                assert!(close(q[k], position) && close(v[k], velocity));
+            advance_positions(
+                simd,
+                (0.9, half, curvature),
+                S::as_mut_simd_f64s(&mut q).0,
+                S::as_mut_simd_f64s(&mut v).0,
+                vectors::<S>(&a),
+            );
+            for k in 0..row {
+                assert!(close(q[k], q0[k] + 0.9 * v0[k] + curvature * a[k]));
+                assert!(close(v[k], v0[k] + half * a[k]));
             }
         }
     }

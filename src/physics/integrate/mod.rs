@@ -162,6 +162,19 @@ fn simulate_unchecked(
     integrate_with_step(model, settings, dt, f64::NAN, &mut |_| ControlFlow::Continue(()))
 }
 
+/// [`simulate`] at the SIMD level `arch` (tests compare the vector and scalar layouts).
+#[cfg(test)]
+fn simulate_on(
+    arch: pulp::Arch,
+    model: &Model<'_>,
+    settings: &Settings,
+) -> Result<Simulation, SimulationError> {
+    let (dt, critical) = resolve_time_step(model, settings)?;
+    integrate_on(arch, model, settings, (dt, critical), &mut |_| {
+        ControlFlow::Continue(())
+    })
+}
+
 /// Integrates with a step already resolved by [`resolve_time_step`] (`dt`, `critical`):
 /// callers that validated the step first need not solve the stability eigenproblem twice.
 pub fn simulate_resolved(
@@ -196,7 +209,18 @@ fn integrate_with_step(
     critical: f64,
     progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
 ) -> Result<Simulation, SimulationError> {
-    let mut run = Integrator::new(model, settings, dt, critical);
+    integrate_on(pulp::Arch::new(), model, settings, (dt, critical), progress)
+}
+
+/// The time loop, with the step compiled for the SIMD level `arch`.
+fn integrate_on(
+    arch: pulp::Arch,
+    model: &Model<'_>,
+    settings: &Settings,
+    (dt, critical): (f64, f64),
+    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+) -> Result<Simulation, SimulationError> {
+    let mut run = Integrator::new(arch, model, settings, (dt, critical));
     let (total_steps, output_every) = step_counts(settings.duration, dt, settings.output_interval);
     run.record_sample(0.0);
     for n in 1..=total_steps {

@@ -26,8 +26,8 @@
 use pulp::Simd;
 
 use super::kernels::{
-    self, BLOCK, ContactState, LevelShapes, ModalCoefficients, Run, advance_positions, axpy, dot_ahead,
-    level_deflections, modal_update, penetrations, scale_into,
+    self, ContactLanes, ContactState, Lanes, LevelShapes, ModalCoefficients, advance_positions, axpy, lanes,
+    level_deflections, modal_update, penetration_rate, penetrations, row_axpy,
 };
 use super::{ContactStatistics, EnergyBalance, Model, PinExtreme, Settings, Simulation, SimulationError};
 use crate::physics::contact::Body;
@@ -38,7 +38,7 @@ fn dot(x: &[f64], y: &[f64]) -> f64 {
     kernels::dot(pulp::Scalar::new(), x, y)
 }
 
-/// Sentinel pin index of a wall (for force projection; reads use the zero slot).
+/// Pin index of a wall in the contact list (its state row is set when the pins are known).
 const WALL: usize = usize::MAX;
 
 pub(super) struct Integrator<'m> {
@@ -46,9 +46,12 @@ pub(super) struct Integrator<'m> {
     model: &'m Model<'m>,
     scheme: Scheme,
     dt: f64,
-    /// Length of one pin's row: the modes rounded up to whole blocks.
+    /// f64 values per SIMD vector of `arch`.
+    lanes: usize,
+    /// Length of one pin's row: the modes rounded up to whole vectors.
     row: usize,
-    pins: usize,
+    /// Slots per block of the block-major deflections: `[wall, pin 0, …, pin n−1, wall]`.
+    stride: usize,
     /// Per mode (padded to `row`): ωᵢ², 2ξᵢωᵢ, and for central difference 1/(1 + ξᵢωᵢΔt).
     omega_squared: Vec<f64>,
     damping: Vec<f64>,
@@ -62,24 +65,26 @@ pub(super) struct Integrator<'m> {
     /// [`level_deflections`].
     level_shapes: Vec<f64>,
     grouped_level_shapes: LevelShapes,
-    /// Per contact: level, left and right pin (WALL for a wall).
-    contact_level: Vec<usize>,
-    contact_left: Vec<usize>,
-    contact_right: Vec<usize>,
-    /// The contacts cut in runs of consecutive slots of `level_deflections`.
-    runs: Vec<Run>,
+    /// The contacts by lanes of the level deflections; everything below that is per
+    /// contact is stored by lane (see [`ContactLanes`]).
+    layout: ContactLanes,
+    /// Per lane: what a closed contact needs, and the gap (∞ in empty lanes).
+    lane_contacts: Vec<LaneContact>,
     gaps: Vec<f64>,
-    /// Per contact: penetration now, a step ago (the two buffers swap every step) and
+    /// Offset (in vectors) of the row of zeros after the pins' rows in `v` and `a`,
+    /// read for a wall.
+    wall_row: usize,
+    /// Per lane: penetration now, a step ago (the two buffers swap every step) and
     /// largest so far.
     penetration: Vec<f64>,
     previous_penetration: Vec<f64>,
     max_penetration: Vec<f64>,
-    /// Scratch: the contacts closed now (the only ones that need more than a penetration).
+    /// Scratch: the lanes closed now (the only ones that need more than a penetration),
+    /// and the groups holding them.
     closed: Vec<u32>,
-    /// Base acceleration at the current step (m/s²).
-    base_now: f64,
-    /// w of every pin at every level (`levels × (pins + 2)`, level by level with a zero
-    /// slot for a wall on each side: `[wall, pin 0, …, pin n−1, wall]`).
+    closed_groups: Vec<u32>,
+    /// w of every pin at every level, block-major (see [`level_deflections`]); the wall
+    /// slots stay 0.
     level_deflections: Vec<f64>,
     /// ψ at each point force's and each output height (padded to `row`).
     point_force_shapes: Vec<Vec<f64>>,
@@ -88,11 +93,14 @@ pub(super) struct Integrator<'m> {
     /// every pin at the last sample (laid out as `level_deflections`).
     node_shapes: LevelShapes,
     node_deflections: Vec<f64>,
-    /// Pin-major state (`pins × row`): coordinates, velocities, accelerations, loads.
+    /// Pin-major state (`pins × row`): coordinates, velocities, accelerations, and the
+    /// contact and point loads of the step (zeroed by the modal update). `v` and `a`
+    /// have one more row, of zeros, for the walls.
     q: Vec<f64>,
     v: Vec<f64>,
     a: Vec<f64>,
     force: Vec<f64>,
+    /// Per lane; only meaningful where the penetration is positive (see [`penetrations`]).
     contact_force: Vec<f64>,
     statistics: Vec<ContactStatistics>,
     energy: EnergyBalance,
@@ -103,6 +111,7 @@ pub(super) struct Integrator<'m> {
     external_work_peak: f64,
     time: Vec<f64>,
     deflections: Vec<Vec<Vec<f64>>>,
+    /// Per contact (not by lane).
     contact_forces: Vec<Vec<f64>>,
     mechanical_energy: Vec<f64>,
     pin_extremes: Vec<PinExtreme>,
@@ -111,7 +120,7 @@ pub(super) struct Integrator<'m> {
 /// What [`StepOp`] does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Operation {
-    /// The forces at t = 0.
+    /// The contact and point forces at t = 0.
     Initial,
     /// One step.
     Step,
@@ -133,17 +142,32 @@ impl pulp::WithSimd for StepOp<'_, '_> {
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
         let integrator = self.integrator;
+        let vectors = integrator.row / lanes::<S>();
+        debug_assert_eq!(integrator.lanes, lanes::<S>());
         match self.operation {
             Operation::Initial => {
-                integrator.contact_forces_and_statistics(simd, self.t, false);
+                integrator.contact_forces_and_statistics(simd, self.t, false, vectors);
             }
-            Operation::Step => integrator.step_body(simd, self.t),
+            // The usual row lengths get a copy of the step where the row length is a
+            // constant: every per-row loop is then unrolled, without bounds checks.
+            Operation::Step => match vectors {
+                1 => integrator.step_body(simd, self.t, 1),
+                2 => integrator.step_body(simd, self.t, 2),
+                3 => integrator.step_body(simd, self.t, 3),
+                4 => integrator.step_body(simd, self.t, 4),
+                5 => integrator.step_body(simd, self.t, 5),
+                6 => integrator.step_body(simd, self.t, 6),
+                7 => integrator.step_body(simd, self.t, 7),
+                8 => integrator.step_body(simd, self.t, 8),
+                _ => integrator.step_body(simd, self.t, vectors),
+            },
             Operation::NodeDeflections => level_deflections(
                 simd,
                 &integrator.node_shapes,
                 integrator.row,
                 &integrator.q,
-                &mut integrator.node_deflections,
+                S::as_mut_simd_f64s(&mut integrator.node_deflections).0,
+                integrator.stride,
             ),
         }
     }
@@ -161,8 +185,27 @@ impl pulp::WithSimd for ModalEnergyOp<'_> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) -> f64 {
-        kernels::modal_energy(simd, self.stiffness, self.q, self.v)
+        kernels::modal_energy(
+            simd,
+            S::as_simd_f64s(self.stiffness).0,
+            S::as_simd_f64s(self.q).0,
+            S::as_simd_f64s(self.v).0,
+        )
     }
+}
+
+/// A contact as its lane needs it; offsets are in SIMD vectors.
+#[derive(Debug, Clone, Copy, Default)]
+struct LaneContact {
+    stiffness: f64,
+    dashpot: f64,
+    /// Offset of ψ at the contact's level in `level_shapes`.
+    shape: usize,
+    /// Offsets of the left and right body's rows in the state (`wall_row` for a wall).
+    left: usize,
+    right: usize,
+    /// Whether it can push at all (stiffness or dashpot > 0): only those count impacts.
+    active: bool,
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -172,7 +215,7 @@ struct Powers {
     external: f64,
 }
 
-/// `values` followed by zeros up to `row`.
+/// `values` followed by `fill` up to `row`.
 fn padded(values: &[f64], row: usize, fill: f64) -> Vec<f64> {
     let mut out = values.to_vec();
     out.resize(row, fill);
@@ -180,10 +223,17 @@ fn padded(values: &[f64], row: usize, fill: f64) -> Vec<f64> {
 }
 
 impl<'m> Integrator<'m> {
-    pub(super) fn new(model: &'m Model<'m>, settings: &Settings, dt: f64, critical: f64) -> Self {
+    /// The state at t = 0, for the SIMD level `arch` (normally `pulp::Arch::new()`).
+    pub(super) fn new(
+        arch: pulp::Arch,
+        model: &'m Model<'m>,
+        settings: &Settings,
+        (dt, critical): (f64, f64),
+    ) -> Self {
+        let lanes = arch.dispatch(Lanes);
         let basis = model.basis;
         let (pins, modes) = (model.pins, basis.modes());
-        let row = modes.div_ceil(BLOCK) * BLOCK;
+        let row = modes.div_ceil(lanes) * lanes;
         let omega = basis.angular_frequencies();
         let damping: Vec<f64> = omega
             .iter()
@@ -217,42 +267,49 @@ impl<'m> Integrator<'m> {
                 }
             }
         }
-        let contacts = model.contacts.len();
-        assert!(
-            u32::try_from(contacts).is_ok(),
-            "contact indices are stored as u32"
-        );
-        let contact_left: Vec<usize> = model.contacts.iter().map(|c| pin_index(c.left)).collect();
-        let contact_right: Vec<usize> = model.contacts.iter().map(|c| pin_index(c.right)).collect();
-        let levels = heights.len().div_ceil(BLOCK) * BLOCK;
+        let contacts = &model.contacts;
+        let contact_left: Vec<usize> = contacts.iter().map(|c| pin_index(c.left)).collect();
+        let contact_right: Vec<usize> = contacts.iter().map(|c| pin_index(c.right)).collect();
+        // Offsets in vectors of one row of `row` values.
+        let vectors = row / lanes;
+        let state_row = |pin: usize| vectors * if pin == WALL { pins } else { pin };
         // A wall on the left reads the zero slot before the first pin, on the right the one
-        // after the last, so a row between two walls is one run per level.
+        // after the last.
         let stride = pins + 2;
-        let slot =
-            |level: usize, pin: usize, wall: usize| level * stride + if pin == WALL { wall } else { 1 + pin };
-        let runs = Run::split((0..contacts).map(|c| {
-            (
-                slot(contact_level[c], contact_left[c], 0),
-                slot(contact_level[c], contact_right[c], pins + 1),
-            )
-        }));
+        let slot = |pin: usize, wall: usize| if pin == WALL { wall } else { 1 + pin };
+        let layout = ContactLanes::new(
+            (0..contacts.len()).map(|c| {
+                (
+                    contact_level[c],
+                    slot(contact_left[c], 0),
+                    slot(contact_right[c], pins + 1),
+                )
+            }),
+            lanes,
+            stride,
+        );
+        let lane_count = layout.len();
+        let groups = lane_count / lanes;
         let level_shapes: Vec<f64> = heights.iter().flat_map(|h| shape_at(*h)).collect();
-        let grouped_level_shapes = LevelShapes::new(&level_shapes, row);
+        let grouped_level_shapes = LevelShapes::new(&level_shapes, row, lanes);
         let node_shapes = LevelShapes::new(
             &(0..nodes)
                 .flat_map(|n| (0..row).map(move |i| if i < modes { basis.shape(i)[2 * n] } else { 0.0 }))
                 .collect::<Vec<_>>(),
             row,
+            lanes,
         );
-        let node_levels = node_shapes.levels;
+        let node_blocks = node_shapes.blocks;
+        let level_blocks = grouped_level_shapes.blocks;
         let r2 = (dt / critical).powi(2);
         let mut integrator = Self {
-            arch: pulp::Arch::new(),
+            arch,
             model,
             scheme: settings.scheme,
             dt,
+            lanes,
             row,
-            pins,
+            stride,
             omega_squared: padded(&omega.iter().map(|w| w * w).collect::<Vec<_>>(), row, 0.0),
             implicit_damping_factor: padded(
                 &damping
@@ -273,140 +330,151 @@ impl<'m> Integrator<'m> {
             },
             level_shapes,
             grouped_level_shapes,
-            contact_level,
-            contact_left,
-            contact_right,
-            runs,
-            gaps: model.contacts.iter().map(|c| c.gap).collect(),
-            penetration: vec![0.0; contacts],
-            previous_penetration: vec![0.0; contacts],
-            max_penetration: vec![f64::NEG_INFINITY; contacts],
-            closed: vec![0; contacts],
-            base_now: 0.0,
-            level_deflections: vec![0.0; levels * stride],
+            lane_contacts: layout.by_lane(
+                &contacts
+                    .iter()
+                    .enumerate()
+                    .map(|(c, contact)| LaneContact {
+                        stiffness: contact.stiffness,
+                        dashpot: contact.damping,
+                        shape: vectors * contact_level[c],
+                        left: state_row(contact_left[c]),
+                        right: state_row(contact_right[c]),
+                        active: contact.stiffness > 0.0 || contact.damping > 0.0,
+                    })
+                    .collect::<Vec<_>>(),
+                LaneContact::default(),
+            ),
+            wall_row: state_row(WALL),
+            gaps: layout.by_lane(&contacts.iter().map(|c| c.gap).collect::<Vec<_>>(), f64::INFINITY),
+            layout,
+            penetration: vec![0.0; lane_count],
+            previous_penetration: vec![0.0; lane_count],
+            max_penetration: vec![f64::NEG_INFINITY; lane_count],
+            closed: vec![0; lane_count],
+            closed_groups: vec![0; groups],
+            level_deflections: vec![0.0; level_blocks * stride * lanes],
             point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
             output_shapes: settings.output_heights.iter().map(|h| shape_at(*h)).collect(),
             node_shapes,
-            node_deflections: vec![0.0; node_levels * stride],
+            node_deflections: vec![0.0; node_blocks * stride * lanes],
             q,
-            v: vec![0.0; pins * row],
-            a: vec![0.0; pins * row],
+            v: vec![0.0; (pins + 1) * row],
+            a: vec![0.0; (pins + 1) * row],
             force: vec![0.0; pins * row],
-            contact_force: vec![0.0; contacts],
-            statistics: vec![ContactStatistics::default(); contacts],
+            contact_force: vec![0.0; lane_count],
+            statistics: vec![ContactStatistics::default(); lane_count],
             energy: EnergyBalance::default(),
             previous_power: Powers::default(),
             divergence_allowance: if r2 < 1.0 { 2.0 / (1.0 - r2) } else { 1.0 },
             external_work_peak: 0.0,
             time: Vec::new(),
             deflections: vec![vec![Vec::new(); pins]; settings.output_heights.len()],
-            contact_forces: vec![Vec::new(); contacts],
+            contact_forces: vec![Vec::new(); contacts.len()],
             mechanical_energy: Vec::new(),
             pin_extremes: vec![PinExtreme::default(); pins],
         };
         // The state at t = 0: contacts already closed count as impacts at t = 0; a₀ from
         // equilibrium (velocities are zero).
-        let arch = integrator.arch;
         arch.dispatch(StepOp {
             integrator: &mut integrator,
             t: 0.0,
             operation: Operation::Initial,
         });
-        for (c, contact) in model.contacts.iter().enumerate() {
-            let stats = &mut integrator.statistics[c];
-            if integrator.penetration[c] > 0.0 && (contact.stiffness > 0.0 || contact.damping > 0.0) {
+        for (contact, lane) in contacts.iter().zip(&integrator.layout.lane) {
+            let lane = *lane as usize;
+            if integrator.penetration[lane] > 0.0 && (contact.stiffness > 0.0 || contact.damping > 0.0) {
+                let stats = &mut integrator.statistics[lane];
                 stats.impacts = 1;
                 stats.first_impact_time = Some(0.0);
             }
         }
+        let base = model.base_acceleration.as_ref().map_or(0.0, |b| b.at(0.0));
         for ((a, f), q) in integrator
             .a
             .chunks_exact_mut(row)
-            .zip(integrator.force.chunks_exact(row))
+            .zip(integrator.force.chunks_exact_mut(row))
             .zip(integrator.q.chunks_exact(row))
         {
             for k in 0..row {
-                a[k] = f[k] - integrator.omega_squared[k] * q[k];
+                a[k] = f[k] - base * integrator.participation[k] - integrator.omega_squared[k] * q[k];
+                f[k] = 0.0;
             }
         }
         integrator.energy.initial = integrator.mechanical_energy_now();
         integrator
     }
 
-    /// External loads at time t into `force`; keeps the base acceleration a(t) in
-    /// `base_now` for the power of the step.
+    /// Point loads at time t added to `force` (which holds no other load yet), contact
+    /// forces from the current positions and the dashpot velocity v + lookahead · a
+    /// added too; updates the per-step statistics when `record` and returns the contact
+    /// dissipation power Σ (F − Kc δ) δ̇. `vectors`: the row length in vectors.
     #[inline(always)]
-    fn external_forces<S: Simd>(&mut self, simd: S, t: f64) {
-        let row = self.row;
-        let base = self.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
-        self.base_now = base;
-        for loads in self.force.chunks_exact_mut(row) {
-            scale_into(simd, -base, &self.participation, loads);
-        }
+    fn contact_forces_and_statistics<S: Simd>(
+        &mut self,
+        simd: S,
+        t: f64,
+        record: bool,
+        vectors: usize,
+    ) -> f64 {
+        // The row length from `vectors`, so that it is a constant where `vectors` is.
+        let (row, dt) = (vectors * lanes::<S>(), self.dt);
         for (point, shape) in self.model.point_forces.iter().zip(&self.point_force_shapes) {
             let value = point.force.at(t);
             axpy(simd, value, shape, &mut self.force[point.pin * row..][..row]);
         }
-    }
-
-    /// Loads at time t (`force`), contact forces from the current positions and the
-    /// dashpot velocity v + lookahead · a; updates the per-step statistics when
-    /// `record` and returns the contact dissipation power Σ (F − Kc δ) δ̇.
-    #[inline(always)]
-    fn contact_forces_and_statistics<S: Simd>(&mut self, simd: S, t: f64, record: bool) -> f64 {
-        self.external_forces(simd, t);
-        let (row, dt) = (self.row, self.dt);
+        let deflections = S::as_mut_simd_f64s(&mut self.level_deflections).0;
         level_deflections(
             simd,
             &self.grouped_level_shapes,
             row,
             &self.q,
-            &mut self.level_deflections,
+            deflections,
+            self.stride,
         );
         // Every contact, in vectors: penetration, its running maximum, a zero force
         // where open, and the list of closed contacts (about one in seven).
         std::mem::swap(&mut self.penetration, &mut self.previous_penetration);
         let count = penetrations(
             simd,
-            &self.runs,
-            &self.level_deflections,
+            &self.layout,
+            deflections,
             &self.gaps,
             ContactState {
                 now: &mut self.penetration,
                 max: &mut self.max_penetration,
-                force: &mut self.contact_force,
                 closed: &mut self.closed,
+                closed_groups: &mut self.closed_groups,
             },
         );
 
         let mut dissipation_power = 0.0;
-        let lookahead = self.dashpot_lookahead;
-        let (v, a) = (self.v.as_slice(), self.a.as_slice());
-        let loads = self.force.as_mut_slice();
+        let (lookahead, wall, n) = (self.dashpot_lookahead, self.wall_row, vectors);
+        let shapes = S::as_simd_f64s(&self.level_shapes).0;
+        let (v, a) = (S::as_simd_f64s(&self.v).0, S::as_simd_f64s(&self.a).0);
+        let loads = S::as_mut_simd_f64s(&mut self.force).0;
+        // Per lane, all of one length (so that one bounds check covers them all).
+        let lane_contacts = self.lane_contacts.as_slice();
+        let lanes = lane_contacts.len();
+        let (now, before) = (&self.penetration[..lanes], &self.previous_penetration[..lanes]);
+        let (forces, statistics) = (&mut self.contact_force[..lanes], &mut self.statistics[..lanes]);
         for &closed in &self.closed[..count] {
-            let c = closed as usize;
-            let (penetration, previous) = (self.penetration[c], self.previous_penetration[c]);
-            let contact = &self.model.contacts[c];
-            let (left, right) = (self.contact_left[c], self.contact_right[c]);
-            let shape = &self.level_shapes[self.contact_level[c] * row..][..row];
-            // A plain `if` rather than a closure: closures are compiled apart from the
-            // SIMD context of the step unless inlined.
-            let mut rate = 0.0;
-            if contact.damping > 0.0 {
-                if left != WALL {
-                    let rows = left * row..(left + 1) * row;
-                    rate += dot_ahead(simd, shape, &v[rows.clone()], &a[rows], lookahead);
-                }
-                if right != WALL {
-                    let rows = right * row..(right + 1) * row;
-                    rate -= dot_ahead(simd, shape, &v[rows.clone()], &a[rows], lookahead);
-                }
-            }
-            let force = contact.force(penetration, rate);
-            self.contact_force[c] = force;
+            let j = closed as usize;
+            let contact = lane_contacts[j];
+            let (penetration, previous) = (now[j], before[j]);
+            let shape = &shapes[contact.shape..][..n];
+            let rate = if contact.dashpot > 0.0 {
+                let rows = |offset: usize| (&v[offset..], &a[offset..]);
+                penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead)
+            } else {
+                0.0
+            };
+            // The penetration is positive: F = max(0, Kc δ + cc δ̇) (`Contact::force`).
+            let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
+            forces[j] = force;
             dissipation_power += (force - contact.stiffness * penetration) * rate;
-            if record && (contact.stiffness > 0.0 || contact.damping > 0.0) {
-                let stats = &mut self.statistics[c];
+            if record && contact.active {
+                let stats = &mut statistics[j];
                 if previous <= 0.0 {
                     stats.impacts += 1;
                     if stats.first_impact_time.is_none() {
@@ -421,10 +489,11 @@ impl<'m> Integrator<'m> {
                 }
             }
             if force != 0.0 {
-                for (pin, sign) in [(left, -force), (right, force)] {
-                    if pin != WALL {
-                        axpy(simd, sign, shape, &mut loads[pin * row..][..row]);
-                    }
+                if contact.left != wall {
+                    row_axpy(simd, -force, shape, &mut loads[contact.left..]);
+                }
+                if contact.right != wall {
+                    row_axpy(simd, force, shape, &mut loads[contact.right..]);
                 }
             }
         }
@@ -441,32 +510,48 @@ impl<'m> Integrator<'m> {
         });
     }
 
+    /// One step; `vectors` is the row length in vectors (a constant in the usual cases).
     #[inline(always)]
-    fn step_body<S: Simd>(&mut self, simd: S, t: f64) {
+    fn step_body<S: Simd>(&mut self, simd: S, t: f64, vectors: usize) {
         let dt = self.dt;
         let half = 0.5 * dt;
-        // v ← v½, q ← qₙ₊₁ (central difference); q ← qₙ₊₁, v ← vₙ₊₁ (Tchamwa).
+        // q ← qₙ₊₁ and v ← v½ (central difference), or vₙ₊₁ (Tchamwa).
         let first_half = match self.scheme {
-            Scheme::CentralDifference => (dt, half, 0.0),
+            Scheme::CentralDifference => (dt, half, half * dt),
             Scheme::Tchamwa { phi } => (dt, dt, phi * dt * dt),
         };
-        advance_positions(simd, first_half, &mut self.q, &mut self.v, &self.a);
-        let contact_damping = self.contact_forces_and_statistics(simd, t, true);
-        let base = self.base_now;
+        // The pins' rows (`v` and `a` have the walls' row of zeros after them).
+        let state = self.q.len();
+        advance_positions(
+            simd,
+            first_half,
+            S::as_mut_simd_f64s(&mut self.q).0,
+            S::as_mut_simd_f64s(&mut self.v[..state]).0,
+            S::as_simd_f64s(&self.a[..state]).0,
+        );
+        let contact_damping = self.contact_forces_and_statistics(simd, t, true, vectors);
+        let base = self.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
         let second_half = match self.scheme {
             Scheme::CentralDifference => half,
             Scheme::Tchamwa { .. } => 0.0,
         };
+        let n = vectors;
         let sums = modal_update(
             simd,
-            &ModalCoefficients {
-                stiffness: &self.omega_squared,
-                damping: &self.damping,
-                factor: &self.implicit_damping_factor,
-                participation: &self.participation,
+            &ModalCoefficients::<S> {
+                stiffness: &S::as_simd_f64s(&self.omega_squared).0[..n],
+                damping: &S::as_simd_f64s(&self.damping).0[..n],
+                factor: &S::as_simd_f64s(&self.implicit_damping_factor).0[..n],
+                participation: &S::as_simd_f64s(&self.participation).0[..n],
             },
+            base,
             second_half,
-            (&self.q, &mut self.v, &mut self.a, &self.force),
+            (
+                S::as_simd_f64s(&self.q).0,
+                S::as_mut_simd_f64s(&mut self.v[..state]).0,
+                S::as_mut_simd_f64s(&mut self.a[..state]).0,
+                S::as_mut_simd_f64s(&mut self.force).0,
+            ),
         );
         let modal_damping = sums.damping_power;
         let mut external = -base * sums.participation_velocity;
@@ -500,8 +585,9 @@ impl<'m> Integrator<'m> {
         self.model
             .contacts
             .iter()
-            .zip(&self.penetration)
-            .filter(|(_, d)| **d > 0.0)
+            .zip(&self.layout.lane)
+            .map(|(c, lane)| (c, self.penetration[*lane as usize]))
+            .filter(|(_, d)| *d > 0.0)
             .map(|(c, d)| 0.5 * c.stiffness * d * d)
             .sum()
     }
@@ -539,8 +625,14 @@ impl<'m> Integrator<'m> {
                 history.push(dot(shape, coordinates));
             }
         }
-        for (c, force) in self.contact_force.iter().enumerate() {
-            self.contact_forces[c].push(*force);
+        for (history, lane) in self.contact_forces.iter_mut().zip(&self.layout.lane) {
+            // Forces are only updated while closed.
+            let lane = *lane as usize;
+            history.push(if self.penetration[lane] > 0.0 {
+                self.contact_force[lane]
+            } else {
+                0.0
+            });
         }
         self.mechanical_energy.push(self.mechanical_energy_now());
         let element_length = self.model.basis.model().element_length;
@@ -550,14 +642,11 @@ impl<'m> Integrator<'m> {
             t,
             operation: Operation::NodeDeflections,
         });
-        let nodes = self.model.basis.model().elements + 1;
-        for (node, deflections) in self
-            .node_deflections
-            .chunks_exact(self.pins + 2)
-            .take(nodes)
-            .enumerate()
-        {
-            for (w, extreme) in deflections[1..].iter().zip(self.pin_extremes.iter_mut()) {
+        let (lanes, stride) = (self.lanes, self.stride);
+        for node in 0..=self.model.basis.model().elements {
+            let (block, lane) = (node / lanes, node % lanes);
+            for (p, extreme) in self.pin_extremes.iter_mut().enumerate() {
+                let w = self.node_deflections[(block * stride + 1 + p) * lanes + lane];
                 if w.abs() > extreme.max_abs_deflection {
                     *extreme = PinExtreme {
                         max_abs_deflection: w.abs(),
@@ -583,7 +672,7 @@ impl<'m> Integrator<'m> {
             time: self.time,
             deflections: self.deflections,
             contact_forces: self.contact_forces,
-            contact_statistics: self.statistics,
+            contact_statistics: self.layout.by_contact(&self.statistics),
             pin_extremes: self.pin_extremes,
             energy: self.energy,
             mechanical_energy: self.mechanical_energy,

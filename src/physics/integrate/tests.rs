@@ -217,12 +217,9 @@ fn critical_step_matches_brute_force_divergence() {
     );
 }
 
-/// Energy balance on a damped two-pin row shaken by a half-sine base shock, with
-/// wall and pin–pin contacts carrying dashpots: kinetic + strain + contact + dissipated
-/// − base work stays equal to the initial energy to within a small fraction.
-#[test]
-fn energy_balance_closes_on_a_damped_excited_multi_contact_row() {
-    let basis = basis(20, 8);
+/// A damped two-pin row shaken by a half-sine base shock, with wall and pin–pin
+/// contacts carrying dashpots at two levels.
+fn shaken_two_pin_row(basis: &ModalBasis) -> Model<'_> {
     let contact = |left, right, height| Contact {
         left,
         right,
@@ -231,10 +228,10 @@ fn energy_balance_closes_on_a_damped_excited_multi_contact_row() {
         stiffness: 2e4,
         damping: 2.0,
     };
-    let model = Model {
-        basis: &basis,
+    Model {
+        basis,
         pins: 2,
-        damping_ratios: vec![0.02; 8],
+        damping_ratios: vec![0.02; basis.modes()],
         contacts: vec![
             contact(Body::Wall, Body::Pin(0), 0.5),
             contact(Body::Pin(0), Body::Pin(1), 0.5),
@@ -249,7 +246,15 @@ fn energy_balance_closes_on_a_damped_excited_multi_contact_row() {
             duration: 0.01,
         }),
         point_forces: vec![],
-    };
+    }
+}
+
+/// Energy balance on the shaken two-pin row: kinetic + strain + contact + dissipated
+/// − base work stays equal to the initial energy to within a small fraction.
+#[test]
+fn energy_balance_closes_on_a_damped_excited_multi_contact_row() {
+    let basis = basis(20, 8);
+    let model = shaken_two_pin_row(&basis);
     let result = run(
         &model,
         &Settings {
@@ -266,6 +271,70 @@ fn energy_balance_closes_on_a_damped_excited_multi_contact_row() {
         "energy balance residual {residual:e}: {:?}",
         result.energy
     );
+}
+
+/// The step lays contacts out by SIMD lanes (one lane per level on the scalar fallback,
+/// four levels per vector with AVX2) and unrolls rows of known lengths: the same run on
+/// this CPU's SIMD level and on the scalar fallback agrees to rounding, with both
+/// schemes, a point force, an odd number of modes, and contacts in no regular order.
+#[test]
+fn this_cpus_simd_level_and_the_scalar_fallback_agree() {
+    let basis = basis(20, 7);
+    let mut model = shaken_two_pin_row(&basis);
+    model.contacts.reverse();
+    model.contacts.push(Contact {
+        left: Body::Pin(1),
+        right: Body::Wall,
+        height: 0.8,
+        gap: 2e-5,
+        stiffness: 3e4,
+        damping: 0.0,
+    });
+    model.point_forces.push(PointForce {
+        pin: 1,
+        height: 0.9,
+        force: Table {
+            time: vec![0.0, 0.005, 1.0],
+            values: vec![0.0, 2.0, 2.0],
+        },
+    });
+    for scheme in [Scheme::CentralDifference, Scheme::Tchamwa { phi: 1.1 }] {
+        let settings = Settings {
+            output_interval: Some(1e-4),
+            ..settings(scheme, 2e-6, 0.02)
+        };
+        let scalar = simulate_on(pulp::Arch::Scalar, &model, &settings).expect("scalar run");
+        let simd = simulate_on(pulp::Arch::new(), &model, &settings).expect("SIMD run");
+        let impacts: u64 = scalar.contact_statistics.iter().map(|s| s.impacts).sum();
+        assert!(impacts > 5, "the case must exercise contacts: {impacts} impacts");
+        let agree = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-9 * scale;
+        for (s, v) in scalar.contact_statistics.iter().zip(&simd.contact_statistics) {
+            assert_eq!(s.impacts, v.impacts, "{scheme:?}");
+            assert!(
+                agree(s.max_force, v.max_force, 1.0 + s.max_force),
+                "{s:?} vs {v:?}"
+            );
+            assert!(agree(s.impulse, v.impulse, 1e-3 + s.impulse), "{s:?} vs {v:?}");
+            assert!(
+                agree(s.max_penetration, v.max_penetration, 1e-4),
+                "{s:?} vs {v:?}"
+            );
+        }
+        for (s, v) in scalar.contact_forces.iter().zip(&simd.contact_forces) {
+            let peak = s.iter().fold(1.0f64, |m, f| m.max(f.abs()));
+            assert!(s.iter().zip(v).all(|(a, b)| agree(*a, *b, peak)), "{scheme:?}");
+        }
+        for (s, v) in scalar.pin_extremes.iter().zip(&simd.pin_extremes) {
+            assert!(agree(s.max_abs_deflection, v.max_abs_deflection, 1e-4) && s.height == v.height);
+        }
+        let scale = scalar.energy.initial + scalar.energy.external_work.abs();
+        assert!(agree(
+            scalar.energy.dissipated_contact,
+            simd.energy.dissipated_contact,
+            scale
+        ));
+        assert!(agree(scalar.energy.kinetic, simd.energy.kinetic, scale));
+    }
 }
 
 /// Cancellation stops the run promptly with a typed error.
