@@ -160,22 +160,14 @@ fn render(stored: &store::StoredHistory, query: &HistoryQuery, format: Format) -
     if format == Format::Csv {
         return Ok(selected.to_csv().into_bytes());
     }
-    let in_window = {
-        let t0 = query.t_start.unwrap_or(f64::NEG_INFINITY);
-        let t1 = query.t_end.unwrap_or(f64::INFINITY);
-        history.time.iter().filter(|t| (t0..=t1).contains(*t)).count()
-    };
+    let in_window = thinning::count_in_window(&history.time, query.t_start, query.t_end);
     let document = HistoryDocument {
         output: selected.name,
         points: selected.time.len(),
         total_points: history.time.len(),
         thinned: selected.time.len() < in_window,
         time: selected.time,
-        series: selected
-            .series
-            .into_iter()
-            .map(|(name, values)| Series { name, values })
-            .collect(),
+        series: Series::from_columns(selected.series),
     };
     serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
 }

@@ -180,11 +180,7 @@ fn render(stored: &store::StoredHistory, query: &SpectrumQuery, format: Format) 
         let text = selected.to_csv();
         return Ok(format!("frequency{}", text.strip_prefix("time").unwrap_or(&text)).into_bytes());
     }
-    let in_window = {
-        let f0 = query.f_min.unwrap_or(f64::NEG_INFINITY);
-        let f1 = query.f_max.unwrap_or(f64::INFINITY);
-        spectra.time.iter().filter(|f| (f0..=f1).contains(*f)).count()
-    };
+    let in_window = thinning::count_in_window(&spectra.time, query.f_min, query.f_max);
     let document = SpectrumDocument {
         output: selected.name,
         sample_interval: dt,
@@ -193,11 +189,7 @@ fn render(stored: &store::StoredHistory, query: &SpectrumQuery, format: Format) 
         total_points: spectra.time.len(),
         thinned: selected.time.len() < in_window,
         frequency: selected.time,
-        series: selected
-            .series
-            .into_iter()
-            .map(|(name, values)| Series { name, values })
-            .collect(),
+        series: Series::from_columns(selected.series),
         comparison,
     };
     serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
