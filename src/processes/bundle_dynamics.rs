@@ -9,7 +9,7 @@ use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
 use super::inputs::{self, at};
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::contact::Contact;
-use crate::physics::integrate::{Model, Settings, SimulationError, simulate_resolved, step_counts};
+use crate::physics::integrate::{Model, Settings, simulate_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
 
 /// Most pins in one row.
@@ -200,22 +200,15 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
         errors.extend(at(&prefix, force.physics().force.validate("force")));
     }
 
-    let mut solver_issues = Vec::new();
-    let scheme = inputs::scheme(inputs.solver.scheme, inputs.solver.phi, &mut solver_issues);
-    let time_step = inputs::time_step(
-        inputs.solver.time_step,
-        inputs.solver.duration,
-        &mut solver_issues,
+    let solver = &inputs.solver;
+    let (scheme, time_step) = inputs::solver(
+        solver.scheme,
+        solver.phi,
+        solver.time_step,
+        solver.duration,
+        &mut errors,
     );
-    errors.extend(at("/inputs/solver", solver_issues));
-    if let Some(interval) = inputs.output.interval
-        && !(interval.is_finite() && interval > 0.0)
-    {
-        errors.push(FieldError::new(
-            "/inputs/output/interval",
-            "must be a positive number of seconds",
-        ));
-    }
+    inputs::check_output_interval(inputs.output.interval, &mut errors);
     let heights = inputs.output.heights.clone().unwrap_or_else(|| vec![length]);
     if heights.is_empty() {
         errors.push(FieldError::new(
@@ -334,11 +327,7 @@ impl Process for BundleDynamics {
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
         let prepared = prepare(inputs)?;
         let model = prepared.model();
-        let simulation =
-            simulate_resolved(&model, &prepared.settings, prepared.steps, progress).map_err(|e| match e {
-                SimulationError::Cancelled => RunError::Cancelled,
-                other => RunError::Failed(other.to_string()),
-            })?;
+        let simulation = simulate_resolved(&model, &prepared.settings, prepared.steps, progress)?;
 
         let contacts: Vec<serde_json::Value> = prepared
             .contacts

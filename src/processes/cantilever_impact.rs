@@ -11,7 +11,7 @@ use super::inputs::{self, BeamInput, SchemeInput, SupportInput, TimeStepInput, a
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
-use crate::physics::integrate::{Model, Settings, SimulationError, simulate_resolved, step_counts};
+use crate::physics::integrate::{Model, Settings, simulate_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
@@ -239,28 +239,21 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
         ));
     }
 
-    let mut solver_issues = Vec::new();
-    let scheme = inputs::scheme(inputs.solver.scheme, inputs.solver.phi, &mut solver_issues);
-    let time_step = inputs::time_step(
-        inputs.solver.time_step,
-        inputs.solver.duration,
-        &mut solver_issues,
+    let solver = &inputs.solver;
+    let (scheme, time_step) = inputs::solver(
+        solver.scheme,
+        solver.phi,
+        solver.time_step,
+        solver.duration,
+        &mut errors,
     );
-    errors.extend(at("/inputs/solver", solver_issues));
     if !(1..=MAX_MODES).contains(&inputs.reference.modes) {
         errors.push(FieldError::new(
             "/inputs/reference/modes",
             format!("must be between 1 and {MAX_MODES}"),
         ));
     }
-    if let Some(interval) = inputs.output.interval
-        && !(interval.is_finite() && interval > 0.0)
-    {
-        errors.push(FieldError::new(
-            "/inputs/output/interval",
-            "must be a positive number of seconds",
-        ));
-    }
+    inputs::check_output_interval(inputs.output.interval, &mut errors);
     if !errors.is_empty() {
         return Err(InvalidInputs(errors));
     }
@@ -394,11 +387,7 @@ impl Process for CantileverImpact {
             &prepared.settings,
             prepared.steps,
             &mut numerical_progress,
-        )
-        .map_err(|e| match e {
-            SimulationError::Cancelled => RunError::Cancelled,
-            other => RunError::Failed(other.to_string()),
-        })?;
+        )?;
         let solution = prepared
             .reference
             .solve(&mut |fraction| progress(0.9 + 0.1 * fraction))

@@ -265,6 +265,34 @@ pub fn time_step(step: TimeStepInput, duration: f64, issues: &mut Vec<InputIssue
     }
 }
 
+/// The scheme and time step of a `solver` block, its problems reported under
+/// `/inputs/solver`.
+pub fn solver(
+    scheme_input: SchemeInput,
+    phi: Option<f64>,
+    step: TimeStepInput,
+    duration: f64,
+    errors: &mut Vec<FieldError>,
+) -> (Scheme, TimeStep) {
+    let mut issues = Vec::new();
+    let scheme = scheme(scheme_input, phi, &mut issues);
+    let time_step = time_step(step, duration, &mut issues);
+    errors.extend(at("/inputs/solver", issues));
+    (scheme, time_step)
+}
+
+/// Checks `output.interval` (s) when given: a positive number of seconds.
+pub fn check_output_interval(interval: Option<f64>, errors: &mut Vec<FieldError>) {
+    if let Some(interval) = interval
+        && !(interval.is_finite() && interval > 0.0)
+    {
+        errors.push(FieldError::new(
+            "/inputs/output/interval",
+            "must be a positive number of seconds",
+        ));
+    }
+}
+
 /// The (time step, critical step) a run will use (s), or a 422 on `/inputs/solver/time_step`
 /// naming both values when a given step exceeds the critical one.
 pub fn resolve_step(

@@ -106,6 +106,17 @@ pub enum RunError {
     Failed(String),
 }
 
+impl From<crate::physics::integrate::SimulationError> for RunError {
+    /// Cancelled stays cancelled; any other failure of the integration (divergence, ...)
+    /// is deterministic.
+    fn from(error: crate::physics::integrate::SimulationError) -> Self {
+        match error {
+            crate::physics::integrate::SimulationError::Cancelled => RunError::Cancelled,
+            other => RunError::Failed(other.to_string()),
+        }
+    }
+}
+
 /// Progress and cancellation: called with the fraction done (0..=1); returning
 /// `ControlFlow::Break(())` stops the run promptly with [`RunError::Cancelled`].
 pub type ProgressFn<'a> = dyn FnMut(f64) -> ControlFlow<()> + 'a;

@@ -36,6 +36,14 @@ pub fn select(
     }
 }
 
+/// How many of the samples at `axis` (times, or frequencies of a spectrum) lie in
+/// `start <= x <= end` (either bound optional): the rows of the window before thinning.
+pub fn count_in_window(axis: &[f64], start: Option<f64>, end: Option<f64>) -> usize {
+    let low = start.unwrap_or(f64::NEG_INFINITY);
+    let high = end.unwrap_or(f64::INFINITY);
+    axis.iter().filter(|x| (low..=high).contains(*x)).count()
+}
+
 /// The columns of `history` named in `names` (comma-separated, in the order given), or
 /// all of them when `names` is `None`; `Err` names a column that does not exist.
 pub fn pick_series(history: History, names: Option<&str>) -> Result<History, String> {

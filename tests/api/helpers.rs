@@ -177,6 +177,16 @@ impl TestApp {
         response.json().await.unwrap()
     }
 
+    /// GET with `If-None-Match: <etag>` (a conditional request).
+    pub async fn get_if_none_match(&self, path: &str, etag: &str) -> Response {
+        self.client
+            .get(self.url(path))
+            .header("if-none-match", etag)
+            .send()
+            .await
+            .unwrap()
+    }
+
     pub async fn delete(&self, path: &str) -> Response {
         self.client.delete(self.url(path)).send().await.unwrap()
     }

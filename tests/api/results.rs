@@ -188,23 +188,11 @@ async fn job_status_has_an_etag_and_answers_304_while_unchanged() {
         !first.headers().contains_key("retry-after"),
         "finished: no Retry-After"
     );
-    let again = app
-        .client
-        .get(app.url(&path))
-        .header("if-none-match", &etag)
-        .send()
-        .await
-        .unwrap();
+    let again = app.get_if_none_match(&path, &etag).await;
     assert_eq!(again.status(), StatusCode::NOT_MODIFIED);
     assert_eq!(again.headers()["etag"].to_str().unwrap(), etag);
     assert!(again.bytes().await.unwrap().is_empty());
-    let stale = app
-        .client
-        .get(app.url(&path))
-        .header("if-none-match", "\"something-else\"")
-        .send()
-        .await
-        .unwrap();
+    let stale = app.get_if_none_match(&path, "\"something-else\"").await;
     assert_eq!(stale.status(), StatusCode::OK);
 }
 
@@ -219,13 +207,7 @@ async fn a_job_not_finished_has_retry_after_and_a_changing_etag() {
     // Conditional polling answers 304 until the job moves on, then 200 with a new tag.
     let deadline = std::time::Instant::now() + Duration::from_secs(5);
     let changed = loop {
-        let response = app
-            .client
-            .get(app.url(&format!("/jobs/{job}")))
-            .header("if-none-match", &first_tag)
-            .send()
-            .await
-            .unwrap();
+        let response = app.get_if_none_match(&format!("/jobs/{job}"), &first_tag).await;
         if response.status() == StatusCode::OK {
             break response;
         }
@@ -262,13 +244,7 @@ async fn finished_results_have_a_strong_etag_and_answer_304() {
         let again = app.get(&path).await;
         assert_eq!(again.headers()["etag"].to_str().unwrap(), etag, "stable tag");
         assert_eq!(again.bytes().await.unwrap().to_vec(), body);
-        let conditional = app
-            .client
-            .get(app.url(&path))
-            .header("if-none-match", &etag)
-            .send()
-            .await
-            .unwrap();
+        let conditional = app.get_if_none_match(&path, &etag).await;
         assert_eq!(conditional.status(), StatusCode::NOT_MODIFIED, "{path}");
     }
     let _: Value = app.get_json(&format!("/jobs/{job}/results")).await;

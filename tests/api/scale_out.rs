@@ -160,26 +160,28 @@ async fn a_worker_service_runs_jobs_queued_by_an_api_and_serves_health_and_metri
     let client = reqwest::Client::new();
     let healthz = client.get(format!("{health}/healthz")).send().await.unwrap();
     assert_eq!(healthz.status(), reqwest::StatusCode::OK);
-    let metrics = client
-        .get(format!("{health}/metrics"))
-        .send()
-        .await
-        .unwrap()
-        .text()
-        .await
-        .unwrap();
-    assert!(
-        metrics.contains(r#"chocmodal_jobs{status="successful"} 1"#),
-        "{metrics}"
-    );
-    assert!(
-        metrics.contains(
-            r#"chocmodal_job_duration_seconds_count{outcome="successful",process="count-steps"} 1"#
-        ),
-        "{metrics}"
+    let metrics = get_text(&client, &format!("{health}/metrics")).await;
+    assert_sample(&metrics, r#"chocmodal_jobs{status="successful"} 1"#);
+    assert_sample(
+        &metrics,
+        r#"chocmodal_job_duration_seconds_count{outcome="successful",process="count-steps"} 1"#,
     );
     let _ = stop.send(());
     served.await.unwrap().unwrap();
+}
+
+/// The body of a GET to another process's port (no `TestApp` there).
+async fn get_text(client: &reqwest::Client, url: &str) -> String {
+    client.get(url).send().await.unwrap().text().await.unwrap()
+}
+
+async fn get_json(client: &reqwest::Client, url: &str) -> Value {
+    client.get(url).send().await.unwrap().json().await.unwrap()
+}
+
+/// Asserts that a Prometheus exposition holds this sample (name, labels and value).
+fn assert_sample(metrics: &str, sample: &str) {
+    assert!(metrics.contains(sample), "no `{sample}` in {metrics}");
 }
 
 /// A process of the real binary, killed when dropped; its logs (JSON lines) in a file.
@@ -355,14 +357,7 @@ async fn killing_a_worker_mid_job_loses_no_job_and_completes_none_twice() {
 
     let deadline = Instant::now() + Duration::from_secs(120);
     let statuses = loop {
-        let page: Value = client
-            .get(format!("{address}/jobs?limit=100"))
-            .send()
-            .await
-            .unwrap()
-            .json()
-            .await
-            .unwrap();
+        let page = get_json(&client, &format!("{address}/jobs?limit=100")).await;
         let statuses: HashMap<String, String> = page["jobs"]
             .as_array()
             .unwrap()
@@ -411,28 +406,11 @@ async fn killing_a_worker_mid_job_loses_no_job_and_completes_none_twice() {
     .unwrap();
     assert_eq!(attempt, 2, "the killed worker's job was claimed again");
     assert_eq!(owner_histories, 2, "tip_displacement and contact_force");
-    let results: Value = client
-        .get(format!("{address}/jobs/{victim}/results"))
-        .send()
-        .await
-        .unwrap()
-        .json()
-        .await
-        .unwrap();
+    let results = get_json(&client, &format!("{address}/jobs/{victim}/results")).await;
     assert!(results["comparison"]["f_err"].is_number(), "{results}");
 
-    let metrics = client
-        .get(format!("{health}/metrics"))
-        .send()
-        .await
-        .unwrap()
-        .text()
-        .await
-        .unwrap();
-    assert!(
-        metrics.contains(r#"chocmodal_jobs{status="successful"} 8"#),
-        "{metrics}"
-    );
+    let metrics = get_text(&client, &format!("{health}/metrics")).await;
+    assert_sample(&metrics, r#"chocmodal_jobs{status="successful"} 8"#);
     assert!(survivor.terminate().success(), "the survivor stops gracefully");
     assert!(api.terminate().success(), "the API stops gracefully");
 }

@@ -76,6 +76,16 @@ fn sweep(inputs: Value, axes: Value) -> Value {
     json!({"process": counting::ID, "inputs": inputs, "axes": axes})
 }
 
+/// The `columns` of a sweep's results table, in order.
+fn column_names(results: &Value) -> Vec<&str> {
+    results["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap())
+        .collect()
+}
+
 fn column(results: &Value, name: &str) -> Vec<f64> {
     results["rows"]
         .as_array()
@@ -101,12 +111,7 @@ async fn a_grid_runs_every_cell_once_and_tabulates_axes_then_metrics(backend: Ba
     assert_eq!(status["progress"], 100);
 
     let results = app.sweep_results(&id).await;
-    let columns: Vec<&str> = results["columns"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c.as_str().unwrap())
-        .collect();
+    let columns = column_names(&results);
     assert_eq!(
         columns,
         ["run", "job", "status", "/steps", "/step_ms", "steps", "sum"]
@@ -533,36 +538,21 @@ async fn sweeps_are_listed_newest_first_with_paging_and_unknown_ones_are_404(bac
             .all(|l| l["rel"] != "next")
     );
 
-    assert_problem(
-        app.get("/sweeps/nope").await,
-        StatusCode::NOT_FOUND,
-        "/no-such-sweep",
-    )
-    .await;
-    assert_problem(
-        app.get("/sweeps/nope/results").await,
-        StatusCode::NOT_FOUND,
-        "/no-such-sweep",
-    )
-    .await;
+    for path in ["/sweeps/nope", "/sweeps/nope/results"] {
+        assert_problem(app.get(path).await, StatusCode::NOT_FOUND, "/no-such-sweep").await;
+    }
     assert_problem(
         app.delete("/sweeps/nope").await,
         StatusCode::NOT_FOUND,
         "/no-such-sweep",
     )
     .await;
-    assert_problem(
-        app.get("/sweeps?limit=0").await,
-        StatusCode::BAD_REQUEST,
-        "/invalid-query",
-    )
-    .await;
-    assert_problem(
-        app.get(&format!("/sweeps/{}/results?format=xml", ids[0])).await,
-        StatusCode::BAD_REQUEST,
-        "/invalid-query",
-    )
-    .await;
+    for path in [
+        "/sweeps?limit=0".to_owned(),
+        format!("/sweeps/{}/results?format=xml", ids[0]),
+    ] {
+        assert_problem(app.get(&path).await, StatusCode::BAD_REQUEST, "/invalid-query").await;
+    }
 }
 
 /// Random gap states on a small real bundle: the seed of the gap generator is the
@@ -578,12 +568,7 @@ async fn a_random_gap_campaign_tabulates_peak_forces_per_contact() {
     app.wait_for_sweep(&id, &["successful"], Duration::from_secs(120))
         .await;
     let results = app.sweep_results(&id).await;
-    let columns: Vec<&str> = results["columns"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c.as_str().unwrap())
-        .collect();
+    let columns = column_names(&results);
     for expected in [
         "/bundle/gaps/seed",
         "max_contact_force.force",

@@ -5,7 +5,7 @@
 use std::time::Duration;
 
 use chocmodal::service::auth::TokenTable;
-use reqwest::{Response, StatusCode};
+use reqwest::{RequestBuilder, Response, StatusCode};
 use serde_json::{Value, json};
 
 use crate::counting;
@@ -34,15 +34,21 @@ struct As<'a> {
     token: &'a str,
 }
 
-impl As<'_> {
+impl<'a> As<'a> {
+    fn alpha(app: &'a TestApp) -> Self {
+        Self { app, token: ALPHA }
+    }
+
+    fn beta(app: &'a TestApp) -> Self {
+        Self { app, token: BETA }
+    }
+
+    async fn send(&self, request: RequestBuilder) -> Response {
+        request.bearer_auth(self.token).send().await.unwrap()
+    }
+
     async fn get(&self, path: &str) -> Response {
-        self.app
-            .client
-            .get(self.app.url(path))
-            .bearer_auth(self.token)
-            .send()
-            .await
-            .unwrap()
+        self.send(self.app.client.get(self.app.url(path))).await
     }
 
     async fn get_json(&self, path: &str) -> Value {
@@ -52,25 +58,27 @@ impl As<'_> {
     }
 
     async fn delete(&self, path: &str) -> Response {
-        self.app
-            .client
-            .delete(self.app.url(path))
-            .bearer_auth(self.token)
-            .send()
-            .await
-            .unwrap()
+        self.send(self.app.client.delete(self.app.url(path))).await
     }
 
     async fn post(&self, path: &str, body: &Value) -> Response {
-        self.app
+        let request = self
+            .app
             .client
             .post(self.app.url(path))
-            .bearer_auth(self.token)
             .header("content-type", "application/json")
-            .body(body.to_string())
-            .send()
-            .await
-            .unwrap()
+            .body(body.to_string());
+        self.send(request).await
+    }
+
+    /// GET of `resource` followed by each of `views` (path suffixes), and its DELETE,
+    /// are all 404 problems of type `…kind`.
+    async fn assert_not_found(&self, resource: &str, views: &[&str], kind: &str) {
+        for view in views {
+            let path = format!("{resource}{view}");
+            assert_problem(self.get(&path).await, StatusCode::NOT_FOUND, kind).await;
+        }
+        assert_problem(self.delete(resource).await, StatusCode::NOT_FOUND, kind).await;
     }
 
     /// Submits `count-steps`; returns the job id.
@@ -148,10 +156,7 @@ async fn a_wrong_token_is_a_401_with_an_invalid_token_challenge() {
         assert_eq!(status, StatusCode::UNAUTHORIZED, "{header}");
         assert!(challenge.contains("invalid_token"), "{header}: {challenge}");
     }
-    let alpha = As {
-        app: &app,
-        token: ALPHA,
-    };
+    let alpha = As::alpha(&app);
     assert_eq!(alpha.get("/jobs").await.status(), StatusCode::OK);
 }
 
@@ -159,10 +164,7 @@ async fn a_wrong_token_is_a_401_with_an_invalid_token_challenge() {
 async fn metrics_need_a_token_unless_public() {
     let app = spawn_with_tenants(Backend::Sqlite).await;
     assert_eq!(app.get("/metrics").await.status(), StatusCode::UNAUTHORIZED);
-    let alpha = As {
-        app: &app,
-        token: ALPHA,
-    };
+    let alpha = As::alpha(&app);
     assert_eq!(alpha.get("/metrics").await.status(), StatusCode::OK);
 
     let public = spawn_app_with(|config| {
@@ -176,33 +178,20 @@ async fn metrics_need_a_token_unless_public() {
 
 async fn another_tenants_job_is_not_found_anywhere(backend: Backend) {
     let app = spawn_with_tenants(backend).await;
-    let alpha = As {
-        app: &app,
-        token: ALPHA,
-    };
-    let beta = As {
-        app: &app,
-        token: BETA,
-    };
+    let (alpha, beta) = (As::alpha(&app), As::beta(&app));
     let job = alpha.submit(json!({"steps": 5})).await;
     assert_eq!(alpha.wait_until_finished(&job).await["status"], "successful");
 
-    for path in [
-        format!("/jobs/{job}"),
-        format!("/jobs/{job}/results"),
-        format!("/jobs/{job}/results/signal"),
-        format!("/jobs/{job}/results/signal?format=csv"),
-        format!("/jobs/{job}/results/signal/spectrum"),
-        format!("/jobs/{job}/inputs"),
-    ] {
-        assert_problem(beta.get(&path).await, StatusCode::NOT_FOUND, "/no-such-job").await;
-    }
-    assert_problem(
-        beta.delete(&format!("/jobs/{job}")).await,
-        StatusCode::NOT_FOUND,
-        "/no-such-job",
-    )
-    .await;
+    let views = [
+        "",
+        "/results",
+        "/results/signal",
+        "/results/signal?format=csv",
+        "/results/signal/spectrum",
+        "/inputs",
+    ];
+    beta.assert_not_found(&format!("/jobs/{job}"), &views, "/no-such-job")
+        .await;
     assert_eq!(beta.get_json("/jobs").await["jobs"], json!([]));
     assert_eq!(
         beta.get_json("/jobs?status=successful&processID=count-steps")
@@ -228,14 +217,7 @@ async fn another_tenants_job_is_not_found_anywhere(backend: Backend) {
 
 async fn identical_inputs_of_another_tenant_are_computed_not_reused(backend: Backend) {
     let app = spawn_with_tenants(backend).await;
-    let alpha = As {
-        app: &app,
-        token: ALPHA,
-    };
-    let beta = As {
-        app: &app,
-        token: BETA,
-    };
+    let (alpha, beta) = (As::alpha(&app), As::beta(&app));
     let first = alpha.submit(json!({"steps": 7})).await;
     alpha.wait_until_finished(&first).await;
     let second = beta.submit(json!({"steps": 7})).await;
@@ -254,14 +236,7 @@ async fn identical_inputs_of_another_tenant_are_computed_not_reused(backend: Bac
 
 async fn another_tenants_sweep_is_not_found_and_its_runs_are_not_listed(backend: Backend) {
     let app = spawn_with_tenants(backend).await;
-    let alpha = As {
-        app: &app,
-        token: ALPHA,
-    };
-    let beta = As {
-        app: &app,
-        token: BETA,
-    };
+    let (alpha, beta) = (As::alpha(&app), As::beta(&app));
     let response = alpha
         .post(
             "/sweeps",
@@ -273,19 +248,9 @@ async fn another_tenants_sweep_is_not_found_and_its_runs_are_not_listed(backend:
     let sweep: Value = response.json().await.unwrap();
     let id = sweep["sweepID"].as_str().unwrap().to_owned();
 
-    for path in [
-        format!("/sweeps/{id}"),
-        format!("/sweeps/{id}/results"),
-        format!("/sweeps/{id}/results?format=csv"),
-    ] {
-        assert_problem(beta.get(&path).await, StatusCode::NOT_FOUND, "/no-such-sweep").await;
-    }
-    assert_problem(
-        beta.delete(&format!("/sweeps/{id}")).await,
-        StatusCode::NOT_FOUND,
-        "/no-such-sweep",
-    )
-    .await;
+    let views = ["", "/results", "/results?format=csv"];
+    beta.assert_not_found(&format!("/sweeps/{id}"), &views, "/no-such-sweep")
+        .await;
     assert_eq!(beta.get_json("/sweeps").await["sweeps"], json!([]));
     assert_eq!(
         beta.get_json(&format!("/jobs?sweepID={id}")).await["jobs"],

@@ -7,6 +7,7 @@ pub mod conditional;
 pub mod dashboard;
 pub mod error;
 pub mod extract;
+mod history_view;
 pub mod job_inputs;
 pub mod jobs;
 pub mod landing;

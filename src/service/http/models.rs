@@ -184,6 +184,16 @@ pub struct Series {
     pub values: Vec<f64>,
 }
 
+impl Series {
+    /// The named columns of a [`History`](crate::processes::History), in order.
+    pub fn from_columns(columns: Vec<(String, Vec<f64>)>) -> Vec<Series> {
+        columns
+            .into_iter()
+            .map(|(name, values)| Series { name, values })
+            .collect()
+    }
+}
+
 /// A time history (or a window of it, thinned on request) as JSON.
 #[derive(Debug, Serialize, ToSchema)]
 pub struct HistoryDocument {

@@ -8,6 +8,7 @@ use super::AppState;
 use super::conditional::tagged;
 use super::error::ApiError;
 use super::extract::ApiQuery;
+use super::history_view::{Format, capped_max_points, require_finite, respond};
 use super::models::{HistoryDocument, Results, Series};
 use crate::problem::Problem;
 use crate::service::auth::Tenant;
@@ -135,85 +136,52 @@ pub async fn output(
     ApiQuery(mut query): ApiQuery<HistoryQuery>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
-    let csv = match query.format.as_deref() {
-        Some("csv") => true,
-        Some("json") => false,
-        Some(other) => {
-            return Err(
-                Problem::invalid_query(format!("`format` must be `csv` or `json`, not `{other}`")).into(),
-            );
-        }
-        None => prefers_csv(&headers),
-    };
-    for (name, value) in [("t_start", query.t_start), ("t_end", query.t_end)] {
-        if value.is_some_and(|t| !t.is_finite()) {
-            return Err(Problem::invalid_query(format!("`{name}` must be a finite number (s)")).into());
-        }
-    }
-    if query.max_points.is_some_and(|n| n < 2) {
-        return Err(Problem::invalid_query("`max_points` must be at least 2").into());
-    }
+    let format = Format::from_query(query.format.as_deref(), preferred_format(&headers))?;
+    require_finite([("t_start", query.t_start), ("t_end", query.t_end)], "s")?;
     // However long the history, a response holds at most the service's cap.
-    let cap = state.max_history_points;
-    query.max_points = Some(query.max_points.map_or(cap, |n| n.min(cap)));
-    with_retry_after(
-        async {
-            successful(&job_id, state.queue.outcome(tenant.as_str(), &job_id).await?)?;
-            let stored = state
-                .queue
-                .history(tenant.as_str(), &job_id, &output)
-                .await?
-                .ok_or_else(|| Problem::no_such_output(&job_id, &output))?;
-            // Decompressing and thinning a long history is CPU work: keep it off the runtime.
-            let rendered = tokio::task::spawn_blocking(move || render(&stored, &query, csv))
-                .await
-                .map_err(|e| ApiError::Internal(format!("rendering a history panicked: {e}")))??;
-            let content_type = if csv {
-                "text/csv; charset=utf-8"
-            } else {
-                "application/json"
-            };
-            Ok(tagged(&headers, content_type, rendered, HeaderMap::new()))
-        }
-        .await,
+    query.max_points = Some(capped_max_points(query.max_points, state.max_history_points)?);
+    respond(
+        &state,
+        &tenant,
+        &job_id,
+        &output,
+        &headers,
+        format,
+        "rendering a history",
+        move |stored| render(stored, &query, format),
     )
+    .await
 }
 
-fn render(stored: &store::StoredHistory, query: &HistoryQuery, csv: bool) -> Result<Vec<u8>, ApiError> {
+fn render(stored: &store::StoredHistory, query: &HistoryQuery, format: Format) -> Result<Vec<u8>, ApiError> {
     let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
     let history = thinning::pick_series(history, query.series.as_deref()).map_err(Problem::invalid_query)?;
     let selected = thinning::select(&history, query.t_start, query.t_end, query.max_points);
-    if csv {
+    if format == Format::Csv {
         return Ok(selected.to_csv().into_bytes());
     }
-    let in_window = {
-        let t0 = query.t_start.unwrap_or(f64::NEG_INFINITY);
-        let t1 = query.t_end.unwrap_or(f64::INFINITY);
-        history.time.iter().filter(|t| (t0..=t1).contains(*t)).count()
-    };
+    let in_window = thinning::count_in_window(&history.time, query.t_start, query.t_end);
     let document = HistoryDocument {
         output: selected.name,
         points: selected.time.len(),
         total_points: history.time.len(),
         thinned: selected.time.len() < in_window,
         time: selected.time,
-        series: selected
-            .series
-            .into_iter()
-            .map(|(name, values)| Series { name, values })
-            .collect(),
+        series: Series::from_columns(selected.series),
     };
     serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
 }
 
-fn prefers_csv(headers: &HeaderMap) -> bool {
+/// CSV when `Accept` names `text/csv` before (or without) `application/json`.
+fn preferred_format(headers: &HeaderMap) -> Format {
     let accept = headers
         .get(header::ACCEPT)
         .and_then(|v| v.to_str().ok())
         .unwrap_or_default();
-    match (accept.find("text/csv"), accept.find("application/json")) {
+    let csv = match (accept.find("text/csv"), accept.find("application/json")) {
         (Some(c), Some(j)) => c < j,
         (Some(_), None) => true,
         _ => false,
-    }
+    };
+    if csv { Format::Csv } else { Format::Json }
 }

@@ -9,11 +9,10 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::AppState;
-use super::conditional::tagged;
 use super::error::ApiError;
 use super::extract::ApiQuery;
+use super::history_view::{Format, capped_max_points, require_finite, respond};
 use super::models::Series;
-use super::results::{successful, with_retry_after};
 use crate::physics::spectrum::{periodogram, spectral_error};
 use crate::problem::Problem;
 use crate::processes::History;
@@ -111,47 +110,21 @@ pub async fn spectrum(
     ApiQuery(mut query): ApiQuery<SpectrumQuery>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
-    let csv = match query.format.as_deref() {
-        Some("csv") => true,
-        None | Some("json") => false,
-        Some(other) => {
-            return Err(
-                Problem::invalid_query(format!("`format` must be `csv` or `json`, not `{other}`")).into(),
-            );
-        }
-    };
-    for (name, value) in [("f_min", query.f_min), ("f_max", query.f_max)] {
-        if value.is_some_and(|f| !f.is_finite()) {
-            return Err(Problem::invalid_query(format!("`{name}` must be a finite number (Hz)")).into());
-        }
-    }
-    if query.max_points.is_some_and(|n| n < 2) {
-        return Err(Problem::invalid_query("`max_points` must be at least 2").into());
-    }
+    let format = Format::from_query(query.format.as_deref(), Format::Json)?;
+    require_finite([("f_min", query.f_min), ("f_max", query.f_max)], "Hz")?;
     // A response holds at most the service's cap of rows, as for histories.
-    let cap = state.max_history_points;
-    query.max_points = Some(query.max_points.map_or(cap, |n| n.min(cap)));
-    with_retry_after(
-        async {
-            successful(&job_id, state.queue.outcome(tenant.as_str(), &job_id).await?)?;
-            let stored = state
-                .queue
-                .history(tenant.as_str(), &job_id, &output)
-                .await?
-                .ok_or_else(|| Problem::no_such_output(&job_id, &output))?;
-            // FFTs of long histories are CPU work: keep them off the runtime.
-            let rendered = tokio::task::spawn_blocking(move || render(&stored, &query, csv))
-                .await
-                .map_err(|e| ApiError::Internal(format!("computing a spectrum panicked: {e}")))??;
-            let content_type = if csv {
-                "text/csv; charset=utf-8"
-            } else {
-                "application/json"
-            };
-            Ok(tagged(&headers, content_type, rendered, HeaderMap::new()))
-        }
-        .await,
+    query.max_points = Some(capped_max_points(query.max_points, state.max_history_points)?);
+    respond(
+        &state,
+        &tenant,
+        &job_id,
+        &output,
+        &headers,
+        format,
+        "computing a spectrum",
+        move |stored| render(stored, &query, format),
     )
+    .await
 }
 
 /// Histories are uniformly sampled (every process records at a fixed output interval).
@@ -166,7 +139,7 @@ fn unprocessable(detail: String) -> ApiError {
     Problem::from_status(422, "Unprocessable Content", detail).into()
 }
 
-fn render(stored: &store::StoredHistory, query: &SpectrumQuery, csv: bool) -> Result<Vec<u8>, ApiError> {
+fn render(stored: &store::StoredHistory, query: &SpectrumQuery, format: Format) -> Result<Vec<u8>, ApiError> {
     let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
     let history = thinning::pick_series(history, query.series.as_deref()).map_err(Problem::invalid_query)?;
     let dt = sample_interval(&history.time);
@@ -202,16 +175,12 @@ fn render(stored: &store::StoredHistory, query: &SpectrumQuery, csv: bool) -> Re
         _ => None,
     };
     let selected = thinning::select(&spectra, query.f_min, query.f_max, query.max_points);
-    if csv {
+    if format == Format::Csv {
         // The shared CSV writer names its first column `time`; here it holds frequencies.
         let text = selected.to_csv();
         return Ok(format!("frequency{}", text.strip_prefix("time").unwrap_or(&text)).into_bytes());
     }
-    let in_window = {
-        let f0 = query.f_min.unwrap_or(f64::NEG_INFINITY);
-        let f1 = query.f_max.unwrap_or(f64::INFINITY);
-        spectra.time.iter().filter(|f| (f0..=f1).contains(*f)).count()
-    };
+    let in_window = thinning::count_in_window(&spectra.time, query.f_min, query.f_max);
     let document = SpectrumDocument {
         output: selected.name,
         sample_interval: dt,
@@ -220,11 +189,7 @@ fn render(stored: &store::StoredHistory, query: &SpectrumQuery, csv: bool) -> Re
         total_points: spectra.time.len(),
         thinned: selected.time.len() < in_window,
         frequency: selected.time,
-        series: selected
-            .series
-            .into_iter()
-            .map(|(name, values)| Series { name, values })
-            .collect(),
+        series: Series::from_columns(selected.series),
         comparison,
     };
     serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))

@@ -1,0 +1,96 @@
+//! The path shared by the views of one stored history of a job, the history itself
+//! (`/jobs/{jobId}/results/{output}`) and its spectrum (`.../spectrum`): the query checks
+//! both make, and [`respond`], which finds the history of a successful job, renders it
+//! off the runtime and sends it with an entity tag.
+
+use axum::http::HeaderMap;
+use axum::response::Response;
+
+use super::AppState;
+use super::conditional::tagged;
+use super::error::ApiError;
+use super::results::{successful, with_retry_after};
+use crate::problem::Problem;
+use crate::service::auth::Tenant;
+use crate::service::store::StoredHistory;
+
+/// The representation asked for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Format {
+    Csv,
+    Json,
+}
+
+impl Format {
+    /// The `format` query parameter, or `default` without one; 400 on anything else.
+    pub(super) fn from_query(format: Option<&str>, default: Format) -> Result<Format, ApiError> {
+        match format {
+            Some("csv") => Ok(Format::Csv),
+            Some("json") => Ok(Format::Json),
+            Some(other) => {
+                Err(Problem::invalid_query(format!("`format` must be `csv` or `json`, not `{other}`")).into())
+            }
+            None => Ok(default),
+        }
+    }
+
+    fn content_type(self) -> &'static str {
+        match self {
+            Format::Csv => "text/csv; charset=utf-8",
+            Format::Json => "application/json",
+        }
+    }
+}
+
+/// 400 unless each bound of a window that is given is finite; `unit` goes in the reason.
+pub(super) fn require_finite(bounds: [(&str, Option<f64>); 2], unit: &str) -> Result<(), ApiError> {
+    for (name, value) in bounds {
+        if value.is_some_and(|v| !v.is_finite()) {
+            return Err(Problem::invalid_query(format!("`{name}` must be a finite number ({unit})")).into());
+        }
+    }
+    Ok(())
+}
+
+/// The rows one response may hold: `max_points` when given (400 below 2), never more than
+/// the service's `cap` however long the history.
+pub(super) fn capped_max_points(requested: Option<usize>, cap: usize) -> Result<usize, ApiError> {
+    if requested.is_some_and(|n| n < 2) {
+        return Err(Problem::invalid_query("`max_points` must be at least 2").into());
+    }
+    Ok(requested.map_or(cap, |n| n.min(cap)))
+}
+
+/// `output` of the job `job_id`, rendered by `render` in `format`: 404 (with `Retry-After`
+/// while the job is not finished) unless the job succeeded and recorded that output.
+/// Decompressing, thinning and transforming a long history is CPU work, so `render` runs
+/// on the blocking pool; `work` names it in the error should it panic.
+pub(super) async fn respond<F>(
+    state: &AppState,
+    tenant: &Tenant,
+    job_id: &str,
+    output: &str,
+    headers: &HeaderMap,
+    format: Format,
+    work: &'static str,
+    render: F,
+) -> Result<Response, ApiError>
+where
+    F: FnOnce(&StoredHistory) -> Result<Vec<u8>, ApiError> + Send + 'static,
+{
+    with_retry_after(
+        async {
+            successful(job_id, state.queue.outcome(tenant.as_str(), job_id).await?)?;
+            let stored = state
+                .queue
+                .history(tenant.as_str(), job_id, output)
+                .await?
+                .ok_or_else(|| Problem::no_such_output(job_id, output))?;
+            let rendered = tokio::task::spawn_blocking(move || render(&stored))
+                .await
+                .map_err(|e| ApiError::Internal(format!("{work} panicked: {e}")))??;
+            Ok(tagged(headers, format.content_type(), rendered, HeaderMap::new()))
+        }
+        .await,
+    )
+}
