@@ -274,66 +274,81 @@ fn energy_balance_closes_on_a_damped_excited_multi_contact_row() {
 }
 
 /// The step lays contacts out by SIMD lanes (one lane per level on the scalar fallback,
-/// four levels per vector with AVX2) and unrolls rows of known lengths: the same run on
-/// this CPU's SIMD level and on the scalar fallback agrees to rounding, with both
-/// schemes, a point force, an odd number of modes, and contacts in no regular order.
+/// four levels per vector with AVX2) and unrolls rows of up to 8 vectors: the same run
+/// on this CPU's SIMD level and on the scalar fallback agrees to rounding, with both
+/// schemes, a point force, contacts in no regular order, and rows short enough to be
+/// unrolled (7 modes) or not (37 modes).
 #[test]
 fn this_cpus_simd_level_and_the_scalar_fallback_agree() {
-    let basis = basis(20, 7);
-    let mut model = shaken_two_pin_row(&basis);
-    model.contacts.reverse();
-    model.contacts.push(Contact {
-        left: Body::Pin(1),
-        right: Body::Wall,
-        height: 0.8,
-        gap: 2e-5,
-        stiffness: 3e4,
-        damping: 0.0,
-    });
-    model.point_forces.push(PointForce {
-        pin: 1,
-        height: 0.9,
-        force: Table {
-            time: vec![0.0, 0.005, 1.0],
-            values: vec![0.0, 2.0, 2.0],
-        },
-    });
-    for scheme in [Scheme::CentralDifference, Scheme::Tchamwa { phi: 1.1 }] {
-        let settings = Settings {
-            output_interval: Some(1e-4),
-            ..settings(scheme, 2e-6, 0.02)
-        };
-        let scalar = simulate_on(pulp::Arch::Scalar, &model, &settings).expect("scalar run");
-        let simd = simulate_on(pulp::Arch::new(), &model, &settings).expect("SIMD run");
-        let impacts: u64 = scalar.contact_statistics.iter().map(|s| s.impacts).sum();
-        assert!(impacts > 5, "the case must exercise contacts: {impacts} impacts");
-        let agree = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-9 * scale;
-        for (s, v) in scalar.contact_statistics.iter().zip(&simd.contact_statistics) {
-            assert_eq!(s.impacts, v.impacts, "{scheme:?}");
-            assert!(
-                agree(s.max_force, v.max_force, 1.0 + s.max_force),
-                "{s:?} vs {v:?}"
-            );
-            assert!(agree(s.impulse, v.impulse, 1e-3 + s.impulse), "{s:?} vs {v:?}");
-            assert!(
-                agree(s.max_penetration, v.max_penetration, 1e-4),
-                "{s:?} vs {v:?}"
-            );
+    for (elements, modes, duration) in [(20, 7, 0.02), (24, 37, 0.005)] {
+        let basis = basis(elements, modes);
+        let mut model = shaken_two_pin_row(&basis);
+        // Six levels: two blocks of levels with AVX2, every lane used.
+        model.contacts.reverse();
+        for (left, right, height, damping) in [
+            (Body::Pin(1), Body::Wall, 0.8, 0.0),
+            (Body::Wall, Body::Pin(0), 0.3, 1.0),
+            (Body::Pin(0), Body::Pin(1), 0.65, 2.0),
+            (Body::Pin(1), Body::Wall, 0.2, 0.5),
+        ] {
+            model.contacts.push(Contact {
+                left,
+                right,
+                height,
+                gap: 2e-5,
+                stiffness: 3e4,
+                damping,
+            });
         }
-        for (s, v) in scalar.contact_forces.iter().zip(&simd.contact_forces) {
-            let peak = s.iter().fold(1.0f64, |m, f| m.max(f.abs()));
-            assert!(s.iter().zip(v).all(|(a, b)| agree(*a, *b, peak)), "{scheme:?}");
+        model.point_forces.push(PointForce {
+            pin: 1,
+            height: 0.9,
+            force: Table {
+                time: vec![0.0, 0.005, 1.0],
+                values: vec![0.0, 2.0, 2.0],
+            },
+        });
+        for scheme in [Scheme::CentralDifference, Scheme::Tchamwa { phi: 1.1 }] {
+            let settings = Settings {
+                time_step: TimeStep::Auto,
+                output_interval: Some(1e-4),
+                ..settings(scheme, 0.0, duration)
+            };
+            let scalar = simulate_on(pulp::Arch::Scalar, &model, &settings).expect("scalar run");
+            let simd = simulate_on(pulp::Arch::new(), &model, &settings).expect("SIMD run");
+            let impacts: u64 = scalar.contact_statistics.iter().map(|s| s.impacts).sum();
+            assert!(impacts > 2, "the case must exercise contacts: {impacts} impacts");
+            let agree = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-9 * scale;
+            for (s, v) in scalar.contact_statistics.iter().zip(&simd.contact_statistics) {
+                assert_eq!(s.impacts, v.impacts, "{modes} modes, {scheme:?}");
+                assert!(
+                    agree(s.max_force, v.max_force, 1.0 + s.max_force),
+                    "{s:?} vs {v:?}"
+                );
+                assert!(agree(s.impulse, v.impulse, 1e-3 + s.impulse), "{s:?} vs {v:?}");
+                assert!(
+                    agree(s.max_penetration, v.max_penetration, 1e-4),
+                    "{s:?} vs {v:?}"
+                );
+            }
+            for (s, v) in scalar.contact_forces.iter().zip(&simd.contact_forces) {
+                let peak = s.iter().fold(1.0f64, |m, f| m.max(f.abs()));
+                assert!(
+                    s.iter().zip(v).all(|(a, b)| agree(*a, *b, peak)),
+                    "{modes} modes, {scheme:?}"
+                );
+            }
+            for (s, v) in scalar.pin_extremes.iter().zip(&simd.pin_extremes) {
+                assert!(agree(s.max_abs_deflection, v.max_abs_deflection, 1e-4) && s.height == v.height);
+            }
+            let scale = scalar.energy.initial + scalar.energy.external_work.abs();
+            assert!(agree(
+                scalar.energy.dissipated_contact,
+                simd.energy.dissipated_contact,
+                scale
+            ));
+            assert!(agree(scalar.energy.kinetic, simd.energy.kinetic, scale));
         }
-        for (s, v) in scalar.pin_extremes.iter().zip(&simd.pin_extremes) {
-            assert!(agree(s.max_abs_deflection, v.max_abs_deflection, 1e-4) && s.height == v.height);
-        }
-        let scale = scalar.energy.initial + scalar.energy.external_work.abs();
-        assert!(agree(
-            scalar.energy.dissipated_contact,
-            simd.energy.dissipated_contact,
-            scale
-        ));
-        assert!(agree(scalar.energy.kinetic, simd.energy.kinetic, scale));
     }
 }
 
