@@ -458,13 +458,17 @@ impl<'m> Integrator<'m> {
         let lanes = lane_contacts.len();
         let (now, before) = (&self.penetration[..lanes], &self.previous_penetration[..lanes]);
         let (forces, statistics) = (&mut self.contact_force[..lanes], &mut self.statistics[..lanes]);
-        for &closed in &self.closed[..count] {
-            let j = closed as usize;
+        let closed = &self.closed[..count];
+        // Two passes over the closed contacts: the forces first (their dot products are
+        // independent of each other, so they overlap), then their projection on the
+        // modes (whose only dependencies are through the rows they update).
+        for &j in closed {
+            let j = j as usize;
             let contact = lane_contacts[j];
             let (penetration, previous) = (now[j], before[j]);
-            let shape = &shapes[contact.shape..][..n];
             let rate = if contact.dashpot > 0.0 {
                 let rows = |offset: usize| (&v[offset..], &a[offset..]);
+                let shape = &shapes[contact.shape..][..n];
                 penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead)
             } else {
                 0.0
@@ -488,7 +492,12 @@ impl<'m> Integrator<'m> {
                     stats.max_force_time = t;
                 }
             }
+        }
+        for &j in closed {
+            let j = j as usize;
+            let (contact, force) = (lane_contacts[j], forces[j]);
             if force != 0.0 {
+                let shape = &shapes[contact.shape..][..n];
                 if contact.left != wall {
                     row_axpy(simd, -force, shape, &mut loads[contact.left..]);
                 }
