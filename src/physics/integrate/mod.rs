@@ -223,9 +223,17 @@ fn integrate_on(
     let mut run = Integrator::new(arch, model, settings, (dt, critical));
     let (total_steps, output_every) = step_counts(settings.duration, dt, settings.output_interval);
     run.record_sample(0.0);
-    for n in 1..=total_steps {
+    let mut n = 0;
+    while n < total_steps {
+        // Steps run in batches up to the next check, sample or progress call, all in
+        // one SIMD context.
+        let next = [DIVERGENCE_CHECK_EVERY, output_every, PROGRESS_EVERY]
+            .iter()
+            .map(|every| (n / every + 1) * every)
+            .fold(total_steps, u64::min);
+        run.steps(n + 1..=next);
+        n = next;
         let t = n as f64 * dt;
-        run.step(t);
         if n % DIVERGENCE_CHECK_EVERY == 0 || n == total_steps {
             run.check_divergence(t)?;
         }

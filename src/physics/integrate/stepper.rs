@@ -118,12 +118,12 @@ pub(super) struct Integrator<'m> {
 }
 
 /// What [`StepOp`] does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 enum Operation {
     /// The contact and point forces at t = 0.
     Initial,
-    /// One step.
-    Step,
+    /// The steps of this range (step n ends at t = n·Δt).
+    Steps(std::ops::RangeInclusive<u64>),
     /// The deflection of every pin at every node, into `node_deflections`.
     NodeDeflections,
 }
@@ -150,16 +150,16 @@ impl pulp::WithSimd for StepOp<'_, '_> {
             }
             // The usual row lengths get a copy of the step where the row length is a
             // constant: every per-row loop is then unrolled, without bounds checks.
-            Operation::Step => match vectors {
-                1 => integrator.step_body(simd, self.t, 1),
-                2 => integrator.step_body(simd, self.t, 2),
-                3 => integrator.step_body(simd, self.t, 3),
-                4 => integrator.step_body(simd, self.t, 4),
-                5 => integrator.step_body(simd, self.t, 5),
-                6 => integrator.step_body(simd, self.t, 6),
-                7 => integrator.step_body(simd, self.t, 7),
-                8 => integrator.step_body(simd, self.t, 8),
-                _ => integrator.step_body(simd, self.t, vectors),
+            Operation::Steps(steps) => match vectors {
+                1 => integrator.steps_body(simd, steps, 1),
+                2 => integrator.steps_body(simd, steps, 2),
+                3 => integrator.steps_body(simd, steps, 3),
+                4 => integrator.steps_body(simd, steps, 4),
+                5 => integrator.steps_body(simd, steps, 5),
+                6 => integrator.steps_body(simd, steps, 6),
+                7 => integrator.steps_body(simd, steps, 7),
+                8 => integrator.steps_body(simd, steps, 8),
+                _ => integrator.steps_body(simd, steps, vectors),
             },
             Operation::NodeDeflections => level_deflections(
                 simd,
@@ -509,14 +509,22 @@ impl<'m> Integrator<'m> {
         dissipation_power
     }
 
-    /// Advances from t − Δt to t, compiled for the best SIMD level of this CPU.
-    pub(super) fn step(&mut self, t: f64) {
+    /// Takes the steps of `steps` (step n advances to t = n·Δt), compiled for the best
+    /// SIMD level of this CPU.
+    pub(super) fn steps(&mut self, steps: std::ops::RangeInclusive<u64>) {
         let arch = self.arch;
         arch.dispatch(StepOp {
             integrator: self,
-            t,
-            operation: Operation::Step,
+            t: 0.0,
+            operation: Operation::Steps(steps),
         });
+    }
+
+    #[inline(always)]
+    fn steps_body<S: Simd>(&mut self, simd: S, steps: std::ops::RangeInclusive<u64>, vectors: usize) {
+        for n in steps {
+            self.step_body(simd, n as f64 * self.dt, vectors);
+        }
     }
 
     /// One step; `vectors` is the row length in vectors (a constant in the usual cases).
