@@ -316,8 +316,8 @@ pub(super) struct ContactState<'a> {
     pub max: &'a mut [f64],
     /// Receives the closed lanes, in order.
     pub closed: &'a mut [u32],
-    /// Scratch: the groups with a closed lane (one per group).
-    pub closed_groups: &'a mut [u32],
+    /// Scratch: the groups with a closed lane, as bits (one word per 64 groups).
+    pub closed_groups: &'a mut [u64],
 }
 
 /// For every group: penetrations and running maxima; returns how many lanes are closed
@@ -338,25 +338,33 @@ pub(super) fn penetrations<S: Simd>(
     let (max, _) = S::as_mut_simd_f64s(state.max);
     let (left, right) = (&layout.left[..groups], &layout.right[..groups]);
     let (gaps, now, max) = (&gaps[..groups], &mut now[..groups], &mut max[..groups]);
-    let closed_groups = &mut state.closed_groups[..groups];
-    let mut any = 0;
-    for g in 0..groups {
-        let n = simd.sub_f64s(
-            simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize]),
-            gaps[g],
-        );
-        now[g] = n;
-        max[g] = simd.max_f64s(max[g], n);
-        // Most groups hold no closed contact: one test each, no branch.
-        closed_groups[any] = g as u32;
-        any += usize::from(simd.reduce_max_f64s(n) > 0.0);
+    // The groups holding a closed lane, as bits: most groups hold none, one test each
+    // and no branch, no store at a data-dependent address.
+    let words = &mut state.closed_groups[..groups.div_ceil(64)];
+    for (w, word) in words.iter_mut().enumerate() {
+        let mut bits = 0u64;
+        for g in w * 64..groups.min(w * 64 + 64) {
+            let n = simd.sub_f64s(
+                simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize]),
+                gaps[g],
+            );
+            now[g] = n;
+            max[g] = simd.max_f64s(max[g], n);
+            bits |= u64::from(simd.reduce_max_f64s(n) > 0.0) << (g % 64);
+        }
+        *word = bits;
     }
     let lanes = layout.lanes;
     let mut count = 0;
-    for &g in &closed_groups[..any] {
-        for lane in g as usize * lanes..(g as usize + 1) * lanes {
-            state.closed[count] = lane as u32;
-            count += usize::from(state.now[lane] > 0.0);
+    for (w, word) in words.iter().enumerate() {
+        let mut bits = *word;
+        while bits != 0 {
+            let g = w * 64 + bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            for lane in g * lanes..(g + 1) * lanes {
+                state.closed[count] = lane as u32;
+                count += usize::from(state.now[lane] > 0.0);
+            }
         }
     }
     count
@@ -583,7 +591,7 @@ mod tests {
         let lanes_total = layout.len();
         let (mut now, mut max) = (vec![0.0; lanes_total], vec![0.2; lanes_total]);
         let mut closed = vec![0; lanes_total];
-        let mut closed_groups = vec![0; groups];
+        let mut closed_groups = vec![0; groups.div_ceil(64)];
         let count = penetrations(
             simd,
             &layout,

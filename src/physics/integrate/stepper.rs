@@ -82,7 +82,7 @@ pub(super) struct Integrator<'m> {
     /// Scratch: the lanes closed now (the only ones that need more than a penetration),
     /// and the groups holding them.
     closed: Vec<u32>,
-    closed_groups: Vec<u32>,
+    closed_groups: Vec<u64>,
     /// w of every pin at every level, block-major (see [`level_deflections`]); the wall
     /// slots stay 0.
     level_deflections: Vec<f64>,
@@ -352,7 +352,7 @@ impl<'m> Integrator<'m> {
             previous_penetration: vec![0.0; lane_count],
             max_penetration: vec![f64::NEG_INFINITY; lane_count],
             closed: vec![0; lane_count],
-            closed_groups: vec![0; groups],
+            closed_groups: vec![0; groups.div_ceil(64)],
             level_deflections: vec![0.0; level_blocks * stride * lanes],
             point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
             output_shapes: settings.output_heights.iter().map(|h| shape_at(*h)).collect(),
