@@ -1,23 +1,35 @@
 //! State and step of one run: the hot loop.
 //!
 //! Layout: pin-major. Each pin's modal coordinates are one contiguous row of `row`
-//! values (the modes rounded up to whole SIMD blocks of [`BLOCK`]; padded modes have
-//! ω = 0, Γ = 0, ψ = 0 and stay 0). A closed contact then reads and writes whole rows:
-//! its dashpot velocity ψ·ṽ is one contiguous dot product and its force projection one
-//! contiguous axpy, both in SIMD blocks.
+//! values (the modes rounded up to whole SIMD vectors; padded modes have ω = 0, Γ = 0,
+//! ψ = 0 and stay 0). A closed contact then reads and writes whole rows: its dashpot
+//! velocity ψ·ṽ is one contiguous dot product and its force projection one contiguous
+//! axpy. The deflections at the contact levels are block-major (a vector holds one
+//! pin's deflections at `lanes` consecutive levels), and the contacts are laid out by
+//! the lanes of those vectors ([`ContactLanes`]): every per-contact array is stored by
+//! lane and mapped back to contact order for samples and results.
 //!
-//! Where the time goes (row17: 17 pins × 20 modes, 10 levels, 180 contacts, about 15 %
-//! of them closed at a time; about 16 000 instructions per step, counted with
-//! callgrind, against 41 000 for the mode-major, autovectorized version before it):
-//! 1. the deflection of every pin at every contact level ([`level_deflections`]): per
-//!    pin, 20 coordinates broadcast against 3 blocks of 4 levels, ~1 000 FMAs, plus
-//!    the scatter into the level-major layout (about a third of the step);
-//! 2. a vector pass over every contact ([`penetrations`], contacts cut in runs of
-//!    consecutive slots): penetration, running maximum, zero force where open, and
-//!    the list of closed ones;
-//! 3. the closed contacts only: dashpot velocity, force, statistics, force projection;
-//! 4. the modal update ([`modal_update`]), which also accumulates the dissipated and
-//!    external powers.
+//! The step is instantiated for rows of 1 to 8 vectors (up to 32 modes with AVX2), so
+//! that every per-row loop is unrolled; longer rows take the same code with a run-time
+//! length. Steps run in batches between two checks or samples, in one SIMD context.
+//!
+//! Where the time goes (row17: 17 pins × 20 modes, 10 levels, 180 contacts, about 15
+//! of them closed at a time; about 12 000 instructions per step counted with
+//! callgrind, against 16 000 for the previous pin-major version and 41 000 for the
+//! first, mode-major one; shares of the step from `perf` samples):
+//! 1. the deflection of every pin at every contact level ([`level_deflections`]): two
+//!    pins at a time, 20 coordinates broadcast against 3 blocks of 4 levels, ~1 000
+//!    FMAs, close to the FMA throughput of the CPU (~20 %);
+//! 2. one vector pass over the groups of contacts ([`penetrations`]): penetration,
+//!    running maximum, and a bit per group holding a closed contact (~20 %);
+//! 3. the closed contacts only, in two passes: dashpot rate, force and statistics, then
+//!    the force projection (~25 %);
+//! 4. the modal update ([`modal_update`]), which also applies the base excitation,
+//!    clears the loads and accumulates the dissipated and external powers (~16 %),
+//!    and the first half of the update ([`advance_positions`], ~7 %).
+//! Two things measured slower and are not done: a masked store of zero forces for the
+//! open contacts (microcoded on AMD), and reading lanes back as scalars right after a
+//! vector store (the store cannot be forwarded).
 //!
 //! The step is dispatched through `pulp` so that it is compiled for the SIMD level of
 //! the running CPU (AVX2 + FMA on x86-64-v3) without unsafe code; see [`kernels`] for
