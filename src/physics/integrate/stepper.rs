@@ -27,6 +27,7 @@
 //! 4. the modal update ([`modal_update`]), which also applies the base excitation,
 //!    clears the loads and accumulates the dissipated and external powers (~16 %),
 //!    and the first half of the update ([`advance_positions`], ~7 %).
+//!
 //! Two things measured slower and are not done: a masked store of zero forces for the
 //! open contacts (microcoded on AMD), and reading lanes back as scalars right after a
 //! vector store (the store cannot be forwarded).
