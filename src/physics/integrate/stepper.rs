@@ -145,7 +145,6 @@ enum Operation {
 /// is compiled with the target features [`pulp::Arch`] detected at run time.
 struct StepOp<'a, 'm> {
     integrator: &'a mut Integrator<'m>,
-    t: f64,
     operation: Operation,
 }
 
@@ -159,7 +158,7 @@ impl pulp::WithSimd for StepOp<'_, '_> {
         debug_assert_eq!(integrator.lanes, lanes::<S>());
         match self.operation {
             Operation::Initial => {
-                integrator.contact_forces_and_statistics(simd, self.t, false, vectors);
+                integrator.contact_forces_and_statistics(simd, 0.0, false, vectors);
             }
             // The usual row lengths get a copy of the step where the row length is a
             // constant: every per-row loop is then unrolled, without bounds checks.
@@ -391,7 +390,6 @@ impl<'m> Integrator<'m> {
         // equilibrium (velocities are zero).
         arch.dispatch(StepOp {
             integrator: &mut integrator,
-            t: 0.0,
             operation: Operation::Initial,
         });
         for (contact, lane) in contacts.iter().zip(&integrator.layout.lane) {
@@ -528,7 +526,6 @@ impl<'m> Integrator<'m> {
         let arch = self.arch;
         arch.dispatch(StepOp {
             integrator: self,
-            t: 0.0,
             operation: Operation::Steps(steps),
         });
     }
@@ -669,7 +666,6 @@ impl<'m> Integrator<'m> {
         let arch = self.arch;
         arch.dispatch(StepOp {
             integrator: self,
-            t,
             operation: Operation::NodeDeflections,
         });
         let (lanes, stride) = (self.lanes, self.stride);
