@@ -95,6 +95,14 @@ impl Table {
         values[upper - 1] + weight * (values[upper] - values[upper - 1])
     }
 
+    /// The shortest interval between two samples (s); ∞ with fewer than two.
+    pub fn shortest_interval(&self) -> f64 {
+        self.time
+            .windows(2)
+            .map(|pair| pair[1] - pair[0])
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Checks the table; `values_field` names the value column (`acceleration`, `force`).
     pub fn validate(&self, values_field: &str) -> Vec<InputIssue> {
         let mut issues = Vec::new();

@@ -9,7 +9,7 @@ use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
 use super::inputs::{self, at};
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::contact::Contact;
-use crate::physics::integrate::{Model, Settings, simulate_resolved, step_counts};
+use crate::physics::integrate::{Check, Model, Settings, StepSize, run_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
 
 /// Most pins in one row.
@@ -23,8 +23,6 @@ pub const DEFAULT_OUTPUT_INTERVAL: f64 = 1e-4;
 
 #[derive(Debug)]
 struct Prepared {
-    /// (time step, critical step) (s), resolved once.
-    steps: (f64, f64),
     inputs: BundleInputs,
     pins: usize,
     contacts: Vec<Contact>,
@@ -60,10 +58,15 @@ impl Prepared {
     /// What the run costs: pins × modes modal DOFs and every contact at each step;
     /// histories `contact_forces` (time + one column per contact) and `displacements`
     /// (time + one column per pin and output height).
-    fn estimate(&self) -> WorkEstimate {
-        let (dt, _) = self.steps;
-        let (steps, every) = step_counts(self.settings.duration, dt, self.settings.output_interval);
-        let columns = (1 + self.contacts.len()) + (1 + self.pins * self.settings.output_heights.len());
+    fn estimate(&self, step: &StepSize) -> WorkEstimate {
+        let (steps, every) = step_counts(self.settings.duration, step, self.settings.output_interval);
+        // Each history and its peaks.
+        let columns = 2 * ((1 + self.contacts.len()) + (1 + self.pins * self.settings.output_heights.len()));
+        // The step-halving check takes twice the steps of the run.
+        let check = match self.settings.check {
+            Check::StepHalving => 3.0,
+            Check::None => 1.0,
+        };
         let generated = self.inputs.bundle.is_some();
         let (pins, contacts) = if generated {
             ("/inputs/bundle/pins", "/inputs/bundle/levels")
@@ -79,7 +82,7 @@ impl Prepared {
             history_drivers.push("/inputs/output/heights".to_owned());
         }
         WorkEstimate {
-            steps: steps as f64,
+            steps: check * steps as f64,
             modal_dofs: (self.pins * self.basis.modes()) as f64,
             contacts: self.contacts.len() as f64,
             history_values: (steps / every + 1) as f64 * columns as f64,
@@ -97,7 +100,14 @@ impl Prepared {
     }
 }
 
-fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
+/// Validated inputs and the step they run with.
+#[derive(Debug)]
+struct Plan {
+    prepared: Prepared,
+    step: StepSize,
+}
+
+fn prepare(json: &serde_json::Value) -> Result<Plan, InvalidInputs> {
     let inputs: BundleInputs = inputs::parse(json)?;
     let length = inputs.pin.length;
     let mut errors: Vec<FieldError> = at("/inputs/pin", inputs.pin.validate());
@@ -200,14 +210,7 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
         errors.extend(at(&prefix, force.physics().force.validate("force")));
     }
 
-    let solver = &inputs.solver;
-    let (scheme, time_step) = inputs::solver(
-        solver.scheme,
-        solver.phi,
-        solver.time_step,
-        solver.duration,
-        &mut errors,
-    );
+    let solver = inputs::solver(inputs.solver.fields(), &mut errors);
     inputs::check_output_interval(inputs.output.interval, &mut errors);
     let heights = inputs.output.heights.clone().unwrap_or_else(|| vec![length]);
     if heights.is_empty() {
@@ -231,27 +234,29 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
     let basis = ModalBasis::compute(&inputs.pin.spec(), inputs.pin.modes)
         .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/pin/modes", e.to_string())]))?;
     let settings = Settings {
-        scheme,
-        time_step,
+        scheme: solver.scheme,
+        time_step: solver.time_step,
+        tolerance: solver.tolerance,
+        check: solver.check,
         duration: inputs.solver.duration,
         output_interval: Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
         output_heights: heights,
     };
-    let mut prepared = Prepared {
-        steps: (0.0, 0.0),
+    let prepared = Prepared {
         inputs,
         pins,
         contacts,
         basis,
         settings,
     };
-    prepared.steps = check_costs(&prepared)?;
-    Ok(prepared)
+    let step = check_costs(&prepared)?;
+    Ok(Plan { prepared, step })
 }
 
-fn check_costs(prepared: &Prepared) -> Result<(f64, f64), InvalidInputs> {
+fn check_costs(prepared: &Prepared) -> Result<StepSize, InvalidInputs> {
     let model = prepared.model();
-    let (dt, critical) = inputs::resolve_step(&model, &prepared.settings)?;
+    let step = inputs::resolve_step(&model, &prepared.settings)?;
+    let dt = step.time_step;
     let duration = prepared.settings.duration;
     let steps = duration / dt;
     let mut errors = Vec::new();
@@ -277,7 +282,7 @@ fn check_costs(prepared: &Prepared) -> Result<(f64, f64), InvalidInputs> {
         ));
     }
     if errors.is_empty() {
-        Ok((dt, critical))
+        Ok(step)
     } else {
         Err(InvalidInputs(errors))
     }
@@ -313,11 +318,15 @@ impl Process for BundleDynamics {
                                "schema": {"type": "string", "contentMediaType": "text/csv"}},
             "displacements": {"title": "Pin deflections (m)", "description": "CSV columns time (s), p0, p1, ... (pin tips; `p<pin>@<height>` for other heights)",
                               "schema": {"type": "string", "contentMediaType": "text/csv"}},
+            "contact_forces_peaks": {"title": "Contact force peaks (N)", "description": "As contact_forces, each value the largest force reached at any step of its output interval: the maximum of column c<k> is contact k's max_force",
+                               "schema": {"type": "string", "contentMediaType": "text/csv"}},
+            "displacements_peaks": {"title": "Pin deflection peaks (m)", "description": "As displacements, each value the deflection of largest magnitude (signed) reached at any step of its output interval",
+                              "schema": {"type": "string", "contentMediaType": "text/csv"}},
         })
     }
 
     fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs> {
-        prepare(inputs).map(|prepared| prepared.estimate())
+        prepare(inputs).map(|plan| plan.prepared.estimate(&plan.step))
     }
 
     fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
@@ -325,9 +334,10 @@ impl Process for BundleDynamics {
     }
 
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
-        let prepared = prepare(inputs)?;
+        let Plan { prepared, step } = prepare(inputs)?;
         let model = prepared.model();
-        let simulation = simulate_resolved(&model, &prepared.settings, prepared.steps, progress)?;
+        let assessed = run_resolved(&model, &prepared.settings, &step, progress)?;
+        let (simulation, quality) = (assessed.simulation, assessed.quality);
 
         let contacts: Vec<serde_json::Value> = prepared
             .contacts
@@ -367,9 +377,11 @@ impl Process for BundleDynamics {
                 "external_work": simulation.energy.external_work, "initial": simulation.energy.initial,
                 "residual": simulation.energy.residual(), "relative_residual": simulation.energy.relative_residual(),
             },
-            "time_step": simulation.time_step,
-            "critical_time_step": simulation.critical_time_step,
+            "time_step": simulation.step.time_step,
+            "critical_time_step": simulation.step.critical_time_step,
             "steps": simulation.steps,
+            "output_interval": simulation.output_interval,
+            "quality": quality,
             "frequencies_hz": prepared.basis.frequencies_hz(),
         });
         if prepared.inputs.bundle.is_some() {
@@ -426,23 +438,28 @@ fn histories(prepared: &Prepared, simulation: crate::physics::integrate::Simulat
             displacement_series.push((name, values));
         }
     }
-    let force_series = simulation
-        .contact_forces
-        .into_iter()
-        .enumerate()
-        .map(|(c, v)| (format!("c{c}"), v))
+    let named = |prefix: &str, columns: Vec<Vec<f64>>| -> Vec<(String, Vec<f64>)> {
+        columns
+            .into_iter()
+            .enumerate()
+            .map(|(c, v)| (format!("{prefix}{c}"), v))
+            .collect()
+    };
+    let peak_series = displacement_series
+        .iter()
+        .map(|(name, _)| name.clone())
+        .zip(simulation.deflection_peaks.into_iter().flatten())
         .collect();
+    let history = |name: &str, series| History {
+        name: name.into(),
+        time: simulation.time.clone(),
+        series,
+    };
     vec![
-        History {
-            name: "contact_forces".into(),
-            time: simulation.time.clone(),
-            series: force_series,
-        },
-        History {
-            name: "displacements".into(),
-            time: simulation.time,
-            series: displacement_series,
-        },
+        history("contact_forces", named("c", simulation.contact_forces)),
+        history("displacements", displacement_series),
+        history("contact_forces_peaks", named("c", simulation.contact_force_peaks)),
+        history("displacements_peaks", peak_series),
     ]
 }
 

@@ -360,13 +360,38 @@ pub struct SolverInput {
     pub scheme: SchemeInput,
     /// Tchamwa–Wielgosz parameter φ in [1, 2] (default 1.1).
     pub phi: Option<f64>,
-    /// Time step (s) or "auto" (0.8 × the critical step; the default).
+    /// Time step (s) or "auto" (the default): chosen for accuracy at `tolerance` within
+    /// stability, a whole number of steps per output interval.
     #[serde(default = "auto")]
     pub time_step: TimeStepInput,
     /// Simulated duration (s), default 0.2 s.
     #[serde(default = "default_duration")]
     pub duration: f64,
+    /// Relative accuracy target in (0, 1), default 1e-3: `auto` picks its step so that
+    /// the energy balance closes within it and peaks are within 10 × it, and
+    /// `quality.verdict` judges against it. Larger values trade accuracy for speed (sweeps).
+    #[serde(default = "super::inputs::default_tolerance")]
+    #[schema(default = 1e-3, exclusive_minimum = 0.0, exclusive_maximum = 1.0)]
+    pub tolerance: f64,
+    /// Accuracy check: `step_halving` (default; the run repeated at Δt/2, three times the
+    /// cost) or `none` (cheap sweeps).
+    #[serde(default)]
+    pub check: super::inputs::CheckInput,
 }
+impl SolverInput {
+    /// The fields the shared solver checks read.
+    pub fn fields(&self) -> super::inputs::SolverFields {
+        super::inputs::SolverFields {
+            scheme: self.scheme,
+            phi: self.phi,
+            time_step: self.time_step,
+            duration: self.duration,
+            tolerance: self.tolerance,
+            check: self.check,
+        }
+    }
+}
+
 impl Default for SolverInput {
     fn default() -> Self {
         Self {
@@ -374,6 +399,8 @@ impl Default for SolverInput {
             phi: None,
             time_step: auto(),
             duration: default_duration(),
+            tolerance: super::inputs::default_tolerance(),
+            check: super::inputs::CheckInput::default(),
         }
     }
 }

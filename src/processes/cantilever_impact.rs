@@ -11,7 +11,7 @@ use super::inputs::{self, BeamInput, SchemeInput, SupportInput, TimeStepInput, a
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
-use crate::physics::integrate::{Model, Settings, simulate_resolved, step_counts};
+use crate::physics::integrate::{Model, Settings, StepSize, run_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
@@ -83,13 +83,38 @@ pub struct SolverInput {
     pub scheme: SchemeInput,
     /// Tchamwa–Wielgosz parameter φ in [1, 2] (default 1.1).
     pub phi: Option<f64>,
-    /// Time step (s) or "auto" (default 1e-5 s).
+    /// Time step (s) or "auto" (chosen for accuracy at `tolerance` within stability);
+    /// default 1e-5 s.
     #[serde(default = "default_time_step")]
     pub time_step: TimeStepInput,
     /// Simulated duration (s) (default 0.5 s).
     #[serde(default = "default_duration")]
     pub duration: f64,
+    /// Relative accuracy target in (0, 1), default 1e-3: `auto` picks its step so that
+    /// the energy balance closes within it and peaks are within 10 × it, and
+    /// `quality.verdict` judges against it. Larger values trade accuracy for speed (sweeps).
+    #[serde(default = "super::inputs::default_tolerance")]
+    #[schema(default = 1e-3, exclusive_minimum = 0.0, exclusive_maximum = 1.0)]
+    pub tolerance: f64,
+    /// Accuracy check: `step_halving` (default; the run repeated at Δt/2, three times the
+    /// cost) or `none` (cheap sweeps).
+    #[serde(default)]
+    pub check: super::inputs::CheckInput,
 }
+impl SolverInput {
+    /// The fields the shared solver checks read.
+    pub fn fields(&self) -> super::inputs::SolverFields {
+        super::inputs::SolverFields {
+            scheme: self.scheme,
+            phi: self.phi,
+            time_step: self.time_step,
+            duration: self.duration,
+            tolerance: self.tolerance,
+            check: self.check,
+        }
+    }
+}
+
 impl Default for SolverInput {
     fn default() -> Self {
         Self {
@@ -97,6 +122,8 @@ impl Default for SolverInput {
             phi: None,
             time_step: default_time_step(),
             duration: default_duration(),
+            tolerance: super::inputs::default_tolerance(),
+            check: super::inputs::CheckInput::default(),
         }
     }
 }
@@ -137,8 +164,6 @@ pub struct OutputInput {
 /// Validated inputs, ready to run.
 #[derive(Debug)]
 struct Prepared {
-    /// (time step, critical step) (s), resolved once.
-    steps: (f64, f64),
     inputs: CantileverInputs,
     basis: ModalBasis,
     contact_stiffness: f64,
@@ -169,9 +194,13 @@ impl Prepared {
 
     /// What the run costs: one pin of `modes` modes and one contact per step; two
     /// histories of three columns (time, numerical, reference).
-    fn estimate(&self) -> WorkEstimate {
-        let (dt, _) = self.steps;
-        let (steps, every) = step_counts(self.settings.duration, dt, self.settings.output_interval);
+    fn estimate(&self, step: &StepSize) -> WorkEstimate {
+        let (steps, every) = step_counts(self.settings.duration, step, self.settings.output_interval);
+        // The step-halving check takes twice the steps of the run.
+        let check = match self.settings.check {
+            crate::physics::integrate::Check::StepHalving => 3.0,
+            crate::physics::integrate::Check::None => 1.0,
+        };
         let mut history_drivers = vec![
             "/inputs/solver/duration".to_owned(),
             "/inputs/output/interval".to_owned(),
@@ -180,10 +209,11 @@ impl Prepared {
             history_drivers.push("/inputs/solver/time_step".to_owned());
         }
         WorkEstimate {
-            steps: steps as f64,
+            steps: check * steps as f64,
             modal_dofs: self.basis.modes() as f64,
             contacts: 1.0,
-            history_values: (steps / every + 1) as f64 * 6.0,
+            // tip_displacement and contact_force, and their peaks.
+            history_values: (steps / every + 1) as f64 * 12.0,
             work_drivers: [
                 "/inputs/solver/duration",
                 "/inputs/solver/time_step",
@@ -196,7 +226,14 @@ impl Prepared {
     }
 }
 
-fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
+/// Validated inputs and the step they run with.
+#[derive(Debug)]
+struct Plan {
+    prepared: Prepared,
+    step: StepSize,
+}
+
+fn prepare(json: &serde_json::Value) -> Result<Plan, InvalidInputs> {
     let inputs: CantileverInputs = inputs::parse(json)?;
     let mut errors: Vec<FieldError> = at("/inputs/beam", inputs.beam.validate());
     let supports = inputs.beam.supports;
@@ -239,14 +276,7 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
         ));
     }
 
-    let solver = &inputs.solver;
-    let (scheme, time_step) = inputs::solver(
-        solver.scheme,
-        solver.phi,
-        solver.time_step,
-        solver.duration,
-        &mut errors,
-    );
+    let solver = inputs::solver(inputs.solver.fields(), &mut errors);
     if !(1..=MAX_MODES).contains(&inputs.reference.modes) {
         errors.push(FieldError::new(
             "/inputs/reference/modes",
@@ -261,8 +291,10 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
     let basis = ModalBasis::compute(&spec, inputs.beam.modes)
         .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/beam/modes", e.to_string())]))?;
     let settings = Settings {
-        scheme,
-        time_step,
+        scheme: solver.scheme,
+        time_step: solver.time_step,
+        tolerance: solver.tolerance,
+        check: solver.check,
         duration: inputs.solver.duration,
         output_interval: inputs.output.interval,
         output_heights: vec![spec.length],
@@ -282,22 +314,22 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
         modes: inputs.reference.modes,
         max_events: 100_000,
     };
-    let mut prepared = Prepared {
-        steps: (0.0, 0.0),
+    let prepared = Prepared {
         inputs,
         basis,
         contact_stiffness,
         settings,
         reference,
     };
-    prepared.steps = check_costs(&prepared)?;
-    Ok(prepared)
+    let step = check_costs(&prepared)?;
+    Ok(Plan { prepared, step })
 }
 
 /// Refuses steps above the critical one, histories too long, references too costly.
-fn check_costs(prepared: &Prepared) -> Result<(f64, f64), InvalidInputs> {
+fn check_costs(prepared: &Prepared) -> Result<StepSize, InvalidInputs> {
     let model = prepared.model();
-    let (dt, critical) = inputs::resolve_step(&model, &prepared.settings)?;
+    let step = inputs::resolve_step(&model, &prepared.settings)?;
+    let dt = step.time_step;
     let duration = prepared.settings.duration;
     let mut errors = Vec::new();
     if duration / dt > inputs::MAX_STEPS {
@@ -333,7 +365,7 @@ fn check_costs(prepared: &Prepared) -> Result<(f64, f64), InvalidInputs> {
         ));
     }
     if errors.is_empty() {
-        Ok((dt, critical))
+        Ok(step)
     } else {
         Err(InvalidInputs(errors))
     }
@@ -368,26 +400,29 @@ impl Process for CantileverImpact {
             json!({"title": what, "description": format!("{what}: CSV columns time (s), numerical, reference"),
                    "schema": {"type": "string", "contentMediaType": "text/csv"}})
         };
+        let peaks = |what: &str| {
+            json!({"title": format!("{what}, peaks"),
+                   "description": format!("{what}: per output interval, the extreme over every step of the interval (largest magnitude, signed); CSV columns time (s), numerical, reference (the reference sampled at the integrator's step)"),
+                   "schema": {"type": "string", "contentMediaType": "text/csv"}})
+        };
         json!({
             "tip_displacement": history("Tip deflection (m)"),
             "contact_force": history("Contact force (N)"),
+            "tip_displacement_peaks": peaks("Tip deflection (m)"),
+            "contact_force_peaks": peaks("Contact force (N)"),
         })
     }
 
     fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs> {
-        prepare(inputs).map(|prepared| prepared.estimate())
+        prepare(inputs).map(|plan| plan.prepared.estimate(&plan.step))
     }
 
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
-        let prepared = prepare(inputs)?;
+        let Plan { prepared, step } = prepare(inputs)?;
         let model = prepared.model();
         let mut numerical_progress = |fraction: f64| progress(0.9 * fraction);
-        let simulation = simulate_resolved(
-            &model,
-            &prepared.settings,
-            prepared.steps,
-            &mut numerical_progress,
-        )?;
+        let assessed = run_resolved(&model, &prepared.settings, &step, &mut numerical_progress)?;
+        let (simulation, quality) = (assessed.simulation, assessed.quality);
         let solution = prepared
             .reference
             .solve(&mut |fraction| progress(0.9 + 0.1 * fraction))
@@ -397,13 +432,12 @@ impl Process for CantileverImpact {
             })?;
 
         let time = simulation.time.clone();
-        let interval = if time.len() > 1 {
-            time[1] - time[0]
-        } else {
-            simulation.time_step
-        };
+        let interval = simulation.output_interval;
         let sampled = solution
             .sample_uniform(0.0, interval, time.len())
+            .map_err(|e| RunError::Failed(format!("reference sampling: {e}")))?;
+        let every = step.output_every(prepared.settings.output_interval);
+        let reference_peaks = reference_peaks(&solution, time.len(), interval, every)
             .map_err(|e| RunError::Failed(format!("reference sampling: {e}")))?;
         let numerical_tip = simulation.deflections[0][0].clone();
         let f_err = spectral_error(&numerical_tip, &sampled.tip_deflection)
@@ -447,9 +481,10 @@ impl Process for CantileverImpact {
                 "contact_time": stats.contact_time,
                 "impulse": stats.impulse,
                 "min_tip_displacement": -gap - stats.max_penetration,
-                "time_step": simulation.time_step,
-                "critical_time_step": simulation.critical_time_step,
+                "time_step": simulation.step.time_step,
+                "critical_time_step": simulation.step.critical_time_step,
                 "steps": simulation.steps,
+                "output_interval": simulation.output_interval,
                 "frequencies_hz": prepared.basis.frequencies_hz(),
                 "energy": simulation.energy,
             },
@@ -471,28 +506,64 @@ impl Process for CantileverImpact {
                 "threshold": AGREEMENT_THRESHOLD,
                 "agrees": f_err < AGREEMENT_THRESHOLD,
             },
+            "quality": quality,
         });
         let contact_force = simulation.contact_forces[0].clone();
+        let pair = |name: &str, numerical: Vec<f64>, reference: Vec<f64>| History {
+            name: name.into(),
+            time: time.clone(),
+            series: vec![("numerical".into(), numerical), ("reference".into(), reference)],
+        };
+        let mut deflection_peaks = simulation.deflection_peaks;
         let histories = vec![
-            History {
-                name: "tip_displacement".into(),
-                time: time.clone(),
-                series: vec![
-                    ("numerical".into(), numerical_tip),
-                    ("reference".into(), sampled.tip_deflection),
-                ],
-            },
-            History {
-                name: "contact_force".into(),
-                time,
-                series: vec![
-                    ("numerical".into(), contact_force),
-                    ("reference".into(), sampled.contact_force),
-                ],
-            },
+            pair("tip_displacement", numerical_tip, sampled.tip_deflection),
+            pair("contact_force", contact_force, sampled.contact_force),
+            pair(
+                "tip_displacement_peaks",
+                std::mem::take(&mut deflection_peaks[0][0]),
+                reference_peaks.tip_deflection,
+            ),
+            pair(
+                "contact_force_peaks",
+                simulation.contact_force_peaks[0].clone(),
+                reference_peaks.contact_force,
+            ),
         ];
         Ok(RunOutput { document, histories })
     }
+}
+
+/// Per output interval, the extremes of the reference sampled at the integrator's step
+/// (`every` steps per interval; sample 0 is the value at t = 0): the largest |tip
+/// deflection| (signed) and the largest contact force, as the numerical peaks are.
+fn reference_peaks(
+    solution: &crate::physics::reference::ReferenceSolution,
+    samples: usize,
+    interval: f64,
+    every: u64,
+) -> Result<crate::physics::reference::TipHistory, crate::physics::reference::ReferenceError> {
+    let mut peaks = solution.sample_uniform(0.0, interval, samples.min(1))?;
+    let every = every as usize;
+    let fine = interval / every as f64;
+    // A bounded number of fine samples at a time.
+    let intervals_per_chunk = (1 << 16) / every + 1;
+    let mut k = 1;
+    while k < samples {
+        let count = intervals_per_chunk.min(samples - k);
+        let start = (k - 1) as f64 * interval + fine;
+        let chunk = solution.sample_uniform(start, fine, count * every)?;
+        for j in 0..count {
+            let range = j * every..(j + 1) * every;
+            let tip = chunk.tip_deflection[range.clone()]
+                .iter()
+                .fold(0.0f64, |m, w| if w.abs() > m.abs() { *w } else { m });
+            let force = chunk.contact_force[range].iter().fold(0.0f64, |m, f| m.max(*f));
+            peaks.tip_deflection.push(tip);
+            peaks.contact_force.push(force);
+        }
+        k += count;
+    }
+    Ok(peaks)
 }
 
 #[cfg(test)]

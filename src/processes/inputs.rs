@@ -12,7 +12,7 @@ use utoipa::ToSchema;
 use super::{FieldError, InvalidInputs};
 use crate::physics::InputIssue;
 use crate::physics::beam::{BeamSpec, Section, Support};
-use crate::physics::integrate::TimeStep;
+use crate::physics::integrate::{Check, DEFAULT_TOLERANCE, TimeStep};
 use crate::physics::stability::Scheme;
 
 /// A uniform, slender Euler–Bernoulli beam (one fuel pin) and its modal truncation.
@@ -204,7 +204,8 @@ pub enum SchemeInput {
     Tchamwa,
 }
 
-/// A time step in seconds, or `"auto"` (0.8 × the critical step).
+/// A time step in seconds, or `"auto"`: chosen for accuracy (the tolerance) within
+/// stability, dividing the output interval.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(untagged, expecting = "a time step in seconds or \"auto\"")]
 pub enum TimeStepInput {
@@ -217,6 +218,32 @@ pub enum TimeStepInput {
 #[serde(rename_all = "snake_case")]
 pub enum AutoKeyword {
     Auto,
+}
+
+/// The accuracy check of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckInput {
+    /// Repeat the whole run at half the step and compare the peaks and the impact count
+    /// (triples the cost; `quality.step_halving`).
+    #[default]
+    StepHalving,
+    /// No repeated run: the verdict rests on the energy balance and the steps per period.
+    None,
+}
+
+impl From<CheckInput> for Check {
+    fn from(value: CheckInput) -> Self {
+        match value {
+            CheckInput::StepHalving => Check::StepHalving,
+            CheckInput::None => Check::None,
+        }
+    }
+}
+
+/// Default relative tolerance of `solver.tolerance`.
+pub fn default_tolerance() -> f64 {
+    DEFAULT_TOLERANCE
 }
 
 /// Largest number of time steps one run may take.
@@ -265,20 +292,47 @@ pub fn time_step(step: TimeStepInput, duration: f64, issues: &mut Vec<InputIssue
     }
 }
 
-/// The scheme and time step of a `solver` block, its problems reported under
-/// `/inputs/solver`.
-pub fn solver(
-    scheme_input: SchemeInput,
-    phi: Option<f64>,
-    step: TimeStepInput,
-    duration: f64,
-    errors: &mut Vec<FieldError>,
-) -> (Scheme, TimeStep) {
+/// What a `solver` block sets, checked.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverSettings {
+    pub scheme: Scheme,
+    pub time_step: TimeStep,
+    pub tolerance: f64,
+    pub check: Check,
+}
+
+/// The fields of a `solver` block (both processes share them).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverFields {
+    pub scheme: SchemeInput,
+    pub phi: Option<f64>,
+    pub time_step: TimeStepInput,
+    pub duration: f64,
+    pub tolerance: f64,
+    pub check: CheckInput,
+}
+
+/// The settings of a `solver` block, its problems reported under `/inputs/solver`.
+pub fn solver(fields: SolverFields, errors: &mut Vec<FieldError>) -> SolverSettings {
     let mut issues = Vec::new();
-    let scheme = scheme(scheme_input, phi, &mut issues);
-    let time_step = time_step(step, duration, &mut issues);
+    let scheme = scheme(fields.scheme, fields.phi, &mut issues);
+    let time_step = time_step(fields.time_step, fields.duration, &mut issues);
+    if !(fields.tolerance.is_finite() && fields.tolerance > 0.0 && fields.tolerance < 1.0) {
+        issues.push(InputIssue::new(
+            "tolerance",
+            format!(
+                "must be a relative tolerance between 0 and 1, both excluded (got {})",
+                fields.tolerance
+            ),
+        ));
+    }
     errors.extend(at("/inputs/solver", issues));
-    (scheme, time_step)
+    SolverSettings {
+        scheme,
+        time_step,
+        tolerance: fields.tolerance,
+        check: fields.check.into(),
+    }
 }
 
 /// Checks `output.interval` (s) when given: a positive number of seconds.
@@ -293,12 +347,12 @@ pub fn check_output_interval(interval: Option<f64>, errors: &mut Vec<FieldError>
     }
 }
 
-/// The (time step, critical step) a run will use (s), or a 422 on `/inputs/solver/time_step`
-/// naming both values when a given step exceeds the critical one.
+/// The step a run will use, or a 422 on `/inputs/solver/time_step` naming both values
+/// when a given step exceeds the critical one.
 pub fn resolve_step(
     model: &crate::physics::integrate::Model<'_>,
     settings: &crate::physics::integrate::Settings,
-) -> Result<(f64, f64), InvalidInputs> {
+) -> Result<crate::physics::integrate::StepSize, InvalidInputs> {
     crate::physics::integrate::resolve_time_step(model, settings)
         .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())]))
 }

@@ -13,7 +13,9 @@
 //! Tchamwa–Wielgosz: qₙ₊₁ = qₙ + Δt vₙ + φΔt² aₙ, vₙ₊₁ = vₙ + Δt aₙ, and all
 //! velocity-dependent forces use that vₙ₊₁, which is exact for the scheme.
 //!
-//! A step above the critical one ([`super::stability`]) is refused before running. A run
+//! A step above the critical one ([`super::stability`]) is refused before running;
+//! `auto` picks one for accuracy ([`step_size`]), and [`run`] checks the result by
+//! repeating it at half the step ([`quality`]). A run
 //! whose mechanical energy exceeds what the initial energy and the external work can
 //! supply (or stops being finite) is stopped at once with [`SimulationError::Diverged`]:
 //! no NaN ever leaves this module.
@@ -23,11 +25,11 @@ use std::ops::ControlFlow;
 use super::contact::Contact;
 use super::loads::{BaseAcceleration, PointForce};
 use super::modal::ModalBasis;
-use super::stability::{Scheme, max_angular_frequency};
+use super::stability::Scheme;
 pub use super::statistics::{ContactStatistics, EnergyBalance, PinExtreme};
+pub use quality::{Check, Quality, StepHalving, Verdict};
+pub use step_size::{DEFAULT_TOLERANCE, StepLimit, StepSize, critical_time_step};
 
-/// Fraction of the critical step used by `time_step: auto`.
-pub const AUTO_SAFETY_FACTOR: f64 = 0.8;
 /// Steps between two calls of the progress callback.
 const PROGRESS_EVERY: u64 = 4096;
 /// Steps between two divergence checks.
@@ -55,7 +57,7 @@ pub struct Model<'a> {
 pub enum TimeStep {
     /// This step (s); refused when above the critical step.
     Fixed(f64),
-    /// [`AUTO_SAFETY_FACTOR`] × the critical step.
+    /// Chosen for accuracy within stability ([`step_size`]).
     Auto,
 }
 
@@ -64,10 +66,16 @@ pub enum TimeStep {
 pub struct Settings {
     pub scheme: Scheme,
     pub time_step: TimeStep,
+    /// Relative accuracy target of `auto` and of the quality verdict, in (0, 1)
+    /// ([`DEFAULT_TOLERANCE`]).
+    pub tolerance: f64,
+    /// The accuracy check run with [`run`] ([`simulate`] runs none).
+    pub check: Check,
     /// Simulated duration (s).
     pub duration: f64,
-    /// Time between two history samples (s), rounded to a whole number of steps;
-    /// `None` samples every step. Samples are uniform: t = 0, k·interval, ... ≤ duration.
+    /// Time between two history samples (s), rounded to a whole number of steps (which
+    /// `auto` makes exact); `None` samples every step. Samples are at t = k·interval ≤
+    /// duration.
     pub output_interval: Option<f64>,
     /// Heights (m) where every pin's deflection is recorded.
     pub output_heights: Vec<f64>,
@@ -81,8 +89,16 @@ pub enum SimulationError {
          (contact stiffness included); use at most the critical step or \"auto\""
     )]
     TimeStepAboveCritical { time_step: f64, critical_time_step: f64 },
-    #[error("the integration diverged at t = {time:e} s ({detail}); reduce the time step")]
-    Diverged { time: f64, detail: String },
+    #[error(
+        "the integration diverged at t = {time:e} s ({detail}) with a time step of {time_step:e} s \
+         (critical time step {critical_time_step:e} s); use time_step \"auto\", which picks the step for accuracy"
+    )]
+    Diverged {
+        time: f64,
+        detail: String,
+        time_step: f64,
+        critical_time_step: f64,
+    },
     #[error("cancelled")]
     Cancelled,
 }
@@ -90,18 +106,24 @@ pub enum SimulationError {
 /// Everything a run produces.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Simulation {
-    /// Step used (s).
-    pub time_step: f64,
-    /// Critical step of the scheme with every contact closed (s).
-    pub critical_time_step: f64,
+    /// The step used and its stability limit.
+    pub step: StepSize,
     /// Number of steps taken.
     pub steps: u64,
+    /// Time between two samples actually used (s); sample k is at exactly k × this.
+    pub output_interval: f64,
     /// Sample times (s).
     pub time: Vec<f64>,
     /// `deflections[h][p]`: deflection (m) of pin p at output height h, per sample.
     pub deflections: Vec<Vec<Vec<f64>>>,
+    /// `deflection_peaks[h][p]`: per sample, the deflection of largest magnitude (signed)
+    /// reached at any step since the previous sample (the sample itself included).
+    pub deflection_peaks: Vec<Vec<Vec<f64>>>,
     /// Contact force (N) of each contact, per sample.
     pub contact_forces: Vec<Vec<f64>>,
+    /// Per contact and sample, the largest force reached at any step since the previous
+    /// sample: its maximum over the run is the contact's `max_force` exactly.
+    pub contact_force_peaks: Vec<Vec<f64>>,
     /// Per contact, accumulated at every step.
     pub contact_statistics: Vec<ContactStatistics>,
     /// Per pin.
@@ -112,44 +134,86 @@ pub struct Simulation {
     pub mechanical_energy: Vec<f64>,
 }
 
-/// Critical time step (s) of `scheme` for this model, all contacts closed.
-pub fn critical_time_step(model: &Model<'_>, scheme: Scheme) -> f64 {
-    let shapes: Vec<Vec<f64>> = model
-        .contacts
-        .iter()
-        .map(|c| model.basis.deflection_at(c.height))
-        .collect();
-    let omega_max = max_angular_frequency(
-        model.basis.angular_frequencies(),
-        model.pins,
-        &model.contacts,
-        &shapes,
-    );
-    scheme.stability_limit() / omega_max
+/// A run with its accuracy assessment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assessed {
+    pub simulation: Simulation,
+    pub quality: Quality,
 }
 
 /// The step a run will use, or why it cannot run.
-pub fn resolve_time_step(model: &Model<'_>, settings: &Settings) -> Result<(f64, f64), SimulationError> {
-    let critical = critical_time_step(model, settings.scheme);
-    match settings.time_step {
-        TimeStep::Auto => Ok((AUTO_SAFETY_FACTOR * critical, critical)),
-        TimeStep::Fixed(dt) if dt > critical * (1.0 + 1e-12) => Err(SimulationError::TimeStepAboveCritical {
-            time_step: dt,
-            critical_time_step: critical,
-        }),
-        TimeStep::Fixed(dt) => Ok((dt, critical)),
-    }
+pub fn resolve_time_step(model: &Model<'_>, settings: &Settings) -> Result<StepSize, SimulationError> {
+    step_size::resolve(model, settings)
 }
 
-/// Integrates the model. `progress` is called every few thousand steps with the
-/// fraction done; `ControlFlow::Break` stops the run with [`SimulationError::Cancelled`].
+/// Integrates the model once, with no accuracy check. `progress` is called every few
+/// thousand steps with the fraction done; `ControlFlow::Break` stops the run with
+/// [`SimulationError::Cancelled`].
 pub fn simulate(
     model: &Model<'_>,
     settings: &Settings,
     progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
 ) -> Result<Simulation, SimulationError> {
-    let (dt, critical) = resolve_time_step(model, settings)?;
-    integrate_with_step(model, settings, dt, critical, progress)
+    let step = resolve_time_step(model, settings)?;
+    integrate_on(pulp::Arch::new(), model, settings, &step, progress)
+}
+
+/// Integrates the model and assesses the result: the check of `settings.check` (the whole
+/// run again at Δt/2 for step halving), then the verdict ([`quality`]).
+pub fn run(
+    model: &Model<'_>,
+    settings: &Settings,
+    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+) -> Result<Assessed, SimulationError> {
+    let step = resolve_time_step(model, settings)?;
+    run_resolved(model, settings, &step, progress)
+}
+
+/// [`run`] with a step already resolved by [`resolve_time_step`] (callers that validated
+/// the step first need not solve the stability eigenproblem twice).
+pub fn run_resolved(
+    model: &Model<'_>,
+    settings: &Settings,
+    step: &StepSize,
+    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+) -> Result<Assessed, SimulationError> {
+    if step.time_step > step.critical_time_step * (1.0 + 1e-12) {
+        return Err(SimulationError::TimeStepAboveCritical {
+            time_step: step.time_step,
+            critical_time_step: step.critical_time_step,
+        });
+    }
+    let arch = pulp::Arch::new();
+    // The check takes twice the steps of the run: a third of the progress for the run.
+    let share = match settings.check {
+        Check::StepHalving => 1.0 / 3.0,
+        Check::None => 1.0,
+    };
+    let simulation = integrate_on(arch, model, settings, step, &mut |f| progress(share * f))?;
+    let step_halving = match settings.check {
+        Check::None => None,
+        Check::StepHalving => {
+            let started = std::time::Instant::now();
+            let halved = step.halved();
+            // The same samples, so that the repeated run costs no more memory per step.
+            let settings = Settings {
+                output_interval: Some(simulation.output_interval),
+                ..settings.clone()
+            };
+            let check = integrate_on(arch, model, &settings, &halved, &mut |f| {
+                progress(share + (1.0 - share) * f)
+            })?;
+            Some(quality::step_halving(
+                settings.scheme,
+                step,
+                quality::KeyFigures::of(&simulation),
+                quality::KeyFigures::of(&check),
+                (check.steps, simulation.steps, started.elapsed().as_secs_f64()),
+            ))
+        }
+    };
+    let quality = quality::assess(&simulation, step, settings.tolerance, step_halving);
+    Ok(Assessed { simulation, quality })
 }
 
 /// Runs with step `dt` whatever the critical step (tests probe instability with it).
@@ -159,7 +223,14 @@ fn simulate_unchecked(
     settings: &Settings,
     dt: f64,
 ) -> Result<Simulation, SimulationError> {
-    integrate_with_step(model, settings, dt, f64::NAN, &mut |_| ControlFlow::Continue(()))
+    let step = StepSize {
+        time_step: dt,
+        ..resolve_time_step(model, &Settings {
+            time_step: TimeStep::Auto,
+            ..settings.clone()
+        })?
+    };
+    integrate_on(pulp::Arch::new(), model, settings, &step, &mut |_| ControlFlow::Continue(()))
 }
 
 /// [`simulate`] at the SIMD level `arch` (tests compare the vector and scalar layouts).
@@ -169,47 +240,15 @@ fn simulate_on(
     model: &Model<'_>,
     settings: &Settings,
 ) -> Result<Simulation, SimulationError> {
-    let (dt, critical) = resolve_time_step(model, settings)?;
-    integrate_on(arch, model, settings, (dt, critical), &mut |_| {
-        ControlFlow::Continue(())
-    })
+    let step = resolve_time_step(model, settings)?;
+    integrate_on(arch, model, settings, &step, &mut |_| ControlFlow::Continue(()))
 }
 
-/// Integrates with a step already resolved by [`resolve_time_step`] (`dt`, `critical`):
-/// callers that validated the step first need not solve the stability eigenproblem twice.
-pub fn simulate_resolved(
-    model: &Model<'_>,
-    settings: &Settings,
-    (dt, critical): (f64, f64),
-    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
-) -> Result<Simulation, SimulationError> {
-    if dt > critical * (1.0 + 1e-12) {
-        return Err(SimulationError::TimeStepAboveCritical {
-            time_step: dt,
-            critical_time_step: critical,
-        });
-    }
-    integrate_with_step(model, settings, dt, critical, progress)
-}
-
-/// Steps of a run and the number of steps between two history samples:
-/// (⌊duration/Δt⌋ (never past the duration), round(interval/Δt) or 1 without an interval).
-/// A run records `steps / every + 1` samples.
-pub fn step_counts(duration: f64, dt: f64, interval: Option<f64>) -> (u64, u64) {
-    // Never past the duration: the last step ends at or (by rounding) just before it.
-    let total_steps = ((duration / dt) * (1.0 + 1e-12)).floor().max(1.0) as u64;
-    let output_every = interval.map_or(1, |interval| ((interval / dt).round() as u64).max(1));
-    (total_steps, output_every)
-}
-
-fn integrate_with_step(
-    model: &Model<'_>,
-    settings: &Settings,
-    dt: f64,
-    critical: f64,
-    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
-) -> Result<Simulation, SimulationError> {
-    integrate_on(pulp::Arch::new(), model, settings, (dt, critical), progress)
+/// Steps of a run and the number of steps between two history samples (cost
+/// estimates): (⌊duration/Δt⌋ (never past the duration), round(interval/Δt) or 1 without
+/// an interval). A run records `steps / every + 1` samples.
+pub fn step_counts(duration: f64, step: &StepSize, interval: Option<f64>) -> (u64, u64) {
+    (step.steps(duration), step.output_every(interval))
 }
 
 /// The time loop, with the step compiled for the SIMD level `arch`.
@@ -217,11 +256,12 @@ fn integrate_on(
     arch: pulp::Arch,
     model: &Model<'_>,
     settings: &Settings,
-    (dt, critical): (f64, f64),
+    step: &StepSize,
     progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
 ) -> Result<Simulation, SimulationError> {
-    let mut run = Integrator::new(arch, model, settings, (dt, critical));
-    let (total_steps, output_every) = step_counts(settings.duration, dt, settings.output_interval);
+    let mut run = Integrator::new(arch, model, settings, step);
+    let (total_steps, output_every) = step_counts(settings.duration, step, settings.output_interval);
+    let interval = step.output_interval(settings.output_interval);
     run.record_sample(0.0);
     let mut n = 0;
     while n < total_steps {
@@ -233,21 +273,23 @@ fn integrate_on(
             .fold(total_steps, u64::min);
         run.steps(n + 1..=next);
         n = next;
-        let t = n as f64 * dt;
         if n % DIVERGENCE_CHECK_EVERY == 0 || n == total_steps {
-            run.check_divergence(t)?;
+            run.check_divergence(n as f64 * step.time_step)?;
         }
         if n % output_every == 0 {
-            run.record_sample(t);
+            // Exactly k × interval, not a sum of steps.
+            run.record_sample((n / output_every) as f64 * interval);
         }
         if n % PROGRESS_EVERY == 0 && progress(n as f64 / total_steps as f64).is_break() {
             return Err(SimulationError::Cancelled);
         }
     }
-    Ok(run.finish(dt, critical, total_steps))
+    Ok(run.finish(total_steps, interval))
 }
 
 mod kernels;
+pub mod quality;
+pub mod step_size;
 mod stepper;
 
 use stepper::Integrator;

@@ -42,14 +42,9 @@ use super::kernels::{
     self, ContactLanes, ContactState, Lanes, LevelShapes, ModalCoefficients, advance_positions, axpy, lanes,
     level_deflections, modal_update, penetration_rate, penetrations, row_axpy,
 };
-use super::{ContactStatistics, EnergyBalance, Model, PinExtreme, Settings, Simulation, SimulationError};
+use super::{ContactStatistics, EnergyBalance, Model, PinExtreme, Settings, Simulation, SimulationError, StepSize};
 use crate::physics::contact::Body;
 use crate::physics::stability::Scheme;
-
-/// Σ x·y outside the hot loop (samples, energies).
-fn dot(x: &[f64], y: &[f64]) -> f64 {
-    kernels::dot(pulp::Scalar::new(), x, y)
-}
 
 /// Pin index of a wall in the contact list (its state row is set when the pins are known).
 const WALL: usize = usize::MAX;
@@ -59,6 +54,7 @@ pub(super) struct Integrator<'m> {
     model: &'m Model<'m>,
     scheme: Scheme,
     dt: f64,
+    step: StepSize,
     /// f64 values per SIMD vector of `arch`.
     lanes: usize,
     /// Length of one pin's row: the modes rounded up to whole vectors.
@@ -99,9 +95,13 @@ pub(super) struct Integrator<'m> {
     /// w of every pin at every level, block-major (see [`level_deflections`]); the wall
     /// slots stay 0.
     level_deflections: Vec<f64>,
-    /// ψ at each point force's and each output height (padded to `row`).
+    /// ψ at each point force's height (padded to `row`).
     point_force_shapes: Vec<Vec<f64>>,
-    output_shapes: Vec<Vec<f64>>,
+    /// The level of each output height among the levels of `level_deflections` (output
+    /// heights that are no contact level are levels with no contact), and per output
+    /// height and pin the deflection of largest magnitude since the last sample.
+    output_levels: Vec<usize>,
+    deflection_peak: Vec<f64>,
     /// Nodal deflection of each mode, for pin extremes, and the nodal deflections of
     /// every pin at the last sample (laid out as `level_deflections`).
     node_shapes: LevelShapes,
@@ -115,6 +115,8 @@ pub(super) struct Integrator<'m> {
     force: Vec<f64>,
     /// Per lane; only meaningful where the penetration is positive (see [`penetrations`]).
     contact_force: Vec<f64>,
+    /// Per lane, the largest force since the last sample.
+    force_peak: Vec<f64>,
     statistics: Vec<ContactStatistics>,
     energy: EnergyBalance,
     previous_power: Powers,
@@ -124,8 +126,10 @@ pub(super) struct Integrator<'m> {
     external_work_peak: f64,
     time: Vec<f64>,
     deflections: Vec<Vec<Vec<f64>>>,
+    deflection_peaks: Vec<Vec<Vec<f64>>>,
     /// Per contact (not by lane).
     contact_forces: Vec<Vec<f64>>,
+    contact_force_peaks: Vec<Vec<f64>>,
     mechanical_energy: Vec<f64>,
     pin_extremes: Vec<PinExtreme>,
 }
@@ -240,8 +244,9 @@ impl<'m> Integrator<'m> {
         arch: pulp::Arch,
         model: &'m Model<'m>,
         settings: &Settings,
-        (dt, critical): (f64, f64),
+        step: &StepSize,
     ) -> Self {
+        let (dt, critical) = (step.time_step, step.critical_time_step);
         let lanes = arch.dispatch(Lanes);
         let basis = model.basis;
         let (pins, modes) = (model.pins, basis.modes());
@@ -261,6 +266,18 @@ impl<'m> Integrator<'m> {
                 Some(level) => level,
                 None => {
                     heights.push(c.height);
+                    heights.len() - 1
+                }
+            })
+            .collect();
+        // The output heights are levels too (with no contact unless one is there).
+        let output_levels: Vec<usize> = settings
+            .output_heights
+            .iter()
+            .map(|h| match heights.iter().position(|level| level == h) {
+                Some(level) => level,
+                None => {
+                    heights.push(*h);
                     heights.len() - 1
                 }
             })
@@ -319,6 +336,7 @@ impl<'m> Integrator<'m> {
             model,
             scheme: settings.scheme,
             dt,
+            step: *step,
             lanes,
             row,
             stride,
@@ -367,7 +385,8 @@ impl<'m> Integrator<'m> {
             closed_groups: vec![0; groups.div_ceil(64)],
             level_deflections: vec![0.0; level_blocks * stride * lanes],
             point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
-            output_shapes: settings.output_heights.iter().map(|h| shape_at(*h)).collect(),
+            deflection_peak: vec![0.0; output_levels.len() * pins],
+            output_levels,
             node_shapes,
             node_deflections: vec![0.0; node_blocks * stride * lanes],
             q,
@@ -375,6 +394,7 @@ impl<'m> Integrator<'m> {
             a: vec![0.0; (pins + 1) * row],
             force: vec![0.0; pins * row],
             contact_force: vec![0.0; lane_count],
+            force_peak: vec![0.0; lane_count],
             statistics: vec![ContactStatistics::default(); lane_count],
             energy: EnergyBalance::default(),
             previous_power: Powers::default(),
@@ -382,7 +402,9 @@ impl<'m> Integrator<'m> {
             external_work_peak: 0.0,
             time: Vec::new(),
             deflections: vec![vec![Vec::new(); pins]; settings.output_heights.len()],
+            deflection_peaks: vec![vec![Vec::new(); pins]; settings.output_heights.len()],
             contact_forces: vec![Vec::new(); contacts.len()],
+            contact_force_peaks: vec![Vec::new(); contacts.len()],
             mechanical_energy: Vec::new(),
             pin_extremes: vec![PinExtreme::default(); pins],
         };
@@ -398,6 +420,9 @@ impl<'m> Integrator<'m> {
                 let stats = &mut integrator.statistics[lane];
                 stats.impacts = 1;
                 stats.first_impact_time = Some(0.0);
+                // The force at t = 0 counts for the peak, as it does in the samples.
+                stats.max_force = integrator.contact_force[lane];
+                stats.max_force_time = 0.0;
             }
         }
         let base = model.base_acceleration.as_ref().map_or(0.0, |b| b.at(0.0));
@@ -469,6 +494,7 @@ impl<'m> Integrator<'m> {
         let lanes = lane_contacts.len();
         let (now, before) = (&self.penetration[..lanes], &self.previous_penetration[..lanes]);
         let (forces, statistics) = (&mut self.contact_force[..lanes], &mut self.statistics[..lanes]);
+        let peaks = &mut self.force_peak[..lanes];
         let closed = &self.closed[..count];
         // Two passes over the closed contacts: the forces first (their dot products are
         // independent of each other, so they overlap), then their projection on the
@@ -488,6 +514,9 @@ impl<'m> Integrator<'m> {
             let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
             forces[j] = force;
             dissipation_power += (force - contact.stiffness * penetration) * rate;
+            if record {
+                peaks[j] = peaks[j].max(force);
+            }
             if record && contact.active {
                 let stats = &mut statistics[j];
                 if previous <= 0.0 {
@@ -557,6 +586,7 @@ impl<'m> Integrator<'m> {
             S::as_simd_f64s(&self.a[..state]).0,
         );
         let contact_damping = self.contact_forces_and_statistics(simd, t, true, vectors);
+        self.track_deflection_peaks();
         let base = self.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
         let second_half = match self.scheme {
             Scheme::CentralDifference => half,
@@ -599,6 +629,29 @@ impl<'m> Integrator<'m> {
         self.previous_power = powers;
     }
 
+    /// Deflection of `pin` at level `level` of `level_deflections` (block-major, the
+    /// walls in slots 0 and pins + 1).
+    #[inline(always)]
+    fn level_deflection(&self, level: usize, pin: usize) -> f64 {
+        let lanes = self.lanes;
+        self.level_deflections[((level / lanes) * self.stride + 1 + pin) * lanes + level % lanes]
+    }
+
+    /// Keeps, per output height and pin, the deflection of largest magnitude.
+    #[inline(always)]
+    fn track_deflection_peaks(&mut self) {
+        let pins = self.model.pins;
+        for (h, &level) in self.output_levels.iter().enumerate() {
+            for p in 0..pins {
+                let w = self.level_deflection(level, p);
+                let peak = &mut self.deflection_peak[h * pins + p];
+                if w.abs() > peak.abs() {
+                    *peak = w;
+                }
+            }
+        }
+    }
+
     fn mechanical_energy_now(&self) -> f64 {
         let modal = self.arch.dispatch(ModalEnergyOp {
             stiffness: &self.omega_squared,
@@ -630,6 +683,8 @@ impl<'m> Integrator<'m> {
             return Err(SimulationError::Diverged {
                 time: t,
                 detail: "non-finite state".into(),
+                time_step: self.dt,
+                critical_time_step: self.step.critical_time_step,
             });
         }
         let dissipated = self.energy.dissipated_modal + self.energy.dissipated_contact;
@@ -639,27 +694,47 @@ impl<'m> Integrator<'m> {
             return Err(SimulationError::Diverged {
                 time: t,
                 detail: format!("the scheme created {created:e} J of energy from {scale:e} J supplied"),
+                time_step: self.dt,
+                critical_time_step: self.step.critical_time_step,
             });
         }
         Ok(())
     }
 
+    /// Records the samples at time `t` (the state is the one of the last step) and the
+    /// peaks since the previous sample, then starts new peaks.
     pub(super) fn record_sample(&mut self, t: f64) {
-        let row = self.row;
         self.time.push(t);
-        for (shape, per_pin) in self.output_shapes.iter().zip(&mut self.deflections) {
-            for (coordinates, history) in self.q.chunks_exact(row).zip(per_pin.iter_mut()) {
-                history.push(dot(shape, coordinates));
+        let pins = self.model.pins;
+        for (h, &level) in self.output_levels.iter().enumerate() {
+            for p in 0..pins {
+                // From the same values as the peaks, so that no sample exceeds its peak.
+                let w = self.level_deflection(level, p);
+                let peak = &mut self.deflection_peak[h * pins + p];
+                if w.abs() > peak.abs() {
+                    *peak = w;
+                }
+                self.deflections[h][p].push(w);
+                self.deflection_peaks[h][p].push(*peak);
+                *peak = 0.0;
             }
         }
-        for (history, lane) in self.contact_forces.iter_mut().zip(&self.layout.lane) {
+        for ((history, peaks), lane) in self
+            .contact_forces
+            .iter_mut()
+            .zip(&mut self.contact_force_peaks)
+            .zip(&self.layout.lane)
+        {
             // Forces are only updated while closed.
             let lane = *lane as usize;
-            history.push(if self.penetration[lane] > 0.0 {
+            let force = if self.penetration[lane] > 0.0 {
                 self.contact_force[lane]
             } else {
                 0.0
-            });
+            };
+            history.push(force);
+            peaks.push(self.force_peak[lane].max(force));
+            self.force_peak[lane] = 0.0;
         }
         self.mechanical_energy.push(self.mechanical_energy_now());
         let element_length = self.model.basis.model().element_length;
@@ -684,7 +759,7 @@ impl<'m> Integrator<'m> {
         }
     }
 
-    pub(super) fn finish(mut self, dt: f64, critical: f64, steps: u64) -> Simulation {
+    pub(super) fn finish(mut self, steps: u64, output_interval: f64) -> Simulation {
         self.energy.kinetic = 0.5 * self.v.iter().map(|v| v * v).sum::<f64>();
         self.energy.contact = self.contact_energy_now();
         self.energy.strain = self.mechanical_energy_now() - self.energy.kinetic - self.energy.contact;
@@ -692,12 +767,14 @@ impl<'m> Integrator<'m> {
             stats.max_penetration = *max;
         }
         Simulation {
-            time_step: dt,
-            critical_time_step: critical,
+            step: self.step,
             steps,
+            output_interval,
             time: self.time,
             deflections: self.deflections,
+            deflection_peaks: self.deflection_peaks,
             contact_forces: self.contact_forces,
+            contact_force_peaks: self.contact_force_peaks,
             contact_statistics: self.layout.by_contact(&self.statistics),
             pin_extremes: self.pin_extremes,
             energy: self.energy,

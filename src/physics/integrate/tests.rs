@@ -27,6 +27,8 @@ fn settings(scheme: Scheme, dt: f64, duration: f64) -> Settings {
     Settings {
         scheme,
         time_step: TimeStep::Fixed(dt),
+        tolerance: DEFAULT_TOLERANCE,
+        check: Check::None,
         duration,
         output_interval: None,
         output_heights: vec![1.0],

@@ -1,0 +1,265 @@
+//! How right a run is: the energy balance, the step against the stability limit and the
+//! fastest motion, and the step-halving check, summed up in a verdict.
+//!
+//! **Step halving.** The run is repeated over its whole duration at Δt/2 and three
+//! results are compared: the peak contact force (largest over all contacts, every
+//! step), the peak deflection (largest |w| at the output heights, every step) and the
+//! total impact count. For a scheme of order p, X(Δt) − X* ≈ (X(Δt) − X(Δt/2)) ·
+//! 2ᵖ/(2ᵖ − 1) (Richardson), so the estimated error of the reported peak is 4/3 of its
+//! relative change for central difference (2 for first-order Tchamwa–Wielgosz). It costs
+//! twice the run. In long chaotic rattling the two runs drift apart whatever the step,
+//! so the change then also measures how sensitive the reported statistics are: a reason
+//! for doubt either way.
+//!
+//! **Verdict** at tolerance τ (`solver.tolerance`, 10⁻³ by default):
+//! - `good`: energy residual ≤ τ, estimated peak errors ≤ 10 τ, impact count change
+//!   ≤ [`IMPACT_COUNT_DOUBT`];
+//! - `poor`: energy residual > 10 τ, or an estimated peak error > [`POOR_FACTOR`] × 10 τ,
+//!   or (without the check) fewer than [`POOR_STEPS_PER_PERIOD`] steps per period of the
+//!   fastest motion;
+//! - `doubtful`: anything between.
+
+use super::step_size::{StepSize, scheme_order};
+use super::Simulation;
+use crate::physics::stability::Scheme;
+
+/// Peaks are held to this multiple of the tolerance (1 % at the default 10⁻³).
+pub const PEAK_TOLERANCE_FACTOR: f64 = 10.0;
+/// An estimated peak error beyond this multiple of the peak tolerance is `poor`.
+pub const POOR_FACTOR: f64 = 2.5;
+/// A relative change of the impact count beyond this is a reason for doubt.
+pub const IMPACT_COUNT_DOUBT: f64 = 0.1;
+/// Fewer steps per period of the fastest motion than this is `poor` when no check runs.
+pub const POOR_STEPS_PER_PERIOD: f64 = 6.0;
+/// Fewer steps per period than this is a reason for doubt when no check runs.
+pub const DOUBTFUL_STEPS_PER_PERIOD: f64 = 15.0;
+
+/// Which accuracy check a run performs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Check {
+    /// Repeat the run at Δt/2 and compare (the default for jobs).
+    #[default]
+    StepHalving,
+    /// No repeated run (cheap sweeps): the verdict rests on the energy balance and the
+    /// steps per period.
+    None,
+}
+
+/// Overall judgement of a run's accuracy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Within the tolerance by every measure.
+    Good,
+    /// Outside the tolerance by some measure, not far enough to call it wrong.
+    Doubtful,
+    /// Do not use the numbers: some measure is far outside the tolerance.
+    Poor,
+}
+
+impl Verdict {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Verdict::Good => "good",
+            Verdict::Doubtful => "doubtful",
+            Verdict::Poor => "poor",
+        }
+    }
+}
+
+/// The results of the step-halving check.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct StepHalving {
+    /// Step of the repeated run (s).
+    pub time_step: f64,
+    /// |F(Δt) − F(Δt/2)| / F(Δt/2) of the peak contact force (0 when no contact closes).
+    pub peak_force_change: f64,
+    /// The same for the peak deflection at the output heights.
+    pub peak_displacement_change: f64,
+    /// |n(Δt) − n(Δt/2)| / max(n(Δt/2), 1) of the total impact count.
+    pub impact_count_change: f64,
+    /// Estimated relative error of the reported peak force (Richardson, see the module).
+    pub estimated_peak_force_error: f64,
+    /// Estimated relative error of the reported peak deflection.
+    pub estimated_peak_displacement_error: f64,
+    /// Steps taken by the check.
+    pub steps: u64,
+    /// Wall time of the check (s).
+    pub seconds: f64,
+    /// Steps of the check over steps of the run (2 for the whole run at Δt/2).
+    pub relative_cost: f64,
+}
+
+/// How right a run is.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Quality {
+    /// |energy balance residual| / largest energy involved.
+    pub energy_residual: f64,
+    /// Δt / critical step.
+    pub time_step_over_critical: f64,
+    /// Steps per period of the fastest motion with the contacts closed, 2π/(ω_max Δt):
+    /// the shortest contact period resolved.
+    pub steps_per_contact_period: f64,
+    /// The tolerance the verdict was judged against.
+    pub tolerance: f64,
+    /// What set the step: `given`, or for `auto` `fastest_motion`, `excitation` or
+    /// `stability`.
+    pub time_step_limited_by: super::step_size::StepLimit,
+    /// `None` when `solver.check` is `none`.
+    pub step_halving: Option<StepHalving>,
+    pub verdict: Verdict,
+    /// One sentence per measure outside the tolerance (empty when `good`).
+    pub reasons: Vec<String>,
+}
+
+/// The figures of a run that the check compares.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct KeyFigures {
+    pub peak_force: f64,
+    pub peak_displacement: f64,
+    pub impacts: u64,
+}
+
+impl KeyFigures {
+    pub fn of(simulation: &Simulation) -> Self {
+        let peak_force = simulation
+            .contact_statistics
+            .iter()
+            .map(|s| s.max_force)
+            .fold(0.0, f64::max);
+        let peak_displacement = simulation
+            .deflection_peaks
+            .iter()
+            .flatten()
+            .flatten()
+            .fold(0.0f64, |m, w| m.max(w.abs()));
+        let impacts = simulation.contact_statistics.iter().map(|s| s.impacts).sum();
+        Self {
+            peak_force,
+            peak_displacement,
+            impacts,
+        }
+    }
+}
+
+/// |coarse − fine| / |fine|; 0 when both are 0, 1 when only the fine one is.
+fn relative_change(coarse: f64, fine: f64) -> f64 {
+    if coarse == fine {
+        0.0
+    } else if fine == 0.0 {
+        1.0
+    } else {
+        (coarse - fine).abs() / fine.abs()
+    }
+}
+
+/// Compares a run with its repetition at Δt/2.
+pub(super) fn step_halving(
+    scheme: Scheme,
+    step: &StepSize,
+    run: KeyFigures,
+    halved: KeyFigures,
+    (steps, run_steps, seconds): (u64, u64, f64),
+) -> StepHalving {
+    let order = scheme_order(scheme);
+    let richardson = 2f64.powf(order) / (2f64.powf(order) - 1.0);
+    let peak_force_change = relative_change(run.peak_force, halved.peak_force);
+    let peak_displacement_change = relative_change(run.peak_displacement, halved.peak_displacement);
+    let impact_count_change =
+        (run.impacts as f64 - halved.impacts as f64).abs() / (halved.impacts.max(1) as f64);
+    StepHalving {
+        time_step: step.halved().time_step,
+        peak_force_change,
+        peak_displacement_change,
+        impact_count_change,
+        estimated_peak_force_error: richardson * peak_force_change,
+        estimated_peak_displacement_error: richardson * peak_displacement_change,
+        steps,
+        seconds,
+        relative_cost: steps as f64 / run_steps.max(1) as f64,
+    }
+}
+
+/// The verdict on a run (see the module doc).
+pub(super) fn assess(
+    simulation: &Simulation,
+    step: &StepSize,
+    tolerance: f64,
+    step_halving: Option<StepHalving>,
+) -> Quality {
+    let energy_residual = simulation.energy.relative_residual();
+    let steps_per_period = step.steps_per_fastest_period();
+    let peak_tolerance = PEAK_TOLERANCE_FACTOR * tolerance;
+    let mut poor = false;
+    let mut reasons = Vec::new();
+    let percent = |x: f64| format!("{:.2} %", 100.0 * x);
+    if energy_residual > tolerance {
+        poor |= energy_residual > PEAK_TOLERANCE_FACTOR * tolerance;
+        reasons.push(format!(
+            "the energy balance is off by {} of the energy involved (tolerance {})",
+            percent(energy_residual),
+            percent(tolerance)
+        ));
+    }
+    match &step_halving {
+        Some(check) => {
+            for (what, change, error) in [
+                (
+                    "peak contact force",
+                    check.peak_force_change,
+                    check.estimated_peak_force_error,
+                ),
+                (
+                    "peak deflection",
+                    check.peak_displacement_change,
+                    check.estimated_peak_displacement_error,
+                ),
+            ] {
+                if error > peak_tolerance {
+                    poor |= error > POOR_FACTOR * peak_tolerance;
+                    reasons.push(format!(
+                        "the {what} changes by {} when the step is halved: estimated error {} (tolerance {})",
+                        percent(change),
+                        percent(error),
+                        percent(peak_tolerance)
+                    ));
+                }
+            }
+            if check.impact_count_change > IMPACT_COUNT_DOUBT {
+                reasons.push(format!(
+                    "the impact count changes by {} when the step is halved",
+                    percent(check.impact_count_change)
+                ));
+            }
+        }
+        None => {
+            if steps_per_period < DOUBTFUL_STEPS_PER_PERIOD {
+                poor |= steps_per_period < POOR_STEPS_PER_PERIOD;
+                reasons.push(format!(
+                    "only {steps_per_period:.1} steps per period of the fastest contact motion \
+                     (at least {DOUBTFUL_STEPS_PER_PERIOD} wanted), and no step-halving check was run"
+                ));
+            }
+        }
+    }
+    if !reasons.is_empty() && step.limited_by == super::step_size::StepLimit::Given {
+        reasons.push("use time_step \"auto\" (it picks the step for the tolerance)".to_owned());
+    }
+    let verdict = if poor {
+        Verdict::Poor
+    } else if reasons.is_empty() {
+        Verdict::Good
+    } else {
+        Verdict::Doubtful
+    };
+    Quality {
+        energy_residual,
+        time_step_over_critical: step.over_critical(),
+        steps_per_contact_period: steps_per_period,
+        tolerance,
+        time_step_limited_by: step.limited_by,
+        step_halving,
+        verdict,
+        reasons,
+    }
+}
