@@ -296,3 +296,6 @@ use stepper::Integrator;
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod accuracy_tests;
