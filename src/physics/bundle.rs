@@ -370,8 +370,9 @@ impl BundleLayout {
     }
 }
 
-/// Level heights (m), snapped onto the pin top when within rounding of it. Callers bound
-/// the count first.
+/// Level heights (m), snapped onto the pin top when within rounding of it; regular
+/// levels as the decimals they stand for (0.2 + 2 × 0.2 is 0.6, not
+/// 0.6000000000000001). Callers bound the count first.
 fn level_heights(levels: &Levels, pin_length: f64) -> Vec<f64> {
     let snap = |height: f64| {
         if (height - pin_length).abs() <= HEIGHT_SNAP_TOLERANCE * pin_length {
@@ -385,7 +386,9 @@ fn level_heights(levels: &Levels, pin_length: f64) -> Vec<f64> {
             first,
             spacing,
             count,
-        } => (0..*count).map(|k| snap(first + k as f64 * spacing)).collect(),
+        } => (0..*count)
+            .map(|k| snap(super::decimal(first + k as f64 * spacing)))
+            .collect(),
         Levels::Explicit(heights) => heights.iter().map(|&h| snap(h)).collect(),
     }
 }

@@ -49,6 +49,16 @@ impl InputIssue {
     }
 }
 
+/// `value` rounded to 12 significant digits: a height computed as `first + k·spacing` or
+/// `node · element length` printed as the decimal it stands for (0.6, not
+/// 0.6000000000000001), 1e-12 relative being far below any geometric meaning.
+pub fn decimal(value: f64) -> f64 {
+    if value == 0.0 || !value.is_finite() {
+        return value;
+    }
+    format!("{value:.11e}").parse().unwrap_or(value)
+}
+
 /// Checks that `value` is finite and strictly positive; records an issue otherwise.
 pub(crate) fn require_positive(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
     if !value.is_finite() {

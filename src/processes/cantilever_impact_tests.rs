@@ -269,3 +269,69 @@ fn tchamwa_scheme_agrees_with_the_reference() {
         "phi only applies to tchamwa"
     );
 }
+
+/// `auto` on the paper's cantilever, soft (Rk = 1) and stiff (Rk = 80) spring: the energy
+/// balance closes within the default tolerance and the peak contact force is within 1 %
+/// (10 × the tolerance) of its Δt → 0 limit, extrapolated (second order) from runs at
+/// Δt/10 and Δt/20; the verdict is good. The contact force peaks, sampled or not, reach
+/// the reported maximum.
+#[test]
+fn auto_is_accurate_on_the_cantilever() {
+    for rk in [1.0, 80.0] {
+        let mut inputs = default_inputs();
+        inputs["contact"]["rk"] = json!(rk);
+        inputs["solver"]["duration"] = json!(0.2);
+        inputs["solver"]["time_step"] = json!("auto");
+        inputs["output"] = json!({"interval": 1e-3});
+        let output = run(&inputs);
+        let doc = &output.document;
+        let quality = &doc["quality"];
+        assert_eq!(quality["verdict"], "good", "Rk {rk}: {quality:#}");
+        let residual = quality["energy_residual"].as_f64().unwrap();
+        assert!(residual <= 1e-3, "Rk {rk}: energy residual {residual:e}");
+        let dt = doc["numerical"]["time_step"].as_f64().unwrap();
+        let peak_at = |step: f64| {
+            let mut fine = inputs.clone();
+            fine["solver"]["time_step"] = json!(step);
+            fine["solver"]["check"] = json!("none");
+            run(&fine).document["numerical"]["max_contact_force"]
+                .as_f64()
+                .unwrap()
+        };
+        let (fine, finer) = (peak_at(dt / 10.0), peak_at(dt / 20.0));
+        let limit = finer + (finer - fine) / 3.0;
+        let peak = doc["numerical"]["max_contact_force"].as_f64().unwrap();
+        assert!(
+            relative(peak, limit) <= 1e-2,
+            "Rk {rk}: peak force {peak} N vs Δt → 0 limit {limit} N"
+        );
+        let peaks = output
+            .histories
+            .iter()
+            .find(|h| h.name == "contact_force_peaks")
+            .unwrap();
+        let envelope = peaks.series[0].1.iter().fold(0.0f64, |m, f| m.max(*f));
+        assert_eq!(envelope, peak, "Rk {rk}: envelope maximum vs max_contact_force");
+        assert_eq!(doc["numerical"]["output_interval"], 1e-3);
+    }
+}
+
+/// Bad solver settings are refused at their pointers: a tolerance outside (0, 1), a check
+/// that is not one of the names.
+#[test]
+fn bad_tolerance_and_check_are_refused_at_their_pointers() {
+    for tolerance in [json!(0.0), json!(-1e-3), json!(1.0), json!(2.0)] {
+        let mut inputs = default_inputs();
+        inputs["solver"]["tolerance"] = tolerance.clone();
+        assert_eq!(
+            pointers(&inputs),
+            ["/inputs/solver/tolerance"],
+            "tolerance {tolerance}"
+        );
+    }
+    let mut inputs = default_inputs();
+    inputs["solver"]["check"] = json!("richardson");
+    let errors = CantileverImpact.validate(&inputs).unwrap_err().0;
+    assert_eq!(errors[0].pointer, "/inputs/solver/check");
+    assert!(errors[0].detail.contains("step_halving"), "{}", errors[0].detail);
+}

@@ -116,6 +116,15 @@ fn row17_benchmark_has_180_contacts_with_the_top_level_on_the_pin() {
         [0.3, 0.3],
         "overshooting top level snapped onto the pin"
     );
+    // Row17's levels are the decimals 0.18, 0.36, …, 1.8, not their float sums
+    // (3 × 0.18 = 0.54 + 1e-16 once accumulated).
+    let heights: Vec<f64> = row17().expand(1.8).unwrap().iter().map(|c| c.height).collect();
+    for (k, decimal) in [0.18, 0.36, 0.54, 0.72, 0.9, 1.08, 1.26, 1.44, 1.62, 1.8]
+        .iter()
+        .enumerate()
+    {
+        assert_eq!(heights[k * 18], *decimal, "level {k}");
+    }
     let layout = row17();
     assert_eq!(layout.contact_count(), 180);
     let contacts = layout.expand(1.8).expect("row17 must expand");

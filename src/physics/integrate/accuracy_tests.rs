@@ -202,7 +202,12 @@ fn auto_closes_the_energy_balance_within_the_tolerance() {
         let basis = row.basis();
         let model = row.model(&basis);
         let assessed = run_at(&model, &row, TimeStep::Auto, Check::None);
-        let impacts: u64 = assessed.simulation.contact_statistics.iter().map(|s| s.impacts).sum();
+        let impacts: u64 = assessed
+            .simulation
+            .contact_statistics
+            .iter()
+            .map(|s| s.impacts)
+            .sum();
         assert!(impacts >= 10, "{name}: the case must rattle, {impacts} impacts");
         let residual = assessed.quality.energy_residual;
         assert!(
@@ -252,7 +257,10 @@ fn auto_peaks_are_within_one_percent_of_the_limit_and_the_check_estimates_the_er
                 "{name}: estimated peak force error {estimate:.2e}, true {error:.2e}"
             );
         } else {
-            assert!(estimate < 3e-4, "{name}: estimate {estimate:.2e}, true {error:.2e}");
+            assert!(
+                estimate < 3e-4,
+                "{name}: estimate {estimate:.2e}, true {error:.2e}"
+            );
         }
         assert_eq!(
             assessed.quality.verdict,
@@ -303,18 +311,27 @@ fn unit_slips_never_diverge_under_auto() {
         ..Row::plausible()
     };
     let slips = [
-        ("E in MPa", Row {
-            young_modulus: 2.1e5,
-            ..base.clone()
-        }),
-        ("length in mm", Row {
-            length: 1200.0,
-            ..base.clone()
-        }),
-        ("gaps in mm", Row {
-            gap: 0.1,
-            ..base.clone()
-        }),
+        (
+            "E in MPa",
+            Row {
+                young_modulus: 2.1e5,
+                ..base.clone()
+            },
+        ),
+        (
+            "length in mm",
+            Row {
+                length: 1200.0,
+                ..base.clone()
+            },
+        ),
+        (
+            "gaps in mm",
+            Row {
+                gap: 0.1,
+                ..base.clone()
+            },
+        ),
     ];
     for (name, row) in slips {
         let basis = row.basis();
@@ -332,7 +349,11 @@ fn unit_slips_never_diverge_under_auto() {
         let assessed = result.unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(
             assessed.quality.energy_residual.is_finite()
-                && assessed.simulation.contact_statistics.iter().all(|s| s.max_force.is_finite()),
+                && assessed
+                    .simulation
+                    .contact_statistics
+                    .iter()
+                    .all(|s| s.max_force.is_finite()),
             "{name}: non-finite results"
         );
     }
@@ -363,11 +384,20 @@ fn peaks_keep_the_extremes_that_samples_miss() {
         let sampled = simulation.contact_forces[k].iter().fold(0.0f64, |m, f| m.max(*f));
         missed += usize::from(sampled < stats.max_force);
         for (sample, peak) in simulation.contact_forces[k].iter().zip(peaks) {
-            assert!(sample <= peak, "contact {k}: sample {sample} above its peak {peak}");
+            assert!(
+                sample <= peak,
+                "contact {k}: sample {sample} above its peak {peak}"
+            );
         }
     }
-    assert!(missed > 0, "sampling every 2 ms must miss some peaks for the test to mean anything");
-    for (samples, peaks) in simulation.deflections[0].iter().zip(&simulation.deflection_peaks[0]) {
+    assert!(
+        missed > 0,
+        "sampling every 2 ms must miss some peaks for the test to mean anything"
+    );
+    for (samples, peaks) in simulation.deflections[0]
+        .iter()
+        .zip(&simulation.deflection_peaks[0])
+    {
         for (w, peak) in samples.iter().zip(peaks) {
             assert!(w.abs() <= peak.abs(), "sample {w} above its peak {peak}");
         }
@@ -478,7 +508,15 @@ fn calibration_table() {
     ));
     let short: Vec<(String, Row)> = cases
         .iter()
-        .map(|(name, row)| (format!("{name}, first 30 ms"), Row { duration: 0.03, ..row.clone() }))
+        .map(|(name, row)| {
+            (
+                format!("{name}, first 30 ms"),
+                Row {
+                    duration: 0.03,
+                    ..row.clone()
+                },
+            )
+        })
         .collect();
     let cases: Vec<(String, Row)> = cases
         .into_iter()
@@ -491,8 +529,10 @@ fn calibration_table() {
         let omega = step_size::max_frequency(&model);
         let period = std::f64::consts::TAU / omega;
         let at = |dt: f64| {
-            simulate(&model, &row.settings(TimeStep::Fixed(dt)), &mut |_| ControlFlow::Continue(()))
-                .map(|s| figures(&s))
+            simulate(&model, &row.settings(TimeStep::Fixed(dt)), &mut |_| {
+                ControlFlow::Continue(())
+            })
+            .map(|s| figures(&s))
         };
         let reference_dt = period / 30.0;
         let (Ok(fine), Ok(finer)) = (at(reference_dt / 10.0), at(reference_dt / 20.0)) else {

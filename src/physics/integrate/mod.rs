@@ -225,12 +225,17 @@ fn simulate_unchecked(
 ) -> Result<Simulation, SimulationError> {
     let step = StepSize {
         time_step: dt,
-        ..resolve_time_step(model, &Settings {
-            time_step: TimeStep::Auto,
-            ..settings.clone()
-        })?
+        ..resolve_time_step(
+            model,
+            &Settings {
+                time_step: TimeStep::Auto,
+                ..settings.clone()
+            },
+        )?
     };
-    integrate_on(pulp::Arch::new(), model, settings, &step, &mut |_| ControlFlow::Continue(()))
+    integrate_on(pulp::Arch::new(), model, settings, &step, &mut |_| {
+        ControlFlow::Continue(())
+    })
 }
 
 /// [`simulate`] at the SIMD level `arch` (tests compare the vector and scalar layouts).

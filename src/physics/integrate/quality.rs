@@ -24,8 +24,8 @@
 //! The impact count is only a reason for doubt: contacts that graze (gap 0) open and
 //! close on rounding, so their count has no Δt → 0 limit.
 
-use super::step_size::{StepSize, scheme_order};
 use super::Simulation;
+use super::step_size::{StepSize, scheme_order};
 use crate::physics::stability::Scheme;
 
 /// Peaks are held to this multiple of the tolerance (1 % at the default 10⁻³).

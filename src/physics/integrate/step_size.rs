@@ -197,7 +197,10 @@ pub fn resolve(model: &Model<'_>, settings: &Settings) -> Result<StepSize, Simul
         TimeStep::Auto => {
             let per_period = steps_per_period(settings.scheme, settings.tolerance);
             let mut candidates = vec![
-                (std::f64::consts::TAU / (omega * per_period), StepLimit::FastestMotion),
+                (
+                    std::f64::consts::TAU / (omega * per_period),
+                    StepLimit::FastestMotion,
+                ),
                 (STABILITY_FRACTION * critical, StepLimit::Stability),
             ];
             if let Some(excitation) = excitation_bound(model, per_period) {

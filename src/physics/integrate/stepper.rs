@@ -42,7 +42,9 @@ use super::kernels::{
     self, ContactLanes, ContactState, Lanes, LevelShapes, ModalCoefficients, advance_positions, axpy, lanes,
     level_deflections, modal_update, penetration_rate, penetrations, row_axpy,
 };
-use super::{ContactStatistics, EnergyBalance, Model, PinExtreme, Settings, Simulation, SimulationError, StepSize};
+use super::{
+    ContactStatistics, EnergyBalance, Model, PinExtreme, Settings, Simulation, SimulationError, StepSize,
+};
 use crate::physics::contact::Body;
 use crate::physics::stability::Scheme;
 
@@ -240,12 +242,7 @@ fn padded(values: &[f64], row: usize, fill: f64) -> Vec<f64> {
 
 impl<'m> Integrator<'m> {
     /// The state at t = 0, for the SIMD level `arch` (normally `pulp::Arch::new()`).
-    pub(super) fn new(
-        arch: pulp::Arch,
-        model: &'m Model<'m>,
-        settings: &Settings,
-        step: &StepSize,
-    ) -> Self {
+    pub(super) fn new(arch: pulp::Arch, model: &'m Model<'m>, settings: &Settings, step: &StepSize) -> Self {
         let (dt, critical) = (step.time_step, step.critical_time_step);
         let lanes = arch.dispatch(Lanes);
         let basis = model.basis;
@@ -751,7 +748,7 @@ impl<'m> Integrator<'m> {
                 if w.abs() > extreme.max_abs_deflection {
                     *extreme = PinExtreme {
                         max_abs_deflection: w.abs(),
-                        height: node as f64 * element_length,
+                        height: crate::physics::decimal(node as f64 * element_length),
                         time: t,
                     };
                 }
