@@ -36,7 +36,9 @@ fn main() {
         println!("benchmarks run with `cargo bench`");
         return;
     }
-    let row17 = example("bundle-row17.json");
+    let mut row17 = example("bundle-row17.json");
+    // The speed target is for the run alone; the check's cost is measured below.
+    row17["solver"]["check"] = serde_json::json!("none");
     let (seconds, output) = best_of(3, || {
         BundleDynamics
             .run(&row17, &mut |_| ControlFlow::Continue(()))
@@ -49,6 +51,8 @@ fn main() {
         1e6 * seconds / steps
     );
 
+    accuracy_costs("row17", &BundleDynamics, &row17, 3);
+
     let cantilever = example("cantilever-impact.json");
     let (seconds, _) = best_of(3, || {
         CantileverImpact
@@ -56,6 +60,9 @@ fn main() {
             .expect("cantilever runs")
     });
     println!("cantilever-impact default case (numerical + reference + f_err): {seconds:.3} s");
+    let mut cantilever_fixed = cantilever.clone();
+    cantilever_fixed["solver"]["check"] = serde_json::json!("none");
+    accuracy_costs("cantilever", &CantileverImpact, &cantilever_fixed, 5);
 
     let reference = chocmodal::physics::reference::CantileverReference {
         length: 1.0,
@@ -81,4 +88,48 @@ fn main() {
         "semi-analytic reference, default case, 30 modes: {:.1} ms",
         1e3 * seconds
     );
+}
+
+/// Prints the cost of `time_step: auto` and of the step-halving check on `inputs` (a
+/// fixed-step run with `check: none`) as ratios to that run, each variant timed as the
+/// best of `runs`, the variants interleaved run by run.
+fn accuracy_costs(name: &str, process: &dyn Process, inputs: &serde_json::Value, runs: usize) {
+    let variant = |time_step: Option<&str>, check: &str| {
+        let mut body = inputs.clone();
+        if let Some(step) = time_step {
+            body["solver"]["time_step"] = serde_json::json!(step);
+        }
+        body["solver"]["check"] = serde_json::json!(check);
+        body
+    };
+    let variants = [
+        ("fixed step", variant(None, "none")),
+        ("fixed step + step-halving check", variant(None, "step_halving")),
+        ("auto", variant(Some("auto"), "none")),
+        ("auto + step-halving check", variant(Some("auto"), "step_halving")),
+    ];
+    let mut best = [f64::INFINITY; 4];
+    let mut steps = [0.0; 4];
+    for _ in 0..runs {
+        for (k, (_, body)) in variants.iter().enumerate() {
+            let start = Instant::now();
+            let output = process
+                .run(body, &mut |_| ControlFlow::Continue(()))
+                .expect("the variant runs");
+            best[k] = best[k].min(start.elapsed().as_secs_f64());
+            let document = &output.document;
+            steps[k] = document["steps"]
+                .as_f64()
+                .or_else(|| document["numerical"]["steps"].as_f64())
+                .unwrap_or(0.0);
+        }
+    }
+    for (k, (label, _)) in variants.iter().enumerate() {
+        println!(
+            "{name} {label}: {:.3} s, {} steps, {:.2} × the fixed-step run",
+            best[k],
+            steps[k],
+            best[k] / best[0]
+        );
+    }
 }

@@ -265,7 +265,8 @@ fn check_costs(prepared: &Prepared) -> Result<StepSize, InvalidInputs> {
         errors.push(FieldError::new(
             "/inputs/solver/duration",
             format!(
-                "{steps:.3e} steps of {dt:e} s over this row is too much work ({work:.3e} > {MAX_WORK:e})"
+                "{steps:.3e} steps of {dt:e} s over this row is too much work ({work:.3e} > {MAX_WORK:e}){}",
+                inputs::step_hint(&prepared.settings)
             ),
         ));
     }

@@ -336,9 +336,10 @@ fn check_costs(prepared: &Prepared) -> Result<StepSize, InvalidInputs> {
         errors.push(FieldError::new(
             "/inputs/solver/duration",
             format!(
-                "needs {:.3e} steps of {dt:e} s, above the limit of {:e}",
+                "needs {:.3e} steps of {dt:e} s, above the limit of {:e}{}",
                 duration / dt,
-                inputs::MAX_STEPS
+                inputs::MAX_STEPS,
+                inputs::step_hint(&prepared.settings)
             ),
         ));
     }

@@ -357,6 +357,18 @@ pub fn resolve_step(
         .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())]))
 }
 
+/// What to add to a "too many steps" refusal: under `auto`, that the tolerance drives
+/// the step.
+pub fn step_hint(settings: &crate::physics::integrate::Settings) -> String {
+    match settings.time_step {
+        TimeStep::Auto => format!(
+            " (time_step \"auto\" chose this step for solver.tolerance {:e}: a larger tolerance takes fewer steps)",
+            settings.tolerance
+        ),
+        TimeStep::Fixed(_) => String::new(),
+    }
+}
+
 /// Turns physics issues into field errors under `prefix` (a JSON pointer).
 pub fn at(prefix: &str, issues: Vec<InputIssue>) -> Vec<FieldError> {
     issues

@@ -51,8 +51,8 @@ async fn a_run_above_the_work_ceiling_is_a_422_naming_the_fields_the_estimate_an
         ..CostLimits::default()
     })
     .await;
-    // 0.5 s / 1e-5 s = 5e4 steps of 10 modes and 1 contact: 5.5e5 updates... twice that
-    // duration is over 1e6.
+    // 1 s / 1e-5 s = 1e5 steps of 10 modes and 1 contact, run once and again at half
+    // the step by the step-halving check (3 × the steps): 3.3e6 updates, over 1e6.
     let mut body = example("cantilever-impact.json");
     body["inputs"]["solver"]["duration"] = json!(1.0);
     let response = app.post_execution("cantilever-impact", &body).await;
@@ -69,7 +69,7 @@ async fn a_run_above_the_work_ceiling_is_a_422_naming_the_fields_the_estimate_an
     assert_eq!(exceeded["quantity"], "work");
     assert_eq!(exceeded["limit"], 1e6);
     let estimate = exceeded["estimate"].as_f64().unwrap();
-    let expected = 1.0 / 1e-5 * 11.0;
+    let expected = 3.0 * 1.0 / 1e-5 * 11.0;
     assert!(
         (estimate - expected).abs() < 1e-6 * expected,
         "estimate {estimate}, expected {expected}"
@@ -79,7 +79,7 @@ async fn a_run_above_the_work_ceiling_is_a_422_naming_the_fields_the_estimate_an
         "{problem}"
     );
 
-    // Half the duration passes (validated, queued).
+    // A twentieth of the duration passes (validated, queued).
     body["inputs"]["solver"]["duration"] = json!(0.05);
     assert_eq!(
         app.post_execution("cantilever-impact", &body).await.status(),
@@ -94,7 +94,8 @@ async fn histories_above_the_ceiling_point_at_the_output_interval() {
         ..CostLimits::default()
     })
     .await;
-    // row17: 0.2 s sampled every 1e-4 s is 2001 samples of 1 + 180 + 1 + 17 columns.
+    // row17: 0.2 s sampled every 1e-4 s is 2001 samples of 1 + 180 + 1 + 17 columns,
+    // twice (each history and its peaks).
     let body = example("bundle-row17.json");
     let response = app.post_execution("bundle-dynamics", &body).await;
     let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/too-costly").await;
@@ -108,7 +109,7 @@ async fn histories_above_the_ceiling_point_at_the_output_interval() {
         "{problem}"
     );
     assert_eq!(problem["exceeded"][0]["quantity"], "history_values");
-    assert_eq!(problem["exceeded"][0]["estimate"], 2001.0 * 199.0);
+    assert_eq!(problem["exceeded"][0]["estimate"], 2.0 * 2001.0 * 199.0);
 }
 
 #[tokio::test]

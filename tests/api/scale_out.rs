@@ -405,7 +405,10 @@ async fn killing_a_worker_mid_job_loses_no_job_and_completes_none_twice() {
     .await
     .unwrap();
     assert_eq!(attempt, 2, "the killed worker's job was claimed again");
-    assert_eq!(owner_histories, 2, "tip_displacement and contact_force");
+    assert_eq!(
+        owner_histories, 4,
+        "tip_displacement, contact_force and their peaks"
+    );
     let results = get_json(&client, &format!("{address}/jobs/{victim}/results")).await;
     assert!(results["comparison"]["f_err"].is_number(), "{results}");
 

@@ -205,11 +205,18 @@ fn critical_step_matches_brute_force_divergence() {
     let stable = simulate(&model, &below, &mut |_| ControlFlow::Continue(()));
     assert!(stable.is_ok(), "stable below critical: {:?}", stable.err());
     let above = simulate_unchecked(&model, &below, 1.01 * critical);
-    assert!(
-        matches!(above, Err(SimulationError::Diverged { .. })),
-        "diverges above critical: {:?}",
-        above.map(|s| s.energy)
-    );
+    let Err(diverged @ SimulationError::Diverged { .. }) = above else {
+        panic!("diverges above critical: {:?}", above.map(|s| s.energy));
+    };
+    // The failure names the step, the critical step, and the way out.
+    let message = diverged.to_string();
+    for expected in [
+        format!("{:e}", 1.01 * critical),
+        format!("{critical:e}"),
+        "\"auto\"".into(),
+    ] {
+        assert!(message.contains(&expected), "{message} lacks {expected}");
+    }
     below.time_step = TimeStep::Fixed(1.01 * critical);
     let refused = simulate(&model, &below, &mut |_| ControlFlow::Continue(()));
     assert!(

@@ -211,6 +211,8 @@ impl Modify for ResourceLinks {
         models::ProcessDescription,
         models::ExecuteRequest,
         models::Results,
+        models::QualityReport,
+        models::StepHalvingReport,
         models::HistoryDocument,
         models::Series,
         spectra::SpectrumDocument,
