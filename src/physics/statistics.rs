@@ -32,6 +32,15 @@ pub struct PinExtreme {
     pub time: f64,
 }
 
+/// The deflection of largest magnitude at one height of one pin, over every step.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct PeakDeflection {
+    /// Signed deflection (m).
+    pub deflection: f64,
+    /// When it occurred (s).
+    pub time: f64,
+}
+
 /// Energy balance of the row in the wrapper frame (J). With exact integration,
 /// kinetic + strain + contact + dissipated − external_work = initial.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]

@@ -364,7 +364,21 @@ impl Process for BundleDynamics {
             .pin_extremes
             .iter()
             .enumerate()
-            .map(|(p, e)| json!({"pin": p, "max_abs_deflection": e.max_abs_deflection, "height": e.height, "time": e.time}))
+            .map(|(p, e)| {
+                // Per output height, the deflection of largest magnitude over every step
+                // (the extreme of its `displacements_peaks` column).
+                let peaks: Vec<serde_json::Value> = prepared
+                    .settings
+                    .output_heights
+                    .iter()
+                    .zip(&simulation.peak_deflections)
+                    .map(|(height, per_pin)| {
+                        json!({"height": height, "deflection": per_pin[p].deflection, "time": per_pin[p].time})
+                    })
+                    .collect();
+                json!({"pin": p, "max_abs_deflection": e.max_abs_deflection, "height": e.height, "time": e.time,
+                       "peak_deflections": peaks})
+            })
             .collect();
         let mut document = json!({
             "contacts": contacts,

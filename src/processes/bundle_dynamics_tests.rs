@@ -195,3 +195,66 @@ fn row17_example_is_the_benchmark_case() {
         assert!(BundleDynamics.validate(&body["inputs"]).is_ok(), "{name}");
     }
 }
+
+/// Row17 (issue 15): samples every 0.1 ms miss the peaks of impacts that last a fraction
+/// of that, but every envelope's maximum is the reported maximum exactly: column c<k> of
+/// `contact_forces_peaks` reaches contact k's `max_force`, column p<p> of
+/// `displacements_peaks` pin p's peak tip deflection, and no sample exceeds its peak.
+/// Samples are at exactly k × 0.1 ms.
+#[test]
+fn row17_envelopes_reach_the_reported_maxima_that_samples_miss() {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/bundle-row17.json")).unwrap();
+    let mut body: Value = serde_json::from_str(&text).unwrap();
+    body["inputs"]["solver"]["check"] = json!("none");
+    let output = run(&body["inputs"]);
+    let doc = &output.document;
+    let history = |name: &str| output.histories.iter().find(|h| h.name == name).unwrap();
+    let (forces, force_peaks) = (history("contact_forces"), history("contact_forces_peaks"));
+    let largest = |values: &[f64]| values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut missed = 0;
+    for (k, contact) in doc["contacts"].as_array().unwrap().iter().enumerate() {
+        let max_force = contact["max_force"].as_f64().unwrap();
+        assert_eq!(force_peaks.series[k].0, format!("c{k}"));
+        assert_eq!(largest(&force_peaks.series[k].1), max_force, "contact {k}");
+        missed += usize::from(largest(&forces.series[k].1) < max_force);
+        for (sample, peak) in forces.series[k].1.iter().zip(&force_peaks.series[k].1) {
+            assert!(
+                sample <= peak,
+                "contact {k}: sample {sample} N above its peak {peak} N"
+            );
+        }
+    }
+    assert!(missed > 10, "only {missed} contacts had a peak between samples");
+    let overall = doc["max_contact_force"]["force"].as_f64().unwrap();
+    assert_eq!(
+        overall,
+        force_peaks
+            .series
+            .iter()
+            .map(|(_, v)| largest(v))
+            .fold(0.0, f64::max)
+    );
+    let (displacements, displacement_peaks) = (history("displacements"), history("displacements_peaks"));
+    for (p, pin) in doc["pins"].as_array().unwrap().iter().enumerate() {
+        let peak = pin["peak_deflections"][0]["deflection"].as_f64().unwrap();
+        assert_eq!(pin["peak_deflections"][0]["height"], 1.8);
+        let column = &displacement_peaks.series[p].1;
+        assert_eq!(largest(column), peak.abs(), "pin {p}");
+        assert!(
+            column.contains(&peak),
+            "pin {p}: the signed peak {peak} is in its column"
+        );
+        for (w, peak) in displacements.series[p].1.iter().zip(column) {
+            assert!(
+                w.abs() <= peak.abs(),
+                "pin {p}: sample {w} m above its peak {peak} m"
+            );
+        }
+    }
+    assert_eq!(doc["output_interval"], 1e-4);
+    for (k, t) in forces.time.iter().enumerate() {
+        assert_eq!(*t, k as f64 * 1e-4, "sample {k}");
+    }
+    assert_eq!(force_peaks.time, forces.time);
+}

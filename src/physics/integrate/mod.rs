@@ -26,7 +26,7 @@ use super::contact::Contact;
 use super::loads::{BaseAcceleration, PointForce};
 use super::modal::ModalBasis;
 use super::stability::Scheme;
-pub use super::statistics::{ContactStatistics, EnergyBalance, PinExtreme};
+pub use super::statistics::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme};
 pub use quality::{Check, Quality, StepHalving, Verdict};
 pub use step_size::{DEFAULT_TOLERANCE, StepLimit, StepSize, critical_time_step};
 
@@ -119,6 +119,9 @@ pub struct Simulation {
     /// `deflection_peaks[h][p]`: per sample, the deflection of largest magnitude (signed)
     /// reached at any step since the previous sample (the sample itself included).
     pub deflection_peaks: Vec<Vec<Vec<f64>>>,
+    /// `peak_deflections[h][p]`: the deflection of largest magnitude of pin p at output
+    /// height h over every step, and when: the extreme of `deflection_peaks[h][p]`.
+    pub peak_deflections: Vec<Vec<PeakDeflection>>,
     /// Contact force (N) of each contact, per sample.
     pub contact_forces: Vec<Vec<f64>>,
     /// Per contact and sample, the largest force reached at any step since the previous

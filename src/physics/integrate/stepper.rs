@@ -43,7 +43,8 @@ use super::kernels::{
     level_deflections, modal_update, penetration_rate, penetrations, row_axpy,
 };
 use super::{
-    ContactStatistics, EnergyBalance, Model, PinExtreme, Settings, Simulation, SimulationError, StepSize,
+    ContactStatistics, EnergyBalance, Model, PeakDeflection, PinExtreme, Settings, Simulation,
+    SimulationError, StepSize,
 };
 use crate::physics::contact::Body;
 use crate::physics::stability::Scheme;
@@ -104,6 +105,8 @@ pub(super) struct Integrator<'m> {
     /// height and pin the deflection of largest magnitude since the last sample.
     output_levels: Vec<usize>,
     deflection_peak: Vec<f64>,
+    /// Per output height and pin, the deflection of largest magnitude over the run.
+    peak_deflections: Vec<PeakDeflection>,
     /// Nodal deflection of each mode, for pin extremes, and the nodal deflections of
     /// every pin at the last sample (laid out as `level_deflections`).
     node_shapes: LevelShapes,
@@ -383,6 +386,7 @@ impl<'m> Integrator<'m> {
             level_deflections: vec![0.0; level_blocks * stride * lanes],
             point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
             deflection_peak: vec![0.0; output_levels.len() * pins],
+            peak_deflections: vec![PeakDeflection::default(); output_levels.len() * pins],
             output_levels,
             node_shapes,
             node_deflections: vec![0.0; node_blocks * stride * lanes],
@@ -583,7 +587,7 @@ impl<'m> Integrator<'m> {
             S::as_simd_f64s(&self.a[..state]).0,
         );
         let contact_damping = self.contact_forces_and_statistics(simd, t, true, vectors);
-        self.track_deflection_peaks();
+        self.track_deflection_peaks(t);
         let base = self.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
         let second_half = match self.scheme {
             Scheme::CentralDifference => half,
@@ -634,9 +638,10 @@ impl<'m> Integrator<'m> {
         self.level_deflections[((level / lanes) * self.stride + 1 + pin) * lanes + level % lanes]
     }
 
-    /// Keeps, per output height and pin, the deflection of largest magnitude.
+    /// Keeps, per output height and pin, the deflection of largest magnitude since the
+    /// last sample and over the run (with its time t).
     #[inline(always)]
-    fn track_deflection_peaks(&mut self) {
+    fn track_deflection_peaks(&mut self, t: f64) {
         let pins = self.model.pins;
         for (h, &level) in self.output_levels.iter().enumerate() {
             for p in 0..pins {
@@ -644,6 +649,13 @@ impl<'m> Integrator<'m> {
                 let peak = &mut self.deflection_peak[h * pins + p];
                 if w.abs() > peak.abs() {
                     *peak = w;
+                    let run = &mut self.peak_deflections[h * pins + p];
+                    if w.abs() > run.deflection.abs() {
+                        *run = PeakDeflection {
+                            deflection: w,
+                            time: t,
+                        };
+                    }
                 }
             }
         }
@@ -710,6 +722,13 @@ impl<'m> Integrator<'m> {
                 let peak = &mut self.deflection_peak[h * pins + p];
                 if w.abs() > peak.abs() {
                     *peak = w;
+                    let run = &mut self.peak_deflections[h * pins + p];
+                    if w.abs() > run.deflection.abs() {
+                        *run = PeakDeflection {
+                            deflection: w,
+                            time: t,
+                        };
+                    }
                 }
                 self.deflections[h][p].push(w);
                 self.deflection_peaks[h][p].push(*peak);
@@ -770,6 +789,11 @@ impl<'m> Integrator<'m> {
             time: self.time,
             deflections: self.deflections,
             deflection_peaks: self.deflection_peaks,
+            peak_deflections: self
+                .peak_deflections
+                .chunks(self.model.pins.max(1))
+                .map(<[_]>::to_vec)
+                .collect(),
             contact_forces: self.contact_forces,
             contact_force_peaks: self.contact_force_peaks,
             contact_statistics: self.layout.by_contact(&self.statistics),
