@@ -188,7 +188,11 @@ fn row17_example_is_the_benchmark_case() {
     let inputs = &body["inputs"];
     assert!(BundleDynamics.validate(inputs).is_ok());
     assert_eq!(inputs["contacts"].as_array().unwrap().len(), 180);
-    for name in ["bundle-random-gaps.json", "bundle-local-closure.json"] {
+    for name in [
+        "bundle-random-gaps.json",
+        "bundle-local-closure.json",
+        "bundle-sine-auto.json",
+    ] {
         let text =
             std::fs::read_to_string(format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap();
         let body: Value = serde_json::from_str(&text).unwrap();
