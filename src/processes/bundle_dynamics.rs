@@ -11,6 +11,7 @@ use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, R
 use crate::physics::contact::Contact;
 use crate::physics::integrate::{Model, Settings, simulate_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
+use super::basis_report::BasisReport;
 
 /// Most pins in one row.
 pub const MAX_PINS: usize = 2000;
@@ -38,7 +39,7 @@ impl Prepared {
         Model {
             basis: &self.basis,
             pins: self.pins,
-            damping_ratios: self.inputs.pin.damping_ratios(),
+            damping_ratios: self.inputs.pin.damping_ratios_for(self.basis.modes()),
             contacts: self.contacts.clone(),
             initial_tip_displacements: tips.clone(),
             base_acceleration: self
@@ -228,8 +229,9 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
         return Err(InvalidInputs(errors));
     }
 
-    let basis = ModalBasis::compute(&inputs.pin.spec(), inputs.pin.modes)
-        .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/pin/modes", e.to_string())]))?;
+    // One static correction per distinct contact height, shared by every pin.
+    let heights: Vec<f64> = contacts.iter().map(|c| c.height).collect();
+    let basis = inputs.pin.basis(&heights, "/inputs/pin")?;
     let settings = Settings {
         scheme,
         time_step,
@@ -371,6 +373,7 @@ impl Process for BundleDynamics {
             "critical_time_step": simulation.critical_time_step,
             "steps": simulation.steps,
             "frequencies_hz": prepared.basis.frequencies_hz(),
+            "basis": BasisReport::of(&model, prepared.settings.scheme, simulation.critical_time_step),
         });
         if prepared.inputs.bundle.is_some() {
             let explicit: Vec<serde_json::Value> = prepared

@@ -13,6 +13,7 @@ use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
 use crate::physics::integrate::{Model, Settings, simulate_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
+use super::basis_report::BasisReport;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
 
@@ -152,7 +153,7 @@ impl Prepared {
         Model {
             basis: &self.basis,
             pins: 1,
-            damping_ratios: self.inputs.beam.damping_ratios(),
+            damping_ratios: self.inputs.beam.damping_ratios_for(self.basis.modes()),
             contacts: vec![Contact {
                 left: Body::Wall,
                 right: Body::Pin(0),
@@ -258,8 +259,8 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
         return Err(InvalidInputs(errors));
     }
 
-    let basis = ModalBasis::compute(&spec, inputs.beam.modes)
-        .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/beam/modes", e.to_string())]))?;
+    // The contact is at the tip: the static correction, if any, is the tip-load shape.
+    let basis = inputs.beam.basis(&[spec.length], "/inputs/beam")?;
     let settings = Settings {
         scheme,
         time_step,
@@ -453,6 +454,7 @@ impl Process for CantileverImpact {
                 "frequencies_hz": prepared.basis.frequencies_hz(),
                 "energy": simulation.energy,
             },
+            "basis": BasisReport::of(&model, prepared.settings.scheme, simulation.critical_time_step),
             "reference": {
                 "first_impact_time": solution.first_impact_time(),
                 "impacts": solution.impact_count(),
