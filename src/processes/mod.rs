@@ -16,6 +16,8 @@ pub mod strict_json;
 
 #[cfg(test)]
 mod robustness_tests;
+#[cfg(test)]
+mod static_correction_tests;
 
 use std::ops::ControlFlow;
 use std::sync::Arc;
