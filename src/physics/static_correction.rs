@@ -102,7 +102,10 @@ pub fn pseudo_modes(
         for _pass in 0..2 {
             for basis_vector in modes.iter().copied().chain(orthonormal.iter().map(Vec::as_slice)) {
                 let c = m_dot(basis_vector, &residual);
-                residual.iter_mut().zip(basis_vector).for_each(|(r, b)| *r -= c * b);
+                residual
+                    .iter_mut()
+                    .zip(basis_vector)
+                    .for_each(|(r, b)| *r -= c * b);
             }
         }
         let left = m_dot(&residual, &residual).sqrt();
@@ -204,10 +207,11 @@ fn allows_rigid_motion(model: &BeamModel) -> bool {
         })
         .collect();
     // Rank 2 iff some pair of rows is independent.
-    !rows
-        .iter()
-        .enumerate()
-        .any(|(i, a)| rows[i + 1..].iter().any(|b| (a[0] * b[1] - a[1] * b[0]).abs() > 1e-12 * (1.0 + model.length)))
+    !rows.iter().enumerate().any(|(i, a)| {
+        rows[i + 1..]
+            .iter()
+            .any(|b| (a[0] * b[1] - a[1] * b[0]).abs() > 1e-12 * (1.0 + model.length))
+    })
 }
 
 fn mat_vec(matrix: &[f64], n: usize, vector: &[f64]) -> Vec<f64> {
@@ -346,7 +350,11 @@ mod tests {
         assert_eq!(basis.modes(), 5, "3 modes + 2 pseudo-modes");
         let complete = spec.free_dof_count();
         let full = ModalBasis::compute_with_static_correction(&spec, complete, &[1.0]).unwrap();
-        assert_eq!(full.modes(), complete, "a complete basis holds every static shape");
+        assert_eq!(
+            full.modes(),
+            complete,
+            "a complete basis holds every static shape"
+        );
         assert_eq!(full.static_correction().unwrap().dropped_heights, vec![1.0]);
     }
 
@@ -360,13 +368,23 @@ mod tests {
             spec.top = top;
             let model = BeamModel::assemble(&spec);
             let error = static_shapes(&model, &[1.0]).unwrap_err();
-            assert_eq!(error, StaticCorrectionError::SingularStiffness, "{foot:?}-{top:?}");
+            assert_eq!(
+                error,
+                StaticCorrectionError::SingularStiffness,
+                "{foot:?}-{top:?}"
+            );
         }
-        for (foot, top) in [(Support::Pinned, Support::Pinned), (Support::Free, Support::Clamped)] {
+        for (foot, top) in [
+            (Support::Pinned, Support::Pinned),
+            (Support::Free, Support::Clamped),
+        ] {
             let mut spec = default_tube(10);
             spec.foot = foot;
             spec.top = top;
-            assert!(static_shapes(&BeamModel::assemble(&spec), &[0.5]).is_ok(), "{foot:?}-{top:?}");
+            assert!(
+                static_shapes(&BeamModel::assemble(&spec), &[0.5]).is_ok(),
+                "{foot:?}-{top:?}"
+            );
         }
     }
 
@@ -429,7 +447,11 @@ mod tests {
         let below = simulate(&corrected, &settings(0.99 * critical, duration), &mut |_| {
             ControlFlow::Continue(())
         });
-        assert!(below.is_ok(), "bounded at 0.99 × critical ({critical:e} s): {:?}", below.err());
+        assert!(
+            below.is_ok(),
+            "bounded at 0.99 × critical ({critical:e} s): {:?}",
+            below.err()
+        );
         let dt = 1.01 * critical;
         let above = simulate_resolved(&corrected, &settings(dt, duration), (dt, dt), &mut |_| {
             ControlFlow::Continue(())
@@ -511,7 +533,8 @@ mod tests {
     fn pin_to_pin_contacts_obey_action_and_reaction_with_the_correction() {
         let basis = ModalBasis::compute_with_static_correction(&default_tube(20), 6, &[0.5, 1.0]).unwrap();
         let mut pair = shaken_row(&basis, [4e-4, -3e-4], true, false);
-        pair.contacts.retain(|c| c.left != Body::Wall && c.right != Body::Wall);
+        pair.contacts
+            .retain(|c| c.left != Body::Wall && c.right != Body::Wall);
         let collided = run(&pair, 0.05);
         let impacts: u64 = collided.contact_statistics.iter().map(|s| s.impacts).sum();
         assert!(impacts >= 2, "the pins must collide: {impacts} impacts");

@@ -5,13 +5,13 @@
 
 use serde_json::json;
 
+use super::basis_report::BasisReport;
 use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
 use super::inputs::{self, at};
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::contact::Contact;
 use crate::physics::integrate::{Model, Settings, simulate_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
-use super::basis_report::BasisReport;
 
 /// Most pins in one row.
 pub const MAX_PINS: usize = 2000;

@@ -7,13 +7,13 @@ use serde::Deserialize;
 use serde_json::json;
 use utoipa::ToSchema;
 
+use super::basis_report::BasisReport;
 use super::inputs::{self, BeamInput, SchemeInput, SupportInput, TimeStepInput, at};
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
 use crate::physics::integrate::{Model, Settings, simulate_resolved, step_counts};
 use crate::physics::modal::ModalBasis;
-use super::basis_report::BasisReport;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
 

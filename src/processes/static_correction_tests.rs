@@ -86,9 +86,7 @@ fn peak_contact_force_converges_faster_in_modes_with_the_correction() {
 }
 
 fn bundle(pin: Value) -> Value {
-    let contact = |left: Value, right: Value, height: f64| {
-        json!({"left": left, "right": right, "height": height, "gap": 1e-4, "stiffness": 2e4})
-    };
+    let contact = |left: Value, right: Value, height: f64| json!({"left": left, "right": right, "height": height, "gap": 1e-4, "stiffness": 2e4});
     json!({
         "pin": pin,
         "pins": 2,
@@ -132,7 +130,10 @@ fn results_list_the_basis_actually_used() {
         number(basis, "/cost/critical_time_step"),
         number(basis, "/cost/critical_time_step_without_correction"),
     );
-    assert!(critical < without, "critical step {critical:e} with vs {without:e} s without");
+    assert!(
+        critical < without,
+        "critical step {critical:e} with vs {without:e} s without"
+    );
     assert_eq!(critical, number(&output.document, "/critical_time_step"));
 
     let plain = run(&BundleDynamics, &bundle(pin("none")));
@@ -171,7 +172,10 @@ fn an_unknown_correction_is_refused_at_its_pointer() {
 fn a_free_free_pin_is_refused_at_its_supports() {
     let mut free = pin("contacts");
     free["supports"] = json!({"foot": "free", "top": "free"});
-    let errors = BundleDynamics.validate(&bundle(free)).expect_err("a free-free pin is refused").0;
+    let errors = BundleDynamics
+        .validate(&bundle(free))
+        .expect_err("a free-free pin is refused")
+        .0;
     assert!(
         errors.iter().any(|e| e.pointer == "/inputs/pin/supports"),
         "errors {errors:?} vs one at /inputs/pin/supports"
