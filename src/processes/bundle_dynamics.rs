@@ -230,8 +230,8 @@ fn prepare(json: &serde_json::Value) -> Result<Prepared, InvalidInputs> {
     }
 
     // One static correction per distinct contact height, shared by every pin.
-    let heights: Vec<f64> = contacts.iter().map(|c| c.height).collect();
-    let basis = inputs.pin.basis(&heights, "/inputs/pin")?;
+    let contact_heights: Vec<f64> = contacts.iter().map(|c| c.height).collect();
+    let basis = inputs.pin.basis(&contact_heights, "/inputs/pin")?;
     let settings = Settings {
         scheme,
         time_step,

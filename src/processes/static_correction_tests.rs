@@ -135,6 +135,13 @@ fn results_list_the_basis_actually_used() {
         "critical step {critical:e} with vs {without:e} s without"
     );
     assert_eq!(critical, number(&output.document, "/critical_time_step"));
+    let displacements = output
+        .histories
+        .iter()
+        .find(|h| h.name == "displacements")
+        .unwrap();
+    let columns: Vec<&str> = displacements.series.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(columns, ["p0", "p1"], "one tip deflection column per pin");
 
     let plain = run(&BundleDynamics, &bundle(pin("none")));
     let basis = &plain.document["basis"];
