@@ -17,6 +17,7 @@ pub mod reference;
 /// One-sided periodogram and the spectral error function f_err (paper eq. 11).
 pub mod spectrum;
 pub mod stability;
+pub mod static_correction;
 pub mod statistics;
 
 /// One problem with a physics input: which field (slash path relative to the checked

@@ -6,11 +6,17 @@
 //! φ = L⁻ᵀ y, which is mass-normalized when y is unit. All identical pins share one
 //! basis. Shapes are stored over all DOFs (zero on fixed ones); each mode's sign makes
 //! its largest deflection positive, so bases are reproducible.
+//!
+//! A basis may be augmented with pseudo-modes, the static correction at contact heights
+//! ([`ModalBasis::compute_with_static_correction`], derivation in
+//! [`super::static_correction`]): they follow the m modes as extra "modes" with
+//! frequencies above ωₘ, and every accessor below covers modes and pseudo-modes alike.
 
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Mat, Par, Side};
 
 use super::beam::{BeamModel, BeamSpec};
+use super::static_correction::{StaticCorrectionError, pseudo_modes};
 
 /// Why a modal basis could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -21,13 +27,29 @@ pub enum ModalError {
     MassNotPositiveDefinite,
     #[error("the eigenvalue solver did not converge")]
     EigenSolverFailed,
+    #[error(transparent)]
+    StaticCorrection(#[from] StaticCorrectionError),
+}
+
+/// The static correction a basis carries: which heights got a pseudo-mode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticCorrection {
+    /// Distinct contact heights (m), increasing, whose static shape was added.
+    pub heights: Vec<f64>,
+    /// Heights (m) whose static shape already lay in the basis (e.g. at a fixed
+    /// support): no pseudo-mode.
+    pub dropped_heights: Vec<f64>,
 }
 
 /// Truncated, mass-normalized modal basis of one beam.
 #[derive(Debug, Clone)]
 pub struct ModalBasis {
     model: BeamModel,
-    /// ωᵢ (rad/s), increasing.
+    /// Number m of eigenmodes; the basis holds them first, then the pseudo-modes.
+    eigenmodes: usize,
+    /// The static correction, `None` when the basis has eigenmodes only.
+    correction: Option<StaticCorrection>,
+    /// ωᵢ (rad/s), increasing (pseudo-modes last, above every eigenmode).
     angular_frequencies: Vec<f64>,
     /// Mode-major: `shapes[i * dofs + d]` is DOF d of mode i (kg^-½ per unit DOF).
     shapes: Vec<f64>,
@@ -42,6 +64,23 @@ pub struct ModalBasis {
 impl ModalBasis {
     /// First `modes` modes of a valid beam ([`BeamSpec::validate`]).
     pub fn compute(spec: &BeamSpec, modes: usize) -> Result<Self, ModalError> {
+        Self::build(spec, modes, None)
+    }
+
+    /// First `modes` modes augmented with one pseudo-mode per distinct height of
+    /// `heights` (m): the static correction at those heights
+    /// ([`super::static_correction`]). Equal heights share one pseudo-mode; a height
+    /// whose static shape the basis already holds adds none. The basis then has
+    /// `modes` + (pseudo-modes) entries, each with its own frequency.
+    pub fn compute_with_static_correction(
+        spec: &BeamSpec,
+        modes: usize,
+        heights: &[f64],
+    ) -> Result<Self, ModalError> {
+        Self::build(spec, modes, Some(heights))
+    }
+
+    fn build(spec: &BeamSpec, modes: usize, correction_heights: Option<&[f64]>) -> Result<Self, ModalError> {
         let model = BeamModel::assemble(spec);
         let free = model.free_dofs.clone();
         let n = free.len();
@@ -94,14 +133,40 @@ impl ModalBasis {
             }
         }
 
+        let mut correction = None;
+        if let Some(heights) = correction_heights {
+            let mode_shapes: Vec<&[f64]> = shapes.chunks_exact(dofs).collect();
+            let pseudo = pseudo_modes(&model, &mode_shapes, heights)?;
+            for (omega, shape) in pseudo.angular_frequencies.iter().zip(&pseudo.shapes) {
+                let mut shape = shape.clone();
+                let largest = shape
+                    .iter()
+                    .step_by(2)
+                    .copied()
+                    .fold(0.0f64, |m, w| if w.abs() > m.abs() { w } else { m });
+                if largest < 0.0 {
+                    shape.iter_mut().for_each(|v| *v = -*v);
+                }
+                angular_frequencies.push(*omega);
+                shapes.extend(shape);
+            }
+            correction = Some(StaticCorrection {
+                heights: pseudo.heights,
+                dropped_heights: pseudo.dropped_heights,
+            });
+        }
+        let total = angular_frequencies.len();
+
         let translation: Vec<f64> = (0..dofs).map(|d| if d % 2 == 0 { 1.0 } else { 0.0 }).collect();
         let mass_times_translation = mat_vec(&model.mass, dofs, &translation);
-        let participation = (0..modes)
+        let participation = (0..total)
             .map(|i| dot(&shapes[i * dofs..(i + 1) * dofs], &mass_times_translation))
             .collect();
 
         let mut basis = Self {
             model,
+            eigenmodes: modes,
+            correction,
             angular_frequencies,
             shapes,
             participation,
@@ -111,9 +176,36 @@ impl ModalBasis {
         Ok(basis)
     }
 
-    /// Number of modes m.
+    /// Number of basis vectors: eigenmodes and pseudo-modes (what the integrator
+    /// treats as modes).
     pub fn modes(&self) -> usize {
         self.angular_frequencies.len()
+    }
+
+    /// Number m of eigenmodes (the first m entries of the basis).
+    pub fn eigenmodes(&self) -> usize {
+        self.eigenmodes
+    }
+
+    /// The static correction, `None` for a basis of eigenmodes only.
+    pub fn static_correction(&self) -> Option<&StaticCorrection> {
+        self.correction.as_ref()
+    }
+
+    /// The same basis without its pseudo-modes (the eigenmodes only).
+    pub fn without_static_correction(&self) -> Self {
+        let (m, dofs) = (self.eigenmodes, self.model.dof_count());
+        let mut basis = Self {
+            model: self.model.clone(),
+            eigenmodes: m,
+            correction: None,
+            angular_frequencies: self.angular_frequencies[..m].to_vec(),
+            shapes: self.shapes[..m * dofs].to_vec(),
+            participation: self.participation[..m].to_vec(),
+            unit_tip_release: None,
+        };
+        basis.unit_tip_release = self.unit_tip_release.as_ref().map(|q| q[..m].to_vec());
+        basis
     }
 
     /// ωᵢ (rad/s).

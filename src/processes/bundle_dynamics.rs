@@ -5,6 +5,7 @@
 
 use serde_json::json;
 
+use super::basis_report::BasisReport;
 use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
 use super::inputs::{self, at};
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
@@ -36,7 +37,7 @@ impl Prepared {
         Model {
             basis: &self.basis,
             pins: self.pins,
-            damping_ratios: self.inputs.pin.damping_ratios(),
+            damping_ratios: self.inputs.pin.damping_ratios_for(self.basis.modes()),
             contacts: self.contacts.clone(),
             initial_tip_displacements: tips.clone(),
             base_acceleration: self
@@ -231,8 +232,9 @@ fn prepare(json: &serde_json::Value) -> Result<Plan, InvalidInputs> {
         return Err(InvalidInputs(errors));
     }
 
-    let basis = ModalBasis::compute(&inputs.pin.spec(), inputs.pin.modes)
-        .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/pin/modes", e.to_string())]))?;
+    // One static correction per distinct contact height, shared by every pin.
+    let contact_heights: Vec<f64> = contacts.iter().map(|c| c.height).collect();
+    let basis = inputs.pin.basis(&contact_heights, "/inputs/pin")?;
     let settings = Settings {
         scheme: solver.scheme,
         time_step: solver.time_step,
@@ -398,6 +400,7 @@ impl Process for BundleDynamics {
             "output_interval": simulation.output_interval,
             "quality": quality,
             "frequencies_hz": prepared.basis.frequencies_hz(),
+            "basis": BasisReport::of(&model, prepared.settings.scheme, simulation.step.critical_time_step),
         });
         if prepared.inputs.bundle.is_some() {
             let explicit: Vec<serde_json::Value> = prepared

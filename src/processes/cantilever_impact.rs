@@ -7,6 +7,7 @@ use serde::Deserialize;
 use serde_json::json;
 use utoipa::ToSchema;
 
+use super::basis_report::BasisReport;
 use super::inputs::{self, BeamInput, SchemeInput, SupportInput, TimeStepInput, at};
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::InputIssue;
@@ -177,7 +178,7 @@ impl Prepared {
         Model {
             basis: &self.basis,
             pins: 1,
-            damping_ratios: self.inputs.beam.damping_ratios(),
+            damping_ratios: self.inputs.beam.damping_ratios_for(self.basis.modes()),
             contacts: vec![Contact {
                 left: Body::Wall,
                 right: Body::Pin(0),
@@ -288,8 +289,8 @@ fn prepare(json: &serde_json::Value) -> Result<Plan, InvalidInputs> {
         return Err(InvalidInputs(errors));
     }
 
-    let basis = ModalBasis::compute(&spec, inputs.beam.modes)
-        .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/beam/modes", e.to_string())]))?;
+    // The contact is at the tip: the static correction, if any, is the tip-load shape.
+    let basis = inputs.beam.basis(&[spec.length], "/inputs/beam")?;
     let settings = Settings {
         scheme: solver.scheme,
         time_step: solver.time_step,
@@ -489,6 +490,7 @@ impl Process for CantileverImpact {
                 "frequencies_hz": prepared.basis.frequencies_hz(),
                 "energy": simulation.energy,
             },
+            "basis": BasisReport::of(&model, prepared.settings.scheme, simulation.step.critical_time_step),
             "reference": {
                 "first_impact_time": solution.first_impact_time(),
                 "impacts": solution.impact_count(),

@@ -45,6 +45,25 @@ pub struct BeamInput {
     /// Boundary conditions (clamped foot, free top by default).
     #[serde(default)]
     pub supports: SupportsInput,
+    /// Static correction of the truncated basis: `contacts` (default) adds one
+    /// pseudo-mode per distinct contact height (the static response to a unit force
+    /// there, M-orthonormalised against the modes), `none` keeps the modes alone.
+    #[serde(default)]
+    pub static_correction: StaticCorrectionInput,
+}
+
+/// Static correction of the modal basis (docs/static-correction.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum StaticCorrectionInput {
+    /// The eigenmodes only.
+    None,
+    /// One pseudo-mode per distinct contact height: the residual flexibility of the
+    /// dropped modes at the contacts. Its frequency is above the last mode's, and the
+    /// critical step accounts for it. Pseudo-modes take the damping ratio rule of the
+    /// modes (a uniform ratio applies to them; a list's last value repeats).
+    #[default]
+    Contacts,
 }
 
 fn default_elements() -> usize {
@@ -112,6 +131,17 @@ fn free() -> SupportInput {
     SupportInput::Free
 }
 
+impl SupportInput {
+    /// The input keyword.
+    pub fn name(self) -> &'static str {
+        match self {
+            SupportInput::Free => "free",
+            SupportInput::Pinned => "pinned",
+            SupportInput::Clamped => "clamped",
+        }
+    }
+}
+
 impl From<SupportInput> for Support {
     fn from(value: SupportInput) -> Self {
         match value {
@@ -156,6 +186,51 @@ impl BeamInput {
                     .collect()
             }
         }
+    }
+
+    /// Damping ratio of each of the `basis_modes` entries of the basis actually used
+    /// (eigenmodes, then pseudo-modes): the rule of [`Self::damping_ratios`] continued
+    /// past the eigenmodes (a uniform ratio everywhere; a list's last value repeats).
+    pub fn damping_ratios_for(&self, basis_modes: usize) -> Vec<f64> {
+        let mut ratios = self.damping_ratios();
+        let last = match &self.damping_ratio {
+            DampingInput::Uniform(xi) => *xi,
+            DampingInput::PerMode(list) => list.last().copied().unwrap_or(0.0),
+        };
+        ratios.resize(basis_modes, last);
+        ratios
+    }
+
+    /// The modal basis of this beam with its static correction at `contact_heights`
+    /// (m) when asked for; a failure is a 422 under `pointer` (the beam's own pointer).
+    pub fn basis(
+        &self,
+        contact_heights: &[f64],
+        pointer: &str,
+    ) -> Result<crate::physics::modal::ModalBasis, InvalidInputs> {
+        use crate::physics::modal::{ModalBasis, ModalError};
+        let spec = self.spec();
+        let basis = match self.static_correction {
+            StaticCorrectionInput::None => ModalBasis::compute(&spec, self.modes),
+            StaticCorrectionInput::Contacts => {
+                ModalBasis::compute_with_static_correction(&spec, self.modes, contact_heights)
+            }
+        };
+        basis.map_err(|e| {
+            let field = match e {
+                ModalError::StaticCorrection(_) => format!("{pointer}/supports"),
+                _ => format!("{pointer}/modes"),
+            };
+            let detail = match e {
+                ModalError::StaticCorrection(_) => format!(
+                    "{e}; supports: foot {}, top {}",
+                    self.supports.foot.name(),
+                    self.supports.top.name()
+                ),
+                _ => e.to_string(),
+            };
+            InvalidInputs(vec![FieldError::new(field, detail)])
+        })
     }
 
     /// Every problem with the beam and its truncation, as physics issues relative to it.

@@ -6,6 +6,7 @@
 //! time histories. It knows nothing about HTTP, the queue or the database: the service
 //! and the CLI drive it through [`Process`].
 
+pub mod basis_report;
 pub mod bundle_dynamics;
 pub mod bundle_inputs;
 pub mod cantilever_impact;
@@ -15,6 +16,8 @@ pub mod strict_json;
 
 #[cfg(test)]
 mod robustness_tests;
+#[cfg(test)]
+mod static_correction_tests;
 
 use std::ops::ControlFlow;
 use std::sync::Arc;

@@ -439,6 +439,10 @@ async fn a_calibration_grid_maps_validity_shrinking_as_rk_and_time_step_grow() {
     let mut body: Value =
         serde_json::from_str(include_str!("../../examples/sweep-calibration.json")).unwrap();
     body["inputs"]["solver"]["duration"] = json!(0.1);
+    // The modes alone: with the static correction (the default) the tip pseudo-mode
+    // shortens the critical step below 1e-5 s at Rk = 1e6, leaving that row without a
+    // valid step (docs/static-correction.md); this test is about the map's shape.
+    body["inputs"]["beam"]["static_correction"] = json!("none");
     body["axes"] = json!([
         {"pointer": "/contact/rk", "logspace": [1.0, 1e6, 3]},
         {"pointer": "/solver/time_step", "values": [1e-5, 3e-5, 1e-4]}

@@ -1,0 +1,76 @@
+//! The `basis` entry of a results document: the modal basis a run actually used
+//! (eigenmodes, static-correction pseudo-modes and their heights) and what it cost.
+
+use serde::Serialize;
+
+use crate::physics::integrate::{Model, critical_time_step};
+use crate::physics::modal::ModalBasis;
+use crate::physics::stability::Scheme;
+
+/// The basis of a run, as reported in its results.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BasisReport {
+    /// `none` or `contacts`, as used.
+    pub static_correction: &'static str,
+    /// Eigenmodes kept (m).
+    pub modes: usize,
+    /// Their frequencies (Hz), increasing.
+    pub mode_frequencies_hz: Vec<f64>,
+    /// Distinct contact heights (m) that got a pseudo-mode.
+    pub correction_heights: Vec<f64>,
+    /// Contact heights (m) whose static shape the modes already hold (e.g. at a fixed
+    /// support): no pseudo-mode.
+    pub dropped_correction_heights: Vec<f64>,
+    /// Frequencies of the pseudo-modes (Hz), increasing, all above the last mode's.
+    /// With several heights a pseudo-mode mixes their static shapes, so they are not
+    /// paired with heights.
+    pub pseudo_mode_frequencies_hz: Vec<f64>,
+    pub cost: BasisCost,
+}
+
+/// What the basis costs the run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BasisCost {
+    /// Modal coordinates per pin (modes + pseudo-modes).
+    pub modal_dofs_per_pin: usize,
+    /// Modal coordinates of the whole run (pins × per pin).
+    pub modal_dofs: usize,
+    /// Critical step of this basis (s), every contact closed.
+    pub critical_time_step: f64,
+    /// Critical step (s) the eigenmodes alone would have: the pseudo-modes' share of the
+    /// cost shows in the ratio (equal without correction).
+    pub critical_time_step_without_correction: f64,
+}
+
+impl BasisReport {
+    /// Report of `model`'s basis; `critical` is the run's critical step (s).
+    pub fn of(model: &Model<'_>, scheme: Scheme, critical: f64) -> Self {
+        let basis: &ModalBasis = model.basis;
+        let m = basis.eigenmodes();
+        let frequencies = basis.frequencies_hz();
+        let correction = basis.static_correction();
+        let without = if basis.modes() > m {
+            let truncated = basis.without_static_correction();
+            let mut plain = model.clone();
+            plain.basis = &truncated;
+            plain.damping_ratios.truncate(m);
+            critical_time_step(&plain, scheme)
+        } else {
+            critical
+        };
+        Self {
+            static_correction: if correction.is_some() { "contacts" } else { "none" },
+            modes: m,
+            mode_frequencies_hz: frequencies[..m].to_vec(),
+            correction_heights: correction.map(|c| c.heights.clone()).unwrap_or_default(),
+            dropped_correction_heights: correction.map(|c| c.dropped_heights.clone()).unwrap_or_default(),
+            pseudo_mode_frequencies_hz: frequencies[m..].to_vec(),
+            cost: BasisCost {
+                modal_dofs_per_pin: basis.modes(),
+                modal_dofs: basis.modes() * model.pins,
+                critical_time_step: critical,
+                critical_time_step_without_correction: without,
+            },
+        }
+    }
+}
