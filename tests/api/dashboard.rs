@@ -239,7 +239,7 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
     };
 
     // The job list: the slow job's progress bar, between 0 and 1, as far as the job got.
-    let dom = load(&browser, &app.url("/jobs?limit=20"), "jobs", 900, 3000).await;
+    let dom = load(&browser, &app.url("/jobs?limit=30"), "jobs", 900, 3000).await;
     let row = element(&dom, &format!("data-job=\"{slow}\""), "</tr>");
     let bar = tags(row, "role=\"progressbar\"");
     assert_eq!(bar.len(), 1, "{row}");
