@@ -425,6 +425,12 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
         contour[0]
     );
     assert!(dom.contains("data-results=\"9\""));
+    // The verdict counts of its runs, as aggregated.
+    let poor = aggregate["aggregates"]["quality"]["poor"].as_u64().unwrap();
+    assert!(
+        dom.contains(&format!("data-quality-counts=\"{poor}\"")),
+        "{poor} poor runs not shown"
+    );
 
     // The Monte Carlo campaign: a histogram of all eight runs.
     let dom = load(
