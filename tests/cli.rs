@@ -140,7 +140,11 @@ fn a_poor_result_warns_on_stderr_and_keeps_its_document_on_stdout() {
     body["inputs"]["solver"]["duration"] = serde_json::json!(0.05);
     body["inputs"]["solver"]["check"] = serde_json::json!("none");
     let first = run_with_stdin("cantilever-impact", &body);
-    assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
     let document: serde_json::Value = serde_json::from_slice(&first.stdout).expect("JSON on stdout");
     let stderr = String::from_utf8_lossy(&first.stderr);
     assert_eq!(

@@ -107,11 +107,7 @@ pub fn quality_counts(table: &Table, list_axes: &[String]) -> Option<QualityCoun
         if row.get("status").and_then(Value::as_str) != Some("successful") {
             continue;
         }
-        let Some(verdict) = row
-            .get(VERDICT)
-            .and_then(Value::as_str)
-            .and_then(parse_verdict)
-        else {
+        let Some(verdict) = row.get(VERDICT).and_then(Value::as_str).and_then(parse_verdict) else {
             continue;
         };
         total.add(verdict);
@@ -358,8 +354,14 @@ mod tests {
         assert_eq!(counts.total, expected(4, 1, 1, 2));
         let values = &counts.by_axis[0].values;
         assert_eq!(values.len(), 2, "{values:?}");
-        assert_eq!((values[0].value.clone(), values[0].counts.clone()), (json!(1e-5), expected(2, 1, 1, 0)));
-        assert_eq!((values[1].value.clone(), values[1].counts.clone()), (json!(1e-4), expected(2, 0, 0, 2)));
+        assert_eq!(
+            (values[0].value.clone(), values[0].counts.clone()),
+            (json!(1e-5), expected(2, 1, 1, 0))
+        );
+        assert_eq!(
+            (values[1].value.clone(), values[1].counts.clone()),
+            (json!(1e-4), expected(2, 0, 0, 2))
+        );
         let document = serde_json::to_value(&counts).unwrap();
         assert_eq!(document["poor"], 2);
         assert_eq!(document["by_axis"][0]["values"][1]["poor"], 2);

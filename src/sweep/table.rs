@@ -50,7 +50,9 @@ pub fn flatten_scalars(document: &Value) -> Vec<(String, Value)> {
                     walk(&name, value, out);
                 }
             }
-            Value::Number(_) | Value::Bool(_) | Value::String(_) => out.push((prefix.to_owned(), value.clone())),
+            Value::Number(_) | Value::Bool(_) | Value::String(_) => {
+                out.push((prefix.to_owned(), value.clone()))
+            }
             _ => {}
         }
     }

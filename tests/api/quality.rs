@@ -110,7 +110,11 @@ async fn a_poor_or_doubtful_job_stays_successful_and_its_message_gives_the_verdi
     let mut doubtful = cantilever(Some(step_for(&auto, 10.0)));
     doubtful["inputs"]["solver"]["tolerance"] = json!(0.1);
     let (status, results) = run(&app, &doubtful).await;
-    assert_eq!(results["quality"]["verdict"], "doubtful", "{}", results["quality"]);
+    assert_eq!(
+        results["quality"]["verdict"], "doubtful",
+        "{}",
+        results["quality"]
+    );
     assert_eq!(
         status["message"],
         format!("finished; quality doubtful: {}", reasons(&results).join("; ")).as_str()
@@ -159,7 +163,10 @@ async fn sweep_rows_carry_the_verdict_and_the_aggregates_count_poor_runs_per_axi
         let over = row["/solver/time_step"].as_f64().unwrap()
             / row["numerical.critical_time_step"].as_f64().unwrap();
         let shown = row["quality.time_step_over_critical"].as_f64().unwrap();
-        assert!((shown - over).abs() <= 1e-12 * over, "Δt/Δt_c {shown}, expected {over}");
+        assert!(
+            (shown - over).abs() <= 1e-12 * over,
+            "Δt/Δt_c {shown}, expected {over}"
+        );
         if row["/solver/time_step"].as_f64() == Some(coarse) {
             assert_eq!(row["quality.verdict"], "poor", "{row:?}");
         }
