@@ -3,6 +3,8 @@
 //! `chocmodal run <processId> <body.json | ->` runs one execution request in-process,
 //! with no server: the results document goes to stdout, invalid inputs give the same
 //! problem document as the HTTP API on stderr and exit status 2, a failed run exits 1.
+//! A result whose quality verdict is not `good` still exits 0 (as its job would be
+//! `successful`) but says so on stderr: `warning: quality poor: <reason>; <reason>`.
 //! `chocmodal serve` runs the HTTP API and its workers, `chocmodal worker` workers alone
 //! (see [`crate::service`]).
 
@@ -15,6 +17,7 @@ use clap::{Parser, Subcommand};
 
 use crate::problem::Problem;
 use crate::processes::{InvalidInputs, Registry, RunError, RunOutput};
+use crate::quality_note::QualityNote;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -65,6 +68,9 @@ pub fn main() -> ExitCode {
 pub fn run_command(args: &RunArgs, registry: &Registry) -> ExitCode {
     match execute(args, registry) {
         Ok(document) => {
+            if let Some(note) = QualityNote::of(&document) {
+                eprintln!("warning: {note}");
+            }
             println!(
                 "{}",
                 serde_json::to_string_pretty(&document).expect("results serialize")

@@ -13,6 +13,8 @@ pub mod physics;
 pub mod problem;
 /// One module per process: JSON inputs (validated) → physics → results document + histories.
 pub mod processes;
+/// A results document's quality verdict in the words users see (job message, CLI, sweeps).
+pub mod quality_note;
 /// The HTTP service: OGC API – Processes, SQLite job queue, workers, results store.
 pub mod service;
 /// Sweeps: expansion of axes into runs, results tables and aggregates (pure).

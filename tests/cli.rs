@@ -108,3 +108,69 @@ fn a_database_password_in_the_environment_stays_out_of_the_help() {
         "{help}"
     );
 }
+
+/// Runs `chocmodal run <process> -` with `body` on stdin.
+fn run_with_stdin(process: &str, body: &serde_json::Value) -> std::process::Output {
+    let mut child = chocmodal()
+        .args(["run", process, "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(body.to_string().as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}
+
+/// A result the verdict calls `poor` is still a result (exit 0, the document on stdout),
+/// but the CLI says so on stderr with the reasons. The poor run is made from the
+/// verdict's definition: fewer than 8 steps per period of the fastest motion is poor,
+/// and steps per period are 2π / (ω_max Δt), so the step of a first run times its
+/// `steps_per_contact_period` / 5 gives 5 steps per period (still stable: central
+/// difference holds up to π).
+#[test]
+fn a_poor_result_warns_on_stderr_and_keeps_its_document_on_stdout() {
+    let mut body: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(example()).unwrap()).unwrap();
+    body["inputs"]["solver"]["duration"] = serde_json::json!(0.05);
+    body["inputs"]["solver"]["check"] = serde_json::json!("none");
+    let first = run_with_stdin("cantilever-impact", &body);
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    let document: serde_json::Value = serde_json::from_slice(&first.stdout).expect("JSON on stdout");
+    let stderr = String::from_utf8_lossy(&first.stderr);
+    assert_eq!(
+        stderr.contains("warning: quality"),
+        document["quality"]["verdict"] != "good",
+        "a warning exactly when the verdict is not good: {stderr}"
+    );
+
+    let time_step = document["numerical"]["time_step"].as_f64().unwrap();
+    let steps_per_period = document["quality"]["steps_per_contact_period"].as_f64().unwrap();
+    body["inputs"]["solver"]["time_step"] = serde_json::json!(time_step * steps_per_period / 5.0);
+    let coarse = run_with_stdin("cantilever-impact", &body);
+    let stderr = String::from_utf8_lossy(&coarse.stderr);
+    assert_eq!(coarse.status.code(), Some(0), "{stderr}");
+    let document: serde_json::Value = serde_json::from_slice(&coarse.stdout).expect("only JSON on stdout");
+    assert_eq!(document["quality"]["verdict"], "poor", "{}", document["quality"]);
+    let reasons: Vec<&str> = document["quality"]["reasons"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r.as_str().unwrap())
+        .collect();
+    assert!(!reasons.is_empty());
+    let expected = format!("warning: quality poor: {}", reasons.join("; "));
+    assert!(
+        stderr.lines().any(|line| line == expected),
+        "expected the line `{expected}` on stderr, got: {stderr}"
+    );
+}

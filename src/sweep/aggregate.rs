@@ -10,10 +10,15 @@
 //!   failed run, e.g. diverged, is not valid), and for each combination of the other
 //!   axes the cheapest valid value of `/solver/time_step` (largest), `/beam/modes` and
 //!   `/beam/elements` (fewest) when the sweep has such an axis.
+//! - Quality (any sweep whose rows have `quality.verdict`): how many successful runs
+//!   were judged `good`, `doubtful` and `poor`, in total and for each value of each list
+//!   axis (a random axis has a value per run: its runs are counted in the total only).
 
 use serde_json::{Map, Value, json};
 
 use super::table::Table;
+use crate::physics::integrate::Verdict;
+use crate::quality_note::parse_verdict;
 
 /// A row of the results table.
 type Row = Map<String, Value>;
@@ -34,6 +39,92 @@ pub const COST_AXES: [(&str, bool); 3] = [
     ("/beam/modes", false),
     ("/beam/elements", false),
 ];
+
+/// Metric column of a run's quality verdict (`good`, `doubtful`, `poor`).
+pub const VERDICT: &str = "quality.verdict";
+
+/// How many successful runs got each verdict.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct VerdictCounts {
+    /// Successful runs with a verdict.
+    pub runs: usize,
+    pub good: usize,
+    pub doubtful: usize,
+    pub poor: usize,
+}
+
+impl VerdictCounts {
+    fn add(&mut self, verdict: Verdict) {
+        self.runs += 1;
+        match verdict {
+            Verdict::Good => self.good += 1,
+            Verdict::Doubtful => self.doubtful += 1,
+            Verdict::Poor => self.poor += 1,
+        }
+    }
+}
+
+/// The verdict counts of the runs that share one value of an axis.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ValueQuality {
+    /// The axis value, as in the table.
+    pub value: Value,
+    #[serde(flatten)]
+    pub counts: VerdictCounts,
+}
+
+/// The verdict counts along one list axis, one entry per value in order of first appearance.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct AxisQuality {
+    /// The axis pointer, e.g. `/solver/time_step`.
+    pub axis: String,
+    pub values: Vec<ValueQuality>,
+}
+
+/// The quality of a sweep's runs: verdict counts in total and per list-axis value.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct QualityCounts {
+    #[serde(flatten)]
+    pub total: VerdictCounts,
+    pub by_axis: Vec<AxisQuality>,
+}
+
+/// Verdict counts of the successful runs, in total and per value of each of
+/// `list_axes`; `None` when no row has a verdict (a process without a quality section).
+pub fn quality_counts(table: &Table, list_axes: &[String]) -> Option<QualityCounts> {
+    if !table.metrics.iter().any(|m| m == VERDICT) {
+        return None;
+    }
+    let mut total = VerdictCounts::default();
+    let mut by_axis: Vec<AxisQuality> = list_axes
+        .iter()
+        .map(|axis| AxisQuality {
+            axis: axis.clone(),
+            values: Vec::new(),
+        })
+        .collect();
+    for row in &table.rows {
+        if row.get("status").and_then(Value::as_str) != Some("successful") {
+            continue;
+        }
+        let Some(verdict) = row.get(VERDICT).and_then(Value::as_str).and_then(parse_verdict) else {
+            continue;
+        };
+        total.add(verdict);
+        for axis in &mut by_axis {
+            let value = row.get(&axis.axis).cloned().unwrap_or(Value::Null);
+            match axis.values.iter_mut().find(|v| v.value == value) {
+                Some(entry) => entry.counts.add(verdict),
+                None => {
+                    let mut counts = VerdictCounts::default();
+                    counts.add(verdict);
+                    axis.values.push(ValueQuality { value, counts });
+                }
+            }
+        }
+    }
+    Some(QualityCounts { total, by_axis })
+}
 
 /// Summary statistics of one column.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -229,6 +320,53 @@ mod tests {
         assert!((stats.q50 - 2.5).abs() < 1e-15);
         assert!((stats.q05 - 1.15).abs() < 1e-12, "{}", stats.q05);
         assert!((stats.q95 - 3.85).abs() < 1e-12, "{}", stats.q95);
+    }
+
+    #[test]
+    fn verdicts_are_counted_in_total_and_per_axis_value_over_successful_runs() {
+        let record = |run: usize, status: &str, dt: f64, verdict: Option<&str>| RunRecord {
+            run,
+            job: format!("j{run}"),
+            status: status.into(),
+            inputs: json!({"solver": {"time_step": dt}}),
+            metrics: verdict
+                .map(|v| vec![(VERDICT.to_owned(), json!(v))])
+                .unwrap_or_default(),
+        };
+        let axes = vec!["/solver/time_step".to_owned()];
+        let table = build(
+            &axes,
+            &[
+                record(0, "successful", 1e-5, Some("good")),
+                record(1, "successful", 1e-5, Some("doubtful")),
+                record(2, "successful", 1e-4, Some("poor")),
+                record(3, "successful", 1e-4, Some("poor")),
+                record(4, "failed", 1e-4, None),
+            ],
+        );
+        let counts = quality_counts(&table, &axes).unwrap();
+        let expected = |runs, good, doubtful, poor| VerdictCounts {
+            runs,
+            good,
+            doubtful,
+            poor,
+        };
+        assert_eq!(counts.total, expected(4, 1, 1, 2));
+        let values = &counts.by_axis[0].values;
+        assert_eq!(values.len(), 2, "{values:?}");
+        assert_eq!(
+            (values[0].value.clone(), values[0].counts.clone()),
+            (json!(1e-5), expected(2, 1, 1, 0))
+        );
+        assert_eq!(
+            (values[1].value.clone(), values[1].counts.clone()),
+            (json!(1e-4), expected(2, 0, 0, 2))
+        );
+        let document = serde_json::to_value(&counts).unwrap();
+        assert_eq!(document["poor"], 2);
+        assert_eq!(document["by_axis"][0]["values"][1]["poor"], 2);
+        let without = build(&axes, &[record(0, "successful", 1e-5, None)]);
+        assert_eq!(quality_counts(&without, &axes), None);
     }
 
     #[test]

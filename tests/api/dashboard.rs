@@ -4,7 +4,9 @@
 //! bar, the finished cantilever's numerical and reference curves (the very extremes of
 //! the served histories) and their spectra with the f_err of the results, the bundle's
 //! peak-force grid, the calibration map with its f_err = 0.2 contour, the Monte Carlo
-//! histogram, and refused inputs marked next to their field.
+//! histogram, and refused inputs marked next to their field. Every job shows its quality
+//! verdict as a badge with its reasons (a poor one too), and the force plots draw the
+//! peak-per-interval envelope whose maximum is the reported peak force.
 //!
 //! Screenshots go to `target/dashboard-screenshots/<page>.png`. Chromium is required:
 //! without it the test fails (set `CHOCMODAL_SKIP_BROWSER_TESTS=1` to skip it).
@@ -201,6 +203,25 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
             "successful"
         );
     }
+    // A poor job, from the verdict's definition: fewer than 8 steps per period of the
+    // fastest motion is poor, and steps per period go as 1/Δt, so the cantilever's step
+    // times its steps per period / 5 gives 5 (central difference is stable up to π).
+    let cantilever_results = app.get_json(&format!("/jobs/{cantilever}/results")).await;
+    let mut poor = example("cantilever-impact.json");
+    poor["inputs"]["solver"]["duration"] = json!(0.05);
+    poor["inputs"]["solver"]["check"] = json!("none");
+    poor["inputs"]["solver"]["time_step"] = json!(
+        cantilever_results["numerical"]["time_step"].as_f64().unwrap()
+            * cantilever_results["quality"]["steps_per_contact_period"]
+                .as_f64()
+                .unwrap()
+            / 5.0
+    );
+    let poor = execute(&app, "cantilever-impact", &poor).await;
+    assert_eq!(
+        app.wait_for(&poor, &["successful"], within).await["status"],
+        "successful"
+    );
     for sweep in [&calibration, &gaps] {
         app.wait_for_sweep(sweep, &["successful"], within).await;
     }
@@ -218,7 +239,7 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
     };
 
     // The job list: the slow job's progress bar, between 0 and 1, as far as the job got.
-    let dom = load(&browser, &app.url("/jobs?limit=20"), "jobs", 900, 3000).await;
+    let dom = load(&browser, &app.url("/jobs?limit=30"), "jobs", 900, 3000).await;
     let row = element(&dom, &format!("data-job=\"{slow}\""), "</tr>");
     let bar = tags(row, "role=\"progressbar\"");
     assert_eq!(bar.len(), 1, "{row}");
@@ -285,6 +306,56 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
     assert!(same(shown, f_err), "f_err {shown} shown, {f_err} in the results");
     assert!(same(number(tags(&dom, "data-f-err")[0], "data-f-err"), f_err));
     assert!(dom.contains("tip_displacement.csv") && dom.contains("contact_force-spectrum.csv"));
+    // Its verdict, as a badge in the quality card and next to f_err, with its reasons.
+    let verdict = results["quality"]["verdict"].as_str().unwrap();
+    assert_eq!(
+        tags(&dom, &format!("data-quality=\"{verdict}\"")).len(),
+        2,
+        "the {verdict} badge in the quality card and next to f_err"
+    );
+    let reasons = results["quality"]["reasons"].as_array().unwrap();
+    if !reasons.is_empty() {
+        let list = element(&dom, "data-quality-reasons=", "</ul>");
+        assert_eq!(list.matches("<li>").count(), reasons.len(), "{list}");
+    }
+    // The force plot: the envelope's maximum and the line drawn at the reported peak
+    // are the reported maximum contact force; the samples never exceed it.
+    let max_force = results["numerical"]["max_contact_force"].as_f64().unwrap();
+    let figure = element(&dom, "data-plot=\"contact_force\"", "</figure>");
+    let envelope = tags(figure, "data-series=\"numerical_peaks\"");
+    assert_eq!(envelope.len(), 1, "one numerical envelope");
+    assert!(
+        same(number(envelope[0], "data-max"), max_force),
+        "envelope maximum drawn: {}, reported {max_force}",
+        envelope[0]
+    );
+    let sampled = tags(figure, "data-series=\"numerical\"");
+    assert!(number(sampled[0], "data-max") <= max_force, "{}", sampled[0]);
+    assert!(
+        same(number(tags(figure, "data-hline=")[0], "data-hline"), max_force),
+        "{figure}"
+    );
+    assert_eq!(tags(figure, "data-envelope=\"true\"").len(), 1);
+
+    // The poor job: a poor badge, every reason listed, and the message saying so.
+    let dom = load(
+        &browser,
+        &app.url(&format!("/jobs/{poor}")),
+        "job-poor",
+        2600,
+        6000,
+    )
+    .await;
+    let poor_results = app.get_json(&format!("/jobs/{poor}/results")).await;
+    assert_eq!(poor_results["quality"]["verdict"], "poor");
+    assert_eq!(tags(&dom, "data-quality=\"poor\"").len(), 2, "poor badges");
+    let reasons = poor_results["quality"]["reasons"].as_array().unwrap();
+    let list = element(&dom, "data-quality-reasons=", "</ul>");
+    assert_eq!(list.matches("<li>").count(), reasons.len(), "{list}");
+    let first = reasons[0].as_str().unwrap();
+    assert!(list.contains(first), "{first} not in {list}");
+    let status = element(&dom, "data-job-status=", "</table>");
+    assert!(status.contains("quality poor"), "{status}");
 
     // The bundle: one grid cell per contact, the strongest contact's history drawn.
     let dom = load(
@@ -309,6 +380,21 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
     let path = tags(figure, &format!("data-series=\"c{strongest}\""));
     assert_eq!(path.len(), 1, "{figure}");
     assert!(number(path[0], "data-max") > 0.0);
+    // The envelope of that contact peaks at its reported max_force, to the last bit.
+    let envelope = tags(figure, &format!("data-series=\"c{strongest}_peaks\""));
+    assert_eq!(envelope.len(), 1, "{figure}");
+    let max_force = contacts[strongest as usize]["max_force"].as_f64().unwrap();
+    assert!(
+        same(number(envelope[0], "data-max"), max_force),
+        "envelope maximum drawn: {}, reported {max_force}",
+        envelope[0]
+    );
+    let verdict = results["quality"]["verdict"].as_str().unwrap();
+    assert_eq!(
+        tags(&dom, &format!("data-quality=\"{verdict}\"")).len(),
+        2,
+        "the {verdict} badge in the quality card and next to the peak force"
+    );
 
     // The calibration map: every run a cell, validity as aggregated, and the contour.
     let dom = load(
@@ -339,6 +425,12 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
         contour[0]
     );
     assert!(dom.contains("data-results=\"9\""));
+    // The verdict counts of its runs, as aggregated.
+    let poor = aggregate["aggregates"]["quality"]["poor"].as_u64().unwrap();
+    assert!(
+        dom.contains(&format!("data-quality-counts=\"{poor}\"")),
+        "{poor} poor runs not shown"
+    );
 
     // The Monte Carlo campaign: a histogram of all eight runs.
     let dom = load(

@@ -127,6 +127,19 @@ pub async fn spawn_app_with_processes(
     spawn_app_serving(TestStore::new(Backend::Sqlite).await, extra, configure).await
 }
 
+/// Starts a service on a fresh database of `backend` that also offers the shipped
+/// processes (`cantilever-impact`, `bundle-dynamics`).
+pub async fn spawn_app_with_shipped_processes_on(backend: Backend) -> TestApp {
+    use chocmodal::processes::bundle_dynamics::BundleDynamics;
+    use chocmodal::processes::cantilever_impact::CantileverImpact;
+    spawn_app_serving(
+        TestStore::new(backend).await,
+        vec![Arc::new(CantileverImpact), Arc::new(BundleDynamics)],
+        |_| {},
+    )
+    .await
+}
+
 async fn spawn_app_serving(
     store: TestStore,
     extra: Vec<Arc<dyn Process>>,

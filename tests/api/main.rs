@@ -17,6 +17,7 @@ mod listing;
 mod load;
 mod negotiation;
 mod physics;
+mod quality;
 mod recovery;
 mod responsiveness;
 mod results;

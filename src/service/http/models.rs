@@ -50,7 +50,9 @@ pub struct StatusInfo {
     /// The sweep this job is a run of (absent for single jobs).
     #[serde(rename = "sweepID", skip_serializing_if = "Option::is_none")]
     pub sweep_id: Option<String>,
-    /// Human-readable state, e.g. `queued`, `running`, `failed: <reason>`.
+    /// Human-readable state, e.g. `queued`, `running`, `failed: <reason>`, `finished`;
+    /// a successful job whose results' `quality.verdict` is `doubtful` or `poor` says so
+    /// with the reasons: `finished; quality poor: <reason>; <reason>`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub message: Option<String>,
     /// Percent done (0–100).

@@ -217,7 +217,8 @@ pub struct SweepResults {
     /// Number of runs.
     pub runs: i64,
     /// `run`, `job`, `status`, one column per axis (its pointer), then the metrics
-    /// flattened with dots (`comparison.f_err`, `contacts.3.max_force`), in SI units.
+    /// flattened with dots (`comparison.f_err`, `contacts.3.max_force`,
+    /// `quality.verdict`, `quality.energy_residual`), in SI units.
     pub columns: Vec<String>,
     /// One object per ended run (successful, failed or dismissed), in run order, keyed by column.
     #[schema(value_type = Vec<Object>)]
@@ -225,7 +226,10 @@ pub struct SweepResults {
     /// `statistics` (random designs: per grid cell of the list axes, count, mean, std,
     /// min, max, q05, q50, q95 of every numeric column over the successful runs) or
     /// `calibration` (grids with `comparison.f_err`: validity map, cheapest valid
-    /// `/solver/time_step`, `/beam/modes`, `/beam/elements`).
+    /// `/solver/time_step`, `/beam/modes`, `/beam/elements`); and `quality` when the
+    /// runs carry a verdict: `{"runs", "good", "doubtful", "poor", "by_axis": [{"axis",
+    /// "values": [{"value", "runs", "good", "doubtful", "poor"}]}]}`, counts of the
+    /// successful runs in total and per value of each list axis.
     #[schema(value_type = Object)]
     pub aggregates: serde_json::Value,
     pub links: Vec<Link>,

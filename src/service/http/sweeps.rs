@@ -413,7 +413,9 @@ pub struct SweepResultsQuery {
 ///
 /// One row per run that ended (rows appear as runs finish): `run`, `job`, `status`, the
 /// axis values (columns named by pointer), then the run's scalar results flattened with
-/// dots. JSON adds the aggregates; `format=csv` gives the table alone.
+/// dots (`quality.verdict` and the numeric quality fields among them). JSON adds the
+/// aggregates, with the count of `poor` (and `doubtful`) runs in total and per axis
+/// value; `format=csv` gives the table alone.
 #[utoipa::path(get, path = "/sweeps/{sweepId}/results", operation_id = "getSweepResults", tag = "Sweeps",
     params(("sweepId" = String, Path, description = "Sweep id"), SweepResultsQuery),
     responses(
@@ -498,17 +500,20 @@ fn render_results(
     if csv {
         return Ok(table.to_csv().into_bytes());
     }
-    let aggregates = match Design::parse(&record.design) {
+    let list_axes: Vec<String> = axes.iter().filter(|a| is_list(a)).map(pointer).collect();
+    let mut aggregates = match Design::parse(&record.design) {
         Some(Design::Grid) => match aggregate::calibration(&table, &pointers) {
             Some(map) => json!({ "calibration": map }),
             None => json!({}),
         },
         _ => {
-            let list_axes: Vec<String> = axes.iter().filter(|a| is_list(a)).map(pointer).collect();
             let random_axes: Vec<String> = axes.iter().filter(|a| !is_list(a)).map(pointer).collect();
             json!({ "statistics": aggregate::cell_statistics(&table, &list_axes, &random_axes) })
         }
     };
+    if let Some(quality) = aggregate::quality_counts(&table, &list_axes) {
+        aggregates["quality"] = json!(quality);
+    }
     let href = format!("/sweeps/{}", record.id);
     let document = SweepResults {
         sweep_id: record.id.clone(),

@@ -7,6 +7,7 @@
 
 use super::{JobQueue, Lease};
 use crate::problem::Problem;
+use crate::quality_note::finished_message;
 use crate::service::db::with_pool;
 use crate::service::store::StoredHistory;
 
@@ -19,7 +20,9 @@ macro_rules! guard {
 
 impl JobQueue {
     /// Marks the job successful with its results document and histories (one transaction:
-    /// the row and its histories appear together or not at all).
+    /// the row and its histories appear together or not at all). The status message is
+    /// `finished`, with the quality verdict and its reasons when they are not good
+    /// ([`finished_message`]).
     pub async fn complete(
         &self,
         lease: &Lease,
@@ -27,12 +30,13 @@ impl JobQueue {
         histories: &[StoredHistory],
     ) -> Result<bool, sqlx::Error> {
         let now = self.now();
+        let message = finished_message(results, None);
         with_pool!(&self.db, pool => {
             let mut tx = pool.begin().await?;
             // The first statement writes, so the transaction holds the write lock (SQLite)
             // or the row lock (PostgreSQL) from the start.
             let updated = sqlx::query(concat!(
-                "UPDATE jobs SET status = 'successful', progress = 100, message = 'finished', \
+                "UPDATE jobs SET status = 'successful', progress = 100, message = $6, \
                      finished_at = $4, updated_at = $4, lease_owner = NULL, lease_expires_at = NULL, \
                      results = $5",
                 guard!()
@@ -42,6 +46,7 @@ impl JobQueue {
             .bind(lease.attempt)
             .bind(now)
             .bind(results.to_string())
+            .bind(&message)
             .execute(&mut *tx)
             .await?;
             if updated.rows_affected() != 1 {

@@ -6,27 +6,27 @@
 //! together (in one sweep, or while the first one computes) are computed once too.
 //! Only the same tenant's jobs are reused: another tenant must not learn, from a reuse
 //! message naming a job, that someone ran the same inputs.
-//! Only the same tenant's jobs are reused: another tenant must not learn, from a reuse
-//! message naming a job, that someone ran the same inputs.
 
 use super::{JobQueue, Lease};
+use crate::quality_note::finished_message;
 use crate::service::db::with_pool;
 
 /// Completes the leased job ($1–$3) with results $5 copied from job $6, only while $6
-/// is still successful. SQLite: this first write takes the database's write lock, so
+/// is still successful; $7 is the status message (the reuse, and the results' quality
+/// verdict when it is not good). SQLite: this first write takes the database's write lock, so
 /// the source cannot change before the histories are copied. PostgreSQL: the source
 /// row is locked `FOR SHARE` (a dismissal or purge of it waits for this transaction).
 const TAKE_SQLITE: &str = "\
     UPDATE jobs SET status = 'successful', progress = 100, finished_at = $4, updated_at = $4, \
         lease_owner = NULL, lease_expires_at = NULL, results = $5, \
-        message = 'finished: reused the results of job ' || $6 \
+        message = $7 \
     WHERE id = $1 AND lease_owner = $2 AND attempt = $3 AND status = 'running' \
         AND EXISTS (SELECT 1 FROM jobs WHERE id = $6 AND status = 'successful')";
 
 const TAKE_POSTGRES: &str = "\
     UPDATE jobs SET status = 'successful', progress = 100, finished_at = $4, updated_at = $4, \
         lease_owner = NULL, lease_expires_at = NULL, results = $5, \
-        message = 'finished: reused the results of job ' || $6 \
+        message = $7 \
     WHERE id = $1 AND lease_owner = $2 AND attempt = $3 AND status = 'running' \
         AND EXISTS (SELECT 1 FROM jobs source WHERE source.id = $6 AND source.status = 'successful' \
             FOR SHARE OF source)";
@@ -62,6 +62,11 @@ impl JobQueue {
                 &format!("/jobs/{source_id}/"),
                 &format!("/jobs/{}/", lease.job_id),
             );
+            let message = serde_json::from_str::<serde_json::Value>(&results)
+                .map(|document| {
+                    finished_message(&document, Some(&format!("reused the results of job {source_id}")))
+                })
+                .unwrap_or_else(|_| format!("finished: reused the results of job {source_id}"));
             let now = self.now();
             let mut tx = pool.begin().await?;
             let updated = sqlx::query(take)
@@ -71,6 +76,7 @@ impl JobQueue {
                 .bind(now)
                 .bind(&results)
                 .bind(&source_id)
+                .bind(&message)
                 .execute(&mut *tx)
                 .await?;
             if updated.rows_affected() != 1 {

@@ -65,6 +65,7 @@ pub const EXAMPLES: &[Example] = &[
     example!("bundle-row17.json", Some("bundle-dynamics")),
     example!("bundle-random-gaps.json", Some("bundle-dynamics")),
     example!("bundle-local-closure.json", Some("bundle-dynamics")),
+    example!("bundle-sine-auto.json", Some("bundle-dynamics")),
     example!("sdnl104c.json", Some("bundle-dynamics")),
     example!("sweep-calibration.json", None),
     example!("sweep-gaps.json", None),

@@ -2,6 +2,9 @@
 // gets its tip deflection and contact force, numerical against reference, and the power
 // spectra of both with f_err; `bundle-dynamics` its peak contact forces by level and
 // position and any contact's or pin's history; any other process its histories.
+// Every job with a quality section shows its verdict as a badge (with the reasons) next
+// to its numbers, and each force or displacement plot draws the history's peak-keeping
+// companion (`<name>_peaks`) with the samples, so the plotted peak is the reported one.
 
 import {FINISHED, ApiProblem, api, badge, card, download, errorBox, fmt, fmtElapsed, fmtTime, h, keyValueTable,
   leaves, poll, progressBar, replace, withUnit} from './util.js';
@@ -88,7 +91,7 @@ async function showResults(box, id, status) {
     return;
   }
   const sections = h('div');
-  replace(box, sections, downloadsCard(id, results));
+  replace(box, qualityCard(results), sections, downloadsCard(id, results));
   if (status.processID === 'cantilever-impact') {
     await cantilever(sections, id, results);
   } else if (status.processID === 'bundle-dynamics') {
@@ -110,6 +113,64 @@ function downloadsCard(id, results) {
           download(`${link.href}/spectrum?format=csv`, `${name}-spectrum.csv`)))))),
   h('p', {class: 'muted'}, 'CSV histories at full resolution; spectra are one-sided power spectral densities.'));
 }
+
+/** What each verdict tells the user. */
+const VERDICT_MEANING = {
+  good: 'within the tolerance by every measure',
+  doubtful: 'outside the tolerance by some measure: check before relying on these numbers',
+  poor: 'do not use these numbers: some measure is far outside the tolerance',
+};
+
+/** The quality verdict as a badge, its reasons as a tooltip; null without a quality section. */
+function qualityBadge(results) {
+  const quality = results.quality;
+  if (!quality || !quality.verdict) return null;
+  return h('span', {class: `badge ${quality.verdict}`, 'data-quality': quality.verdict,
+    title: (quality.reasons || []).join('\n') || VERDICT_MEANING[quality.verdict] || ''}, `quality ${quality.verdict}`);
+}
+
+/** The quality section: verdict, reasons, and the measures behind them. */
+function qualityCard(results) {
+  const q = results.quality;
+  if (!q) return null;
+  const percent = (x) => (Number.isFinite(x) ? `${fmt(100 * x, 3)} %` : '–');
+  const check = q.step_halving;
+  const reasons = q.reasons || [];
+  return card('Quality',
+    h('p', {class: 'big'}, qualityBadge(results), h('span', {class: 'muted'}, VERDICT_MEANING[q.verdict] || '')),
+    reasons.length ? h('ul', {class: `quality-reasons ${q.verdict}`, 'data-quality-reasons': reasons.length},
+      reasons.map((reason) => h('li', {}, reason))) : null,
+    keyValueTable([
+      ['energy balance residual', `${percent(q.energy_residual)} (tolerance ${percent(q.tolerance)})`],
+      ['time step / critical', fmt(q.time_step_over_critical, 3)],
+      ['steps per contact period', `${fmt(q.steps_per_contact_period, 3)} (time step set by ${q.time_step_limited_by || '–'})`],
+      ['step halving', check
+        ? `peak force ${percent(check.peak_force_change)}, peak displacement ${percent(check.peak_displacement_change)}, ` +
+          `impacts ${percent(check.impact_count_change)} (cost ×${fmt(check.relative_cost, 3)})`
+        : 'not run (solver.check "none")'],
+    ], {'data-quality-measures': ''}));
+}
+
+/**
+ * The peak-keeping companion of `output` (`<output>_peaks`: the extreme of every output
+ * interval over all steps), or null when the results have none.
+ */
+async function envelope(id, results, output, series) {
+  const name = `${output}_peaks`;
+  if (!(results.outputs || {})[name]) return null;
+  return history(id, name, series);
+}
+
+/** The series of an envelope document, drawn light under the samples of the same colour. */
+function envelopeSeries(doc, styles = {}) {
+  if (!doc) return [];
+  return doc.series.map((item, k) => ({...(styles[item.name] || {color: k}), name: `${item.name}_peaks`,
+    label: `${item.name}: peak per output interval`, x: doc.time, y: item.values, envelope: true, dashed: false}));
+}
+
+/** A horizontal line at a reported peak. */
+const reportedPeak = (value, unit) => (Number.isFinite(value) && value !== 0
+  ? [{y: value, label: `reported ${fmt(value, 4)} ${unit}`}] : []);
 
 /** A history (or some of its series) thinned for plotting: {time, series: [{name, values}]}. */
 function history(id, output, series) {
@@ -133,7 +194,8 @@ async function cantilever(box, id, results) {
   const verdict = c.agrees ? 'agree' : 'differ';
   append(box, card('Numerical against reference',
     h('p', {class: 'big'}, 'f_err = ', h('strong', {'data-f-err': c.f_err}, fmt(c.f_err, 3)),
-      h('span', {class: `badge ${c.agrees ? 'successful' : 'failed'}`}, `${verdict} (threshold ${fmt(c.threshold)})`)),
+      h('span', {class: `badge ${c.agrees ? 'successful' : 'failed'}`}, `${verdict} (threshold ${fmt(c.threshold)})`),
+      qualityBadge(results)),
     h('table', {class: 'list compare'},
       h('thead', {}, h('tr', {}, h('th'), h('th', {}, 'numerical'), h('th', {}, 'reference'), h('th'))),
       h('tbody', {},
@@ -149,12 +211,17 @@ async function cantilever(box, id, results) {
   const plots = h('div');
   const spectrumBox = h('div');
   append(box, card('Histories', plots), card('Power spectra', spectrumBox));
-  const [tip, force] = await Promise.all([history(id, 'tip_displacement'), history(id, 'contact_force')]);
+  const [tip, force, tipPeaks, forcePeaks] = await Promise.all([history(id, 'tip_displacement'),
+    history(id, 'contact_force'), envelope(id, results, 'tip_displacement'), envelope(id, results, 'contact_force')]);
   append(plots,
-    linePlot({id: 'tip_displacement', title: 'Tip displacement w(L, t)', series: seriesOf(tip, COMPARED),
-      xLabel: 'time (s)', yLabel: 'w (m)', caption: thinned(tip)}),
-    linePlot({id: 'contact_force', title: 'Contact force', series: seriesOf(force, COMPARED),
-      xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(force)}));
+    linePlot({id: 'tip_displacement', title: 'Tip displacement w(L, t)',
+      series: [...envelopeSeries(tipPeaks, COMPARED), ...seriesOf(tip, COMPARED)],
+      hLines: reportedPeak(n.min_tip_displacement, 'm'),
+      xLabel: 'time (s)', yLabel: 'w (m)', caption: thinned(tip, tipPeaks)}),
+    linePlot({id: 'contact_force', title: 'Contact force',
+      series: [...envelopeSeries(forcePeaks, COMPARED), ...seriesOf(force, COMPARED)],
+      hLines: reportedPeak(n.max_contact_force, 'N'),
+      xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(force, forcePeaks)}));
   const highest = Math.max(...(r.free_frequencies_hz || []).slice(0, 2), ...(r.contact_frequencies_hz || []).slice(0, 2));
   const fMax = h('input', {type: 'number', min: 0, step: 'any', value: Number.isFinite(highest) ? fmt(1.25 * highest, 2) : 200,
     'aria-label': 'highest frequency (Hz)'});
@@ -179,9 +246,10 @@ async function cantilever(box, id, results) {
   await draw();
 }
 
-function thinned(doc) {
-  return h('span', {class: 'muted'}, doc.thinned ? ` ${doc.points} of ${doc.total_points} samples (peaks kept)`
-    : ` ${doc.points} samples`);
+function thinned(doc, peaks = null) {
+  return h('span', {class: 'muted', 'data-envelope': peaks ? 'true' : null},
+    doc.thinned ? ` ${doc.points} of ${doc.total_points} samples (peaks kept)` : ` ${doc.points} samples`,
+    peaks ? '; light: the extreme of every output interval over all steps' : '');
 }
 
 function append(parent, ...children) {
@@ -199,8 +267,8 @@ async function bundle(box, id, results) {
   const energy = results.energy || {};
   append(box, card('Summary', keyValueTable([
     ['pins, contacts', `${pins.length}, ${contacts.length}`],
-    ['peak contact force', peak.force === undefined ? '–'
-      : `${withUnit(peak.force, 'N')} at contact c${peak.contact}, t = ${withUnit(peak.time, 's')}`],
+    ['peak contact force', [peak.force === undefined ? '–'
+      : `${withUnit(peak.force, 'N')} at contact c${peak.contact}, t = ${withUnit(peak.time, 's')} `, qualityBadge(results)]],
     ['impacts', fmt(results.impacts)],
     ['time step', `${withUnit(results.time_step, 's')} (critical ${withUnit(results.critical_time_step, 's')})`],
     ['steps', fmt(results.steps)],
@@ -249,9 +317,11 @@ async function bundle(box, id, results) {
         ['impacts', fmt(c.impacts)], ['time in contact', withUnit(c.contact_time, 's')], ['impulse', withUnit(c.impulse, 'N·s')],
       ], {class: 'kv wide'}));
       try {
-        const doc = await history(id, 'contact_forces', `c${k}`);
-        replace(plotBox, linePlot({id: 'contact_forces', title: `Contact force c${k}`, series: seriesOf(doc),
-          xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(doc)}));
+        const [doc, peaks] = await Promise.all([history(id, 'contact_forces', `c${k}`),
+          envelope(id, results, 'contact_forces', `c${k}`)]);
+        replace(plotBox, linePlot({id: 'contact_forces', title: `Contact force c${k}`,
+          series: [...envelopeSeries(peaks), ...seriesOf(doc)], hLines: reportedPeak(c.max_force, 'N'),
+          xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(doc, peaks)}));
       } catch (error) {
         replace(plotBox, errorBox(error));
       }
@@ -270,9 +340,11 @@ async function bundle(box, id, results) {
       try {
         const names = await seriesNames(id, 'displacements');
         const name = names.find((n) => n === `p${p}`) || names.find((n) => n.startsWith(`p${p}@`)) || names[0];
-        const doc = await history(id, 'displacements', name);
-        replace(pinBox, linePlot({id: 'displacements', title: `Deflection of pin ${p} (${name})`, series: seriesOf(doc),
-          xLabel: 'time (s)', yLabel: 'w (m)', caption: thinned(doc)}));
+        const [doc, peaks] = await Promise.all([history(id, 'displacements', name),
+          envelope(id, results, 'displacements', name)]);
+        replace(pinBox, linePlot({id: 'displacements', title: `Deflection of pin ${p} (${name})`,
+          series: [...envelopeSeries(peaks), ...seriesOf(doc)],
+          xLabel: 'time (s)', yLabel: 'w (m)', caption: thinned(doc, peaks)}));
       } catch (error) {
         replace(pinBox, errorBox(error));
       }

@@ -26,7 +26,8 @@ function jobRow(job) {
   return h('tr', {'data-job': job.jobID, 'data-status': job.status},
     h('td', {}, h('a', {href: `/jobs/${job.jobID}`, title: job.jobID, class: 'mono'}, shortId(job.jobID))),
     h('td', {}, job.processID),
-    h('td', {}, badge(job.status), job.message && job.status === 'failed'
+    h('td', {}, badge(job.status), job.message && (job.status === 'failed'
+        || (job.status === 'successful' && job.message !== 'finished'))
       ? h('div', {class: 'message', title: job.message}, job.message) : null),
     h('td', {}, job.status === 'running' || job.status === 'accepted' ? progressBar(job.progress, job.status)
       : h('span', {class: 'muted'}, job.status === 'successful' ? '100 %' : '')),

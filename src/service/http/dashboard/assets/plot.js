@@ -71,7 +71,8 @@ export function viridis(t) {
 function legend(series) {
   return h('div', {class: 'legend'}, series.map((item, k) =>
     h('span', {class: 'key'},
-      h('span', {class: `swatch c${item.color ?? k}${item.dashed ? ' dashed' : ''}`}), item.label || item.name)));
+      h('span', {class: `swatch c${item.color ?? k}${item.dashed ? ' dashed' : ''}${item.envelope ? ' envelope' : ''}`}),
+      item.label || item.name)));
 }
 
 function figure(id, title, caption, svg, extra = {}) {
@@ -90,7 +91,8 @@ function axisLabels(width, height, margin, xLabel, yLabel) {
 }
 
 /**
- * A line plot. `series`: [{name, label, x: [...], y: [...], dashed, color}]; `logY` draws
+ * A line plot. `series`: [{name, label, x: [...], y: [...], dashed, color, envelope}]
+ * (`envelope`: drawn light, behind, for the peak-per-interval companion of a history); `logY` draws
  * y on a log scale (values ≤ 0 sit on the floor, at most `logRange` decades below the
  * top); `markers`: vertical lines [{x, label}]; `hLines`: horizontal lines [{y, label}].
  */
@@ -151,7 +153,7 @@ export function linePlot({id, title, caption, series, xLabel, yLabel, logY = fal
       pen = true;
     }
     const [min, max] = extent(item.y);
-    return s('path', {class: `series c${item.color ?? k}${item.dashed ? ' dashed' : ''}`, d,
+    return s('path', {class: `series c${item.color ?? k}${item.dashed ? ' dashed' : ''}${item.envelope ? ' envelope' : ''}`, d,
       'data-series': item.name, 'data-points': item.x.length, 'data-min': min, 'data-max': max});
   });
   const lines = [

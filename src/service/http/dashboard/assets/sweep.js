@@ -1,5 +1,6 @@
 // One sweep: status and progress (live), definition, the calibration map of f_err over
-// two axes with its 0.2 contour, histograms of Monte Carlo metrics, and the results table.
+// two axes with its 0.2 contour, histograms of Monte Carlo metrics, the quality verdicts
+// of the runs (how many poor, per axis value), and the results table.
 
 import {FINISHED, api, badge, card, download, errorBox, fmt, fmtTime, h, keyValueTable, poll, progressBar, replace,
   shortId} from './util.js';
@@ -96,9 +97,31 @@ function showResults(box, status, doc) {
   const axes = ((status.definition && status.definition.axes) || []).map((a) => a.pointer);
   const jobOf = new Map(doc.rows.map((row) => [row.run, row.job]));
   replace(box,
+    aggregates.quality ? qualityCard(aggregates.quality) : null,
     aggregates.calibration ? calibrationCard(aggregates.calibration, axes, jobOf) : null,
     aggregates.statistics ? monteCarloCard(aggregates.statistics, doc, status.definition) : null,
     tableCard(doc));
+}
+
+/** Verdict counts of the successful runs: in total, then per value of each list axis. */
+function qualityCard(quality) {
+  const counts = (c) => [
+    h('td', {}, fmt(c.runs)),
+    h('td', {}, c.good ? h('span', {class: 'badge good'}, `${c.good} good`) : '0'),
+    h('td', {}, c.doubtful ? h('span', {class: 'badge doubtful'}, `${c.doubtful} doubtful`) : '0'),
+    h('td', {'data-poor': c.poor}, c.poor ? h('span', {class: 'badge poor'}, `${c.poor} poor`) : '0'),
+  ];
+  const head = h('thead', {}, h('tr', {}, ['axis', 'value', 'runs', 'good', 'doubtful', 'poor'].map((t) => h('th', {}, t))));
+  const rows = [h('tr', {'data-quality-total': ''}, h('th', {}, 'all runs'), h('td'), counts(quality))];
+  for (const axis of quality.by_axis || []) {
+    for (const entry of axis.values) {
+      rows.push(h('tr', {}, h('th', {}, h('code', {}, axis.axis)),
+        h('td', {}, typeof entry.value === 'number' ? fmt(entry.value, 6) : JSON.stringify(entry.value)), counts(entry)));
+    }
+  }
+  return card('Quality of the runs',
+    h('p', {class: 'muted'}, 'verdicts of the successful runs (quality.verdict); the reasons are on each run\'s page'),
+    h('table', {class: 'list', 'data-quality-counts': quality.poor}, head, h('tbody', {}, rows)));
 }
 
 function sortedValues(values) {
