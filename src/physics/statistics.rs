@@ -37,7 +37,8 @@ pub struct PinExtreme {
 pub struct PeakDeflection {
     /// Signed deflection (m).
     pub deflection: f64,
-    /// When it occurred (s).
+    /// When it occurred (s): the end of the output interval that holds it (the peak is
+    /// tracked at every step, its time to within `output.interval`).
     pub time: f64,
 }
 

@@ -100,11 +100,12 @@ pub(super) struct Integrator<'m> {
     level_deflections: Vec<f64>,
     /// ψ at each point force's height (padded to `row`).
     point_force_shapes: Vec<Vec<f64>>,
-    /// The level of each output height among the levels of `level_deflections` (output
+    /// Where pin 0's deflection at each output height is in `level_deflections` (output
     /// heights that are no contact level are levels with no contact), and per output
     /// height and pin the deflection of largest magnitude since the last sample.
-    output_levels: Vec<usize>,
-    deflection_peak: Vec<f64>,
+    output_offsets: Vec<usize>,
+    deflection_high: Vec<f64>,
+    deflection_low: Vec<f64>,
     /// Per output height and pin, the deflection of largest magnitude over the run.
     peak_deflections: Vec<PeakDeflection>,
     /// Nodal deflection of each mode, for pin extremes, and the nodal deflections of
@@ -385,9 +386,13 @@ impl<'m> Integrator<'m> {
             closed_groups: vec![0; groups.div_ceil(64)],
             level_deflections: vec![0.0; level_blocks * stride * lanes],
             point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
-            deflection_peak: vec![0.0; output_levels.len() * pins],
+            deflection_high: vec![0.0; output_levels.len() * pins],
+            deflection_low: vec![0.0; output_levels.len() * pins],
             peak_deflections: vec![PeakDeflection::default(); output_levels.len() * pins],
-            output_levels,
+            output_offsets: output_levels
+                .iter()
+                .map(|level| Self::level_offset(lanes, stride, *level))
+                .collect(),
             node_shapes,
             node_deflections: vec![0.0; node_blocks * stride * lanes],
             q,
@@ -515,8 +520,8 @@ impl<'m> Integrator<'m> {
             let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
             forces[j] = force;
             dissipation_power += (force - contact.stiffness * penetration) * rate;
-            if record {
-                peaks[j] = peaks[j].max(force);
+            if record && force > peaks[j] {
+                peaks[j] = force;
             }
             if record && contact.active {
                 let stats = &mut statistics[j];
@@ -587,7 +592,7 @@ impl<'m> Integrator<'m> {
             S::as_simd_f64s(&self.a[..state]).0,
         );
         let contact_damping = self.contact_forces_and_statistics(simd, t, true, vectors);
-        self.track_deflection_peaks(t);
+        self.track_deflection_peaks();
         let base = self.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
         let second_half = match self.scheme {
             Scheme::CentralDifference => half,
@@ -630,33 +635,25 @@ impl<'m> Integrator<'m> {
         self.previous_power = powers;
     }
 
-    /// Deflection of `pin` at level `level` of `level_deflections` (block-major, the
-    /// walls in slots 0 and pins + 1).
-    #[inline(always)]
-    fn level_deflection(&self, level: usize, pin: usize) -> f64 {
-        let lanes = self.lanes;
-        self.level_deflections[((level / lanes) * self.stride + 1 + pin) * lanes + level % lanes]
+    /// Index in `level_deflections` of pin 0 at `level` (block-major, the walls in slots
+    /// 0 and pins + 1); pin p is `lanes` × p further.
+    fn level_offset(lanes: usize, stride: usize, level: usize) -> usize {
+        ((level / lanes) * stride + 1) * lanes + level % lanes
     }
 
-    /// Keeps, per output height and pin, the deflection of largest magnitude since the
-    /// last sample and over the run (with its time t).
+    /// Keeps, per output height and pin, the highest and the lowest deflection since the
+    /// last sample (branch-free: this runs at every step).
     #[inline(always)]
-    fn track_deflection_peaks(&mut self, t: f64) {
-        let pins = self.model.pins;
-        for (h, &level) in self.output_levels.iter().enumerate() {
-            for p in 0..pins {
-                let w = self.level_deflection(level, p);
-                let peak = &mut self.deflection_peak[h * pins + p];
-                if w.abs() > peak.abs() {
-                    *peak = w;
-                    let run = &mut self.peak_deflections[h * pins + p];
-                    if w.abs() > run.deflection.abs() {
-                        *run = PeakDeflection {
-                            deflection: w,
-                            time: t,
-                        };
-                    }
-                }
+    fn track_deflection_peaks(&mut self) {
+        let (pins, lanes) = (self.model.pins, self.lanes);
+        for (h, &offset) in self.output_offsets.iter().enumerate() {
+            let column = &self.level_deflections[offset..][..(pins - 1) * lanes + 1];
+            let highs = &mut self.deflection_high[h * pins..][..pins];
+            let lows = &mut self.deflection_low[h * pins..][..pins];
+            for (p, (high, low)) in highs.iter_mut().zip(lows.iter_mut()).enumerate() {
+                let w = column[p * lanes];
+                *high = if w > *high { w } else { *high };
+                *low = if w < *low { w } else { *low };
             }
         }
     }
@@ -714,25 +711,26 @@ impl<'m> Integrator<'m> {
     /// peaks since the previous sample, then starts new peaks.
     pub(super) fn record_sample(&mut self, t: f64) {
         self.time.push(t);
-        let pins = self.model.pins;
-        for (h, &level) in self.output_levels.iter().enumerate() {
+        let (pins, lanes) = (self.model.pins, self.lanes);
+        for (h, &offset) in self.output_offsets.iter().enumerate() {
             for p in 0..pins {
                 // From the same values as the peaks, so that no sample exceeds its peak.
-                let w = self.level_deflection(level, p);
-                let peak = &mut self.deflection_peak[h * pins + p];
-                if w.abs() > peak.abs() {
-                    *peak = w;
-                    let run = &mut self.peak_deflections[h * pins + p];
-                    if w.abs() > run.deflection.abs() {
-                        *run = PeakDeflection {
-                            deflection: w,
-                            time: t,
-                        };
-                    }
+                let w = self.level_deflections[offset + p * lanes];
+                let k = h * pins + p;
+                let (high, low) = (self.deflection_high[k].max(w), self.deflection_low[k].min(w));
+                // The extreme of largest magnitude, signed (the highest on a tie).
+                let peak = if high >= -low { high } else { low };
+                let run = &mut self.peak_deflections[k];
+                if peak.abs() > run.deflection.abs() {
+                    // Located to within the interval that ends at this sample.
+                    *run = PeakDeflection {
+                        deflection: peak,
+                        time: t,
+                    };
                 }
                 self.deflections[h][p].push(w);
-                self.deflection_peaks[h][p].push(*peak);
-                *peak = 0.0;
+                self.deflection_peaks[h][p].push(peak);
+                (self.deflection_high[k], self.deflection_low[k]) = (0.0, 0.0);
             }
         }
         for ((history, peaks), lane) in self
