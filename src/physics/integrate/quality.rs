@@ -31,7 +31,7 @@ use crate::physics::stability::Scheme;
 /// Peaks are held to this multiple of the tolerance (1 % at the default 10⁻³).
 pub const PEAK_TOLERANCE_FACTOR: f64 = 10.0;
 /// An estimated peak error beyond this multiple of the peak tolerance is `poor`.
-pub const POOR_FACTOR: f64 = 3.0;
+pub const POOR_FACTOR: f64 = 2.0;
 /// A relative change of the impact count beyond this is a reason for doubt.
 pub const IMPACT_COUNT_DOUBT: f64 = 0.25;
 /// Fewer steps per period of the fastest motion than this is `poor`.

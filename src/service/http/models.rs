@@ -200,7 +200,7 @@ pub struct QualityReport {
     pub step_halving: Option<StepHalvingReport>,
     /// `good`: within the tolerance by every measure; `doubtful`: some measure outside it,
     /// none by far; `poor`: do not use the numbers (energy residual > 10 × tolerance, an
-    /// estimated peak error > 30 × tolerance, or fewer than 8 steps per contact period).
+    /// estimated peak error > 20 × tolerance, or fewer than 8 steps per contact period).
     #[schema(pattern = "^(good|doubtful|poor)$")]
     pub verdict: String,
     /// One sentence per measure outside the tolerance (empty when `good`).
