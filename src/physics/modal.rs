@@ -287,11 +287,13 @@ impl ModalBasis {
     }
 }
 
-fn mat_vec(matrix: &[f64], n: usize, vector: &[f64]) -> Vec<f64> {
+/// `matrix` (n × n, row-major) times `vector`.
+pub(super) fn mat_vec(matrix: &[f64], n: usize, vector: &[f64]) -> Vec<f64> {
     (0..n).map(|i| dot(&matrix[i * n..(i + 1) * n], vector)).collect()
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+/// Σ aᵢ bᵢ.
+pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 

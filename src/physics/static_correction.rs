@@ -45,6 +45,7 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 
 use super::beam::BeamModel;
+use super::modal::{dot, mat_vec};
 
 /// A static shape whose part outside the span of the basis has an M-norm below this
 /// fraction of its own M-norm is dropped (it adds nothing but rounding noise).
@@ -212,14 +213,6 @@ fn allows_rigid_motion(model: &BeamModel) -> bool {
             .iter()
             .any(|b| (a[0] * b[1] - a[1] * b[0]).abs() > 1e-12 * (1.0 + model.length))
     })
-}
-
-fn mat_vec(matrix: &[f64], n: usize, vector: &[f64]) -> Vec<f64> {
-    (0..n).map(|i| dot(&matrix[i * n..(i + 1) * n], vector)).collect()
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 #[cfg(test)]

@@ -448,62 +448,12 @@ fn energy_spread() {
 #[test]
 #[ignore = "calibration table, run by hand with --nocapture"]
 fn calibration_table() {
-    let mut cases = vec![("plausible", Row::plausible())];
-    let base = Row::plausible();
-    cases.push((
-        "soft E 2e9",
-        Row {
-            young_modulus: 2e9,
-            ..base.clone()
-        },
-    ));
-    cases.push((
-        "Kc 1e7 gap 0",
-        Row {
-            stiffness: 1e7,
-            gap: 0.0,
-            ..base.clone()
-        },
-    ));
-    cases.push((
-        "Kc 1e5 gap 1mm",
-        Row {
-            stiffness: 1e5,
-            gap: 1e-3,
-            ..base.clone()
-        },
-    ));
-    cases.push((
-        "20 pins half-sine",
-        Row {
-            pins: 20,
-            excitation: BaseAcceleration::HalfSine {
-                amplitude: 100.0,
-                duration: 0.01,
-            },
-            duration: 0.1,
-            ..base.clone()
-        },
-    ));
-    cases.push((
-        "5 pins table",
-        Row {
-            pins: 5,
-            excitation: BaseAcceleration::Table(Table {
-                time: (0..=200).map(|k| k as f64 * 5e-4).collect(),
-                values: (0..=200)
-                    .map(|k| 30.0 * ((k as f64 * 0.37).sin() + (k as f64 * 0.11).cos()))
-                    .collect(),
-            }),
-            duration: 0.15,
-            ..base.clone()
-        },
-    ));
+    let mut cases = realistic_rows();
     cases.push((
         "E in MPa",
         Row {
             young_modulus: 2.1e5,
-            ..base.clone()
+            ..Row::plausible()
         },
     ));
     let short: Vec<(String, Row)> = cases
