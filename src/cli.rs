@@ -16,7 +16,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::problem::Problem;
-use crate::processes::{InvalidInputs, Registry, RunError, RunOutput};
+use crate::processes::{Registry, RunError, RunOutput};
 use crate::quality_note::QualityNote;
 
 #[derive(Debug, Parser)]
@@ -104,7 +104,7 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
         .get(&args.process_id)
         .ok_or_else(|| CliFailure::Problem(Problem::no_such_process(&args.process_id)))?;
     let text = read_body(&args.body).map_err(CliFailure::Failed)?;
-    let inputs = parse_envelope(&text).map_err(CliFailure::Problem)?;
+    let inputs = crate::json_body::parse_envelope(&text).map_err(CliFailure::Problem)?;
     // `run` validates too (invalid inputs come back as `RunError::Invalid`): validating
     // first would do the modal analysis and the stability eigenproblem twice.
 
@@ -128,24 +128,10 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
     if let Some(dir) = &args.out {
         write_histories(dir, &output).map_err(CliFailure::Failed)?;
     }
-    Ok(document_with_outputs(output, |name| match &args.out {
+    Ok(output.document_with_outputs(|name| match &args.out {
         Some(dir) => dir.join(format!("{name}.csv")).display().to_string(),
         None => format!("{name}.csv"),
     }))
-}
-
-/// Adds the `outputs` links (`{name: {href}}`) to a run's results document.
-pub fn document_with_outputs(output: RunOutput, href: impl Fn(&str) -> String) -> serde_json::Value {
-    let mut document = output.document;
-    let outputs: serde_json::Map<String, serde_json::Value> = output
-        .histories
-        .iter()
-        .map(|h| (h.name.clone(), serde_json::json!({ "href": href(&h.name) })))
-        .collect();
-    if let serde_json::Value::Object(map) = &mut document {
-        map.insert("outputs".into(), serde_json::Value::Object(outputs));
-    }
-    document
 }
 
 fn read_body(source: &str) -> Result<String, String> {
@@ -158,35 +144,6 @@ fn read_body(source: &str) -> Result<String, String> {
         text = std::fs::read_to_string(source).map_err(|e| format!("cannot read {source}: {e}"))?;
     }
     Ok(text)
-}
-
-/// Parses an execution request body and returns its `inputs` object.
-pub fn parse_envelope(text: &str) -> Result<serde_json::Value, Problem> {
-    let body = crate::json_body::parse(text)?;
-    let serde_json::Value::Object(mut map) = body else {
-        return Err(Problem::malformed_body(
-            "the body must be a JSON object `{\"inputs\": {...}}`",
-        ));
-    };
-    if let Some(unknown) = map
-        .keys()
-        .find(|k| !matches!(k.as_str(), "inputs" | "outputs" | "response" | "subscriber"))
-    {
-        let invalid = InvalidInputs(vec![crate::processes::FieldError::new(
-            format!("/{unknown}"),
-            "unknown member of the execution request",
-        )]);
-        return Err(Problem::invalid_inputs(&invalid));
-    }
-    match map.remove("inputs") {
-        Some(inputs @ serde_json::Value::Object(_)) => Ok(inputs),
-        Some(_) => Err(Problem::invalid_inputs(&InvalidInputs(vec![
-            crate::processes::FieldError::new("/inputs", "must be an object"),
-        ]))),
-        None => Err(Problem::invalid_inputs(&InvalidInputs(vec![
-            crate::processes::FieldError::new("/inputs", "is required"),
-        ]))),
-    }
 }
 
 fn write_histories(dir: &Path, output: &RunOutput) -> Result<(), String> {

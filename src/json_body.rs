@@ -8,6 +8,7 @@
 
 use serde_json::Value;
 
+use crate::pointer::pointer_of;
 use crate::problem::Problem;
 use crate::processes::{FieldError, InvalidInputs};
 
@@ -41,20 +42,35 @@ pub fn parse(text: &str) -> Result<Value, Problem> {
     Ok(value)
 }
 
-/// The JSON pointer of a serde path (`~` and `/` escaped).
-pub fn pointer_of(path: &serde_path_to_error::Path) -> String {
-    let mut pointer = String::new();
-    for segment in path.iter() {
-        match segment {
-            serde_path_to_error::Segment::Seq { index } => pointer.push_str(&format!("/{index}")),
-            serde_path_to_error::Segment::Map { key } => {
-                pointer.push('/');
-                pointer.push_str(&key.replace('~', "~0").replace('/', "~1"));
-            }
-            serde_path_to_error::Segment::Enum { .. } | serde_path_to_error::Segment::Unknown => {}
-        }
+/// Parses an execution request body and returns its `inputs` object.
+pub fn parse_envelope(text: &str) -> Result<serde_json::Value, Problem> {
+    let body = parse(text)?;
+    let serde_json::Value::Object(mut map) = body else {
+        return Err(Problem::malformed_body(
+            "the body must be a JSON object `{\"inputs\": {...}}`",
+        ));
+    };
+    if let Some(unknown) = map
+        .keys()
+        .find(|k| !matches!(k.as_str(), "inputs" | "outputs" | "response" | "subscriber"))
+    {
+        let invalid = InvalidInputs(vec![FieldError::new(
+            format!("/{unknown}"),
+            "unknown member of the execution request",
+        )]);
+        return Err(Problem::invalid_inputs(&invalid));
     }
-    pointer
+    match map.remove("inputs") {
+        Some(inputs @ serde_json::Value::Object(_)) => Ok(inputs),
+        Some(_) => Err(Problem::invalid_inputs(&InvalidInputs(vec![FieldError::new(
+            "/inputs",
+            "must be an object",
+        )]))),
+        None => Err(Problem::invalid_inputs(&InvalidInputs(vec![FieldError::new(
+            "/inputs",
+            "is required",
+        )]))),
+    }
 }
 
 #[cfg(test)]

@@ -9,6 +9,8 @@ pub mod cli;
 pub mod json_body;
 /// Pure numerics: beams, modal bases, contacts, explicit integration, reference solution.
 pub mod physics;
+/// JSON pointers of serde paths (a leaf: nothing else in the crate is imported).
+pub mod pointer;
 /// RFC 9457 problem details shared by the HTTP API and the CLI.
 pub mod problem;
 /// One module per process: JSON inputs (validated) → physics → results document + histories.
@@ -19,3 +21,6 @@ pub mod quality_note;
 pub mod service;
 /// Sweeps: expansion of axes into runs, results tables and aggregates (pure).
 pub mod sweep;
+
+#[cfg(test)]
+mod architecture_tests;

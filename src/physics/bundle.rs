@@ -6,7 +6,7 @@
 //! `wall–0, 0–1, …, (n−2)–(n−1), (n−1)–wall` (`left`, `right`). Contact `i` therefore sits
 //! at level `i / (pins + 1)`, slot `i % (pins + 1)`.
 //!
-//! Random gap states are drawn by [`GapRng`], whose module doc (`bundle/random.rs`) defines the
+//! Random gap states are drawn by [`GapRng`], whose module doc (`physics/random.rs`) defines the
 //! algorithm bit for bit (SplitMix64-seeded xoshiro256**, polar-method normals,
 //! Robert's tail sampler): same seed, same gaps, on every machine.
 //!
@@ -16,8 +16,7 @@
 use super::contact::{Body, Contact};
 use super::{InputIssue, require_non_negative, require_positive};
 
-mod random;
-pub use random::{GapRng, ln, splitmix64};
+pub use super::random::{GapRng, ln, splitmix64};
 
 /// Hard ceiling on levels × (pins + 1); the service may configure a lower one.
 pub const MAX_CONTACTS: usize = 100_000;

@@ -12,6 +12,8 @@ pub mod contact;
 pub mod integrate;
 pub mod loads;
 pub mod modal;
+/// A seeded, bit-reproducible random stream and its samplers (gaps, sweep sampling).
+pub mod random;
 /// Exact (up to modal truncation) cantilever / tip-spring impact solution (paper §2).
 pub mod reference;
 /// One-sided periodogram and the spectral error function f_err (paper eq. 11).

@@ -424,7 +424,7 @@ impl Process for BundleDynamics {
 /// (`contacts.<k>.max_force`, N) and the largest deflection of each pin
 /// (`pins.<p>.max_abs_deflection`, m).
 fn bundle_metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
-    let mut metrics = crate::sweep::table::flatten_scalars(document);
+    let mut metrics = super::metrics::flatten_scalars(document);
     let entries = |list: &str, field: &str| {
         document[list]
             .as_array()

@@ -463,7 +463,7 @@ fn join_pointer(prefix: &str, field: &str) -> String {
 /// Deserializes process inputs strictly; a failure names its JSON pointer (under `/inputs`).
 pub fn parse<T: DeserializeOwned>(inputs: &serde_json::Value) -> Result<T, InvalidInputs> {
     serde_path_to_error::deserialize(super::strict_json::Strict(inputs)).map_err(|error| {
-        let mut pointer = format!("/inputs{}", crate::json_body::pointer_of(error.path()));
+        let mut pointer = format!("/inputs{}", crate::pointer::pointer_of(error.path()));
         let detail = error.into_inner().to_string();
         // An unknown member is reported at the member when serde tracked its key, but at
         // an enclosing object when it could not (inside internally tagged enums, which

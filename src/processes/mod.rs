@@ -12,6 +12,7 @@ pub mod bundle_inputs;
 pub mod cantilever_impact;
 pub mod cost;
 pub mod inputs;
+pub mod metrics;
 pub mod strict_json;
 
 #[cfg(test)]
@@ -95,6 +96,23 @@ pub struct RunOutput {
     pub histories: Vec<History>,
 }
 
+impl RunOutput {
+    /// The results document with its `outputs` links (`{name: {href}}`), `href` giving
+    /// where each history is served from.
+    pub fn document_with_outputs(self, href: impl Fn(&str) -> String) -> serde_json::Value {
+        let mut document = self.document;
+        let outputs: serde_json::Map<String, serde_json::Value> = self
+            .histories
+            .iter()
+            .map(|h| (h.name.clone(), serde_json::json!({ "href": href(&h.name) })))
+            .collect();
+        if let serde_json::Value::Object(map) = &mut document {
+            map.insert("outputs".into(), serde_json::Value::Object(outputs));
+        }
+        document
+    }
+}
+
 /// Why a run did not produce results.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RunError {
@@ -144,10 +162,10 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError>;
     /// The scalar results of a results document as `(dotted.name, value)` pairs: the
     /// metric columns of a sweep's results table. Default: the numbers and booleans of
-    /// nested objects ([`crate::sweep::table::flatten_scalars`]); a process adds entries
+    /// nested objects ([`metrics::flatten_scalars`]); a process adds entries
     /// of its arrays worth a column.
     fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
-        crate::sweep::table::flatten_scalars(document)
+        metrics::flatten_scalars(document)
     }
 }
 

@@ -16,8 +16,8 @@
 //!    with Φ⁻¹ by Acklam's rational approximation (relative error below 1.2·10⁻⁹);
 //!    lognormal `exp(mean + std·Φ⁻¹(u))`, `mean` and `std` being those of the logarithm.
 
-use crate::physics::bundle::GapRng;
-pub use crate::physics::bundle::ln;
+use crate::physics::random::GapRng;
+pub use crate::physics::random::ln;
 
 /// A probability law of a random axis.
 #[derive(Debug, Clone, Copy, PartialEq)]

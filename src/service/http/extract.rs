@@ -8,7 +8,7 @@ use axum::http::{StatusCode, header};
 use serde::de::DeserializeOwned;
 
 use super::error::ApiError;
-use crate::cli::parse_envelope;
+use crate::json_body::parse_envelope;
 use crate::problem::Problem;
 
 /// The `inputs` object of an execution request body `{"inputs": {...}}`.

@@ -484,7 +484,7 @@ fn render_results(
                 .and_then(|text| serde_json::from_str(text).ok());
             let metrics = match (&document, process) {
                 (Some(document), Some(process)) => process.summary_metrics(document),
-                (Some(document), None) => table::flatten_scalars(document),
+                (Some(document), None) => crate::processes::metrics::flatten_scalars(document),
                 (None, _) => Vec::new(),
             };
             RunRecord {

@@ -14,7 +14,6 @@ use std::time::{Duration, Instant};
 use tokio::sync::{oneshot, watch};
 
 use super::WorkerContext;
-use crate::cli::document_with_outputs;
 use crate::problem::{CHOCMODAL_PROBLEMS, Problem};
 use crate::processes::{RunError, RunOutput};
 use crate::service::queue::{ClaimedJob, Lease};
@@ -182,7 +181,7 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
                     .iter()
                     .map(store::encode)
                     .collect::<Result<Vec<_>, _>>()?;
-                let document = document_with_outputs(output, |name| format!("/jobs/{job_id}/results/{name}"));
+                let document = output.document_with_outputs(|name| format!("/jobs/{job_id}/results/{name}"));
                 Ok::<_, store::HistoryError>((document, histories))
             })
             .await;

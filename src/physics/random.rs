@@ -1,6 +1,6 @@
-//! Reproducible random gaps for the bundle generator: a seeded stream and the samplers
-//! of the gap laws, defined bit for bit so that the same seed gives the same gaps on
-//! every machine and Rust version.
+//! A reproducible random stream for the bundle generator's gaps and the sweeps' random
+//! axes: a seeded stream and the samplers of the gap laws, defined bit for bit so that
+//! the same seed gives the same draws on every machine and Rust version.
 //!
 //! # Exact algorithm
 //! Only IEEE-754 `+ − × ÷ √` (correctly rounded everywhere, and Rust never fuses them)
@@ -25,7 +25,7 @@
 //!
 //! One stream per layout: contacts draw in expansion order.
 
-use super::GapDistribution;
+use super::bundle::GapDistribution;
 
 /// Natural logarithm from `+ − × ÷` only (bit-identical everywhere, within ~2 ulp of the
 /// true value): x = m·2ᵉ with m in [√½, √2), ln x = e·ln 2 + 2 atanh(t), t = (m−1)/(m+1),

@@ -1,0 +1,174 @@
+//! The layers of the crate, checked on its sources: data flows one way (HTTP/CLI →
+//! request parsing → processes → physics; sweeps and the service above the processes),
+//! so no top-level module may reach back into one that depends on it, and the physics
+//! imports nothing of the crate but itself and no IO or service crate.
+//!
+//! Edges are the `crate::<module>` paths in each top-level module's files, test modules
+//! left out (`*tests.rs` files and inline `#[cfg(test)] mod … {` blocks, which may use
+//! any layer to build their cases).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+const SOURCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/src");
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("readable source tree").flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The top-level module a source file belongs to (`processes` for
+/// `src/processes/inputs.rs`), `None` for the crate root and the binary.
+fn top_level(path: &Path) -> Option<String> {
+    let relative = path.strip_prefix(SOURCES).ok()?;
+    let first = relative.components().next()?.as_os_str().to_str()?;
+    let name = first.strip_suffix(".rs").unwrap_or(first);
+    (!matches!(name, "lib" | "main")).then(|| name.to_owned())
+}
+
+/// The source without its inline test modules.
+fn without_tests(source: &str) -> &str {
+    let mut end = source.len();
+    let mut from = 0;
+    while let Some(at) = source[from..].find("#[cfg(test)]") {
+        let at = from + at;
+        let rest = source[at + "#[cfg(test)]".len()..].trim_start();
+        if rest.starts_with("mod ") && rest.lines().next().is_some_and(|l| l.trim_end().ends_with('{')) {
+            end = at;
+            break;
+        }
+        from = at + 1;
+    }
+    &source[..end]
+}
+
+/// `crate::a` and `crate::{a, b::c}` paths: the modules named first.
+fn referenced(source: &str) -> BTreeSet<String> {
+    let mut modules = BTreeSet::new();
+    let ident = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect()
+    };
+    for (at, _) in source.match_indices("crate::") {
+        let rest = &source[at + "crate::".len()..];
+        if let Some(group) = rest.strip_prefix('{') {
+            let inner = &group[..group.find('}').unwrap_or(group.len())];
+            modules.extend(
+                inner
+                    .split(',')
+                    .map(|item| ident(item.trim()))
+                    .filter(|m| !m.is_empty()),
+            );
+        } else {
+            let name = ident(rest);
+            if !name.is_empty() {
+                modules.insert(name);
+            }
+        }
+    }
+    modules
+}
+
+fn dependencies() -> BTreeMap<String, BTreeSet<String>> {
+    let mut files = Vec::new();
+    rust_files(Path::new(SOURCES), &mut files);
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for file in files {
+        let Some(module) = top_level(&file) else { continue };
+        let name = file.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        if name.ends_with("tests.rs") {
+            continue;
+        }
+        let source = std::fs::read_to_string(&file).expect("readable source");
+        let edges = graph.entry(module.clone()).or_default();
+        edges.extend(
+            referenced(without_tests(&source))
+                .into_iter()
+                .filter(|m| *m != module),
+        );
+    }
+    graph
+}
+
+/// A cycle through `start`, if any (depth-first).
+fn cycle_from(graph: &BTreeMap<String, BTreeSet<String>>, start: &str) -> Option<Vec<String>> {
+    fn visit(
+        graph: &BTreeMap<String, BTreeSet<String>>,
+        start: &str,
+        node: &str,
+        path: &mut Vec<String>,
+        seen: &mut BTreeSet<String>,
+    ) -> bool {
+        for next in graph.get(node).into_iter().flatten() {
+            if next == start {
+                path.push(next.clone());
+                return true;
+            }
+            if seen.insert(next.clone()) {
+                path.push(next.clone());
+                if visit(graph, start, next, path, seen) {
+                    return true;
+                }
+                path.pop();
+            }
+        }
+        false
+    }
+    let mut path = vec![start.to_owned()];
+    visit(graph, start, start, &mut path, &mut BTreeSet::new()).then_some(path)
+}
+
+#[test]
+fn no_top_level_module_reaches_back_into_one_that_depends_on_it() {
+    let graph = dependencies();
+    assert!(graph.len() >= 6, "too few modules found: {graph:?}");
+    assert!(
+        graph["service"].contains("processes"),
+        "the scan must see the service's use of the processes: {graph:?}"
+    );
+    for module in graph.keys() {
+        if let Some(cycle) = cycle_from(&graph, module) {
+            panic!("import cycle {}: {graph:#?}", cycle.join(" → "));
+        }
+    }
+}
+
+#[test]
+fn the_physics_imports_nothing_of_the_crate_nor_io_crates() {
+    let graph = dependencies();
+    assert_eq!(graph["physics"], BTreeSet::new(), "physics imports crate modules");
+    let mut files = Vec::new();
+    rust_files(&Path::new(SOURCES).join("physics"), &mut files);
+    for file in files {
+        let source = std::fs::read_to_string(&file).expect("readable source");
+        for forbidden in [
+            "tokio",
+            "sqlx",
+            "axum",
+            "serde_json",
+            "hyper",
+            "std::fs",
+            "std::net",
+        ] {
+            assert!(
+                !source.contains(&format!("{forbidden}::")),
+                "{} uses {forbidden}",
+                file.display()
+            );
+        }
+    }
+}
+
+#[test]
+fn the_scan_sees_grouped_paths_and_skips_test_modules() {
+    let source = "use crate::{a, b::c};\nuse crate::d::e;\n#[cfg(test)]\nmod tests {\n use crate::f;\n}\n";
+    let found = referenced(without_tests(source));
+    assert_eq!(found, ["a", "b", "d"].into_iter().map(String::from).collect());
+}
