@@ -49,9 +49,6 @@ use super::{
 use crate::physics::contact::Body;
 use crate::physics::stability::Scheme;
 
-/// Pin index of a wall in the contact list (its state row is set when the pins are known).
-const WALL: usize = usize::MAX;
-
 pub(super) struct Integrator<'m> {
     arch: pulp::Arch,
     model: &'m Model<'m>,
@@ -283,10 +280,6 @@ impl<'m> Integrator<'m> {
                 }
             })
             .collect();
-        let pin_index = |body: Body| match body {
-            Body::Wall => WALL,
-            Body::Pin(p) => p,
-        };
         let shape_at = |height: f64| padded(&basis.deflection_at(height), row, 0.0);
         let nodes = basis.model().elements + 1;
         let mut q = vec![0.0; pins * row];
@@ -298,21 +291,26 @@ impl<'m> Integrator<'m> {
             }
         }
         let contacts = &model.contacts;
-        let contact_left: Vec<usize> = contacts.iter().map(|c| pin_index(c.left)).collect();
-        let contact_right: Vec<usize> = contacts.iter().map(|c| pin_index(c.right)).collect();
-        // Offsets in vectors of one row of `row` values.
+        // Offsets in vectors of one row of `row` values; a wall reads the row of zeros
+        // after the pins' rows.
         let vectors = row / lanes;
-        let state_row = |pin: usize| vectors * if pin == WALL { pins } else { pin };
+        let state_row = |body: Body| match body {
+            Body::Wall => vectors * pins,
+            Body::Pin(pin) => vectors * pin,
+        };
         // A wall on the left reads the zero slot before the first pin, on the right the one
         // after the last.
         let stride = pins + 2;
-        let slot = |pin: usize, wall: usize| if pin == WALL { wall } else { 1 + pin };
+        let slot = |body: Body, wall: usize| match body {
+            Body::Wall => wall,
+            Body::Pin(pin) => 1 + pin,
+        };
         let layout = ContactLanes::new(
-            (0..contacts.len()).map(|c| {
+            contacts.iter().enumerate().map(|(c, contact)| {
                 (
                     contact_level[c],
-                    slot(contact_left[c], 0),
-                    slot(contact_right[c], pins + 1),
+                    slot(contact.left, 0),
+                    slot(contact.right, pins + 1),
                 )
             }),
             lanes,
@@ -369,14 +367,14 @@ impl<'m> Integrator<'m> {
                         stiffness: contact.stiffness,
                         dashpot: contact.damping,
                         shape: vectors * contact_level[c],
-                        left: state_row(contact_left[c]),
-                        right: state_row(contact_right[c]),
+                        left: state_row(contact.left),
+                        right: state_row(contact.right),
                         active: contact.stiffness > 0.0 || contact.damping > 0.0,
                     })
                     .collect::<Vec<_>>(),
                 LaneContact::default(),
             ),
-            wall_row: state_row(WALL),
+            wall_row: state_row(Body::Wall),
             gaps: layout.by_lane(&contacts.iter().map(|c| c.gap).collect::<Vec<_>>(), f64::INFINITY),
             layout,
             penetration: vec![0.0; lane_count],
