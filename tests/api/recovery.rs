@@ -107,7 +107,12 @@ async fn expired_leases_are_recovered_periodically_once_the_clock_passes_them(ba
         config.clock = clock.clone();
     })
     .await;
-    tokio::time::sleep(Duration::from_millis(400)).await;
+    // What the periodic pass does at the manual clock's (unchanged) time: nothing.
+    let recovered = app.queue.recover_expired(3).await.unwrap();
+    assert!(
+        recovered.requeued.is_empty() && recovered.failed.is_empty(),
+        "the lease still holds: {recovered:?}"
+    );
     assert_eq!(
         app.status(&job).await["status"],
         "running",

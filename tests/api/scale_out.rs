@@ -274,7 +274,10 @@ const LONG_JOB_SECONDS_SIMULATED: f64 = 15.0;
 /// of any job, from any process, would show.
 #[tokio::test]
 async fn killing_a_worker_mid_job_loses_no_job_and_completes_none_twice() {
-    if crate::postgres::skipped() {
+    if crate::postgres::skipped(concat!(
+        module_path!(),
+        "::killing_a_worker_mid_job_loses_no_job_and_completes_none_twice"
+    )) {
         return;
     }
     let url = crate::postgres::fresh_database().await;
