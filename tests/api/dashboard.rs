@@ -9,7 +9,8 @@
 //! peak-per-interval envelope whose maximum is the reported peak force.
 //!
 //! Screenshots go to `target/dashboard-screenshots/<page>.png`. Chromium is required:
-//! without it the test fails (set `CHOCMODAL_SKIP_BROWSER_TESTS=1` to skip it).
+//! without it the test fails. `CHOCMODAL_SKIP_BROWSER_TESTS=1` skips these tests, each
+//! printing `SKIPPED: <test> (...)` to stderr; under `CI=true` it fails them instead.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -22,10 +23,10 @@ use serde_json::{Value, json};
 
 use crate::helpers::{TestApp, spawn_app_with_processes};
 
-/// Headless Chromium, or `None` when browser tests are explicitly skipped.
-fn chromium() -> Option<PathBuf> {
-    if std::env::var("CHOCMODAL_SKIP_BROWSER_TESTS").as_deref() == Ok("1") {
-        eprintln!("CHOCMODAL_SKIP_BROWSER_TESTS=1: the dashboard's browser test is skipped");
+/// Headless Chromium for `test`, or `None` when browser tests are explicitly skipped
+/// (said on stderr; refused under CI, see [`crate::skip`]).
+fn chromium(test: &str) -> Option<PathBuf> {
+    if crate::skip::requested("CHOCMODAL_SKIP_BROWSER_TESTS", test, "needs headless Chromium") {
         return None;
     }
     let candidates = std::env::var_os("CHOCMODAL_CHROMIUM")
@@ -169,7 +170,12 @@ async fn execute(app: &TestApp, process: &str, body: &Value) -> String {
 
 #[tokio::test]
 async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_browser() {
-    let Some(browser) = chromium() else { return };
+    let Some(browser) = chromium(concat!(
+        module_path!(),
+        "::the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_browser"
+    )) else {
+        return;
+    };
     let app =
         spawn_app_with_processes(vec![Arc::new(CantileverImpact), Arc::new(BundleDynamics)], |_| {}).await;
     let within = Duration::from_secs(60);
@@ -484,7 +490,12 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
 /// by the API, ask for the team's token instead of showing empty tables.
 #[tokio::test]
 async fn with_tokens_the_dashboard_asks_for_one() {
-    let Some(browser) = chromium() else { return };
+    let Some(browser) = chromium(concat!(
+        module_path!(),
+        "::with_tokens_the_dashboard_asks_for_one"
+    )) else {
+        return;
+    };
     let tokens = chocmodal::service::auth::TokenTable::parse("alpha alpha-token-0123456789\n").unwrap();
     let app = crate::helpers::spawn_app_with(|config| config.auth = Some(tokens)).await;
 

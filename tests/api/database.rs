@@ -1,7 +1,7 @@
 //! The SQLite settings really apply, and retention deletes old finished jobs (both backends).
 
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use chocmodal::service::clock::ManualClock;
 use reqwest::StatusCode;
@@ -64,7 +64,16 @@ async fn retention_deletes_finished_jobs_and_their_histories(backend: Backend) {
     let recent = app.submit(json!({"steps": 10})).await;
     app.wait_until_finished(&recent).await;
     clock.advance(Duration::from_secs(11 * 86_400));
-    tokio::time::sleep(Duration::from_millis(400)).await;
+    // The next maintenance pass (every 100 ms) finds the old job past retention; once it
+    // is gone, that pass has also judged the recent one.
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while app.get(&format!("/jobs/{old}")).await.status() != StatusCode::NOT_FOUND {
+        assert!(
+            Instant::now() < deadline,
+            "retention never deleted the 31-day-old job"
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
 
     assert_problem(
         app.get(&format!("/jobs/{old}")).await,

@@ -39,7 +39,7 @@ macro_rules! on_both_backends {
             $(
                 #[tokio::test]
                 async fn $test() {
-                    if $crate::postgres::skipped() {
+                    if $crate::postgres::skipped(concat!(module_path!(), "::", stringify!($test))) {
                         return;
                     }
                     super::$test($crate::helpers::Backend::Postgres).await

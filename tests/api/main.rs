@@ -5,6 +5,7 @@
 mod counting;
 mod helpers;
 mod postgres;
+mod skip;
 
 mod capabilities;
 mod dashboard;

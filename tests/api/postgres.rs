@@ -11,7 +11,8 @@
 //! `CHOCMODAL_TEST_DATABASE_URL=postgres://user@host/db` uses that server instead (the
 //! user must be allowed to create databases). Without PostgreSQL binaries the
 //! PostgreSQL tests fail, saying how to install them, unless
-//! `CHOCMODAL_SKIP_POSTGRES_TESTS=1`.
+//! `CHOCMODAL_SKIP_POSTGRES_TESTS=1`: then each prints `SKIPPED: <test> (...)` to stderr,
+//! and under `CI=true` that variable fails them instead (see `skip.rs`).
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -26,13 +27,10 @@ pub const SKIP_VARIABLE: &str = "CHOCMODAL_SKIP_POSTGRES_TESTS";
 /// A server to use instead of a throwaway cluster.
 pub const URL_VARIABLE: &str = "CHOCMODAL_TEST_DATABASE_URL";
 
-/// True when the PostgreSQL tests are skipped on request.
-pub fn skipped() -> bool {
-    let skip = std::env::var(SKIP_VARIABLE).is_ok_and(|value| value == "1");
-    if skip {
-        eprintln!("{SKIP_VARIABLE}=1: PostgreSQL test skipped");
-    }
-    skip
+/// True when the PostgreSQL test `test` is skipped on request (it says so on stderr);
+/// panics when asked to skip under CI (see [`crate::skip`]).
+pub fn skipped(test: &str) -> bool {
+    crate::skip::requested(SKIP_VARIABLE, test, "needs a PostgreSQL server")
 }
 
 struct Server {

@@ -24,9 +24,11 @@ on_both_backends!(
 const NO_MAINTENANCE: Duration = Duration::from_secs(3600);
 
 async fn a_job_left_running_by_a_dead_worker_is_requeued_at_startup_and_completes(backend: Backend) {
+    let clock = Arc::new(ManualClock::starting_now());
     let before = spawn_app_on(backend, |config| {
         config.workers = 0;
         config.maintenance_interval = NO_MAINTENANCE;
+        config.clock = clock.clone();
     })
     .await;
     let job = before.submit(json!({"steps": 20})).await;
@@ -35,9 +37,13 @@ async fn a_job_left_running_by_a_dead_worker_is_requeued_at_startup_and_complete
     assert_eq!(claimed.unwrap().lease.job_id, job);
     assert_eq!(before.status(&job).await["status"], "running");
     let store = before.stop().await;
-    tokio::time::sleep(Duration::from_millis(5)).await;
+    clock.advance(Duration::from_millis(1));
 
-    let after = spawn_app_in(store, |config| config.workers = 1).await;
+    let after = spawn_app_in(store, |config| {
+        config.workers = 1;
+        config.clock = clock.clone();
+    })
+    .await;
     let status = after.wait_until_finished(&job).await;
     assert_eq!(status["status"], "successful", "{status}");
     assert_eq!(
@@ -49,16 +55,18 @@ async fn a_job_left_running_by_a_dead_worker_is_requeued_at_startup_and_complete
 }
 
 async fn a_job_whose_worker_keeps_dying_fails_with_a_clear_message(backend: Backend) {
+    let clock = Arc::new(ManualClock::starting_now());
     let app = spawn_app_on(backend, |config| {
         config.workers = 0;
         config.max_attempts = 2;
         config.maintenance_interval = NO_MAINTENANCE;
+        config.clock = clock.clone();
     })
     .await;
     let job = app.submit(json!({"steps": 20})).await;
     for dead in ["first-dead-worker", "second-dead-worker"] {
         assert!(app.queue.claim(dead, Duration::ZERO).await.unwrap().is_some());
-        tokio::time::sleep(Duration::from_millis(5)).await;
+        clock.advance(Duration::from_millis(1));
         app.queue.recover_expired(2).await.unwrap();
     }
     let status = app.status(&job).await;
@@ -107,7 +115,12 @@ async fn expired_leases_are_recovered_periodically_once_the_clock_passes_them(ba
         config.clock = clock.clone();
     })
     .await;
-    tokio::time::sleep(Duration::from_millis(400)).await;
+    // What the periodic pass does at the manual clock's (unchanged) time: nothing.
+    let recovered = app.queue.recover_expired(3).await.unwrap();
+    assert!(
+        recovered.requeued.is_empty() && recovered.failed.is_empty(),
+        "the lease still holds: {recovered:?}"
+    );
     assert_eq!(
         app.status(&job).await["status"],
         "running",

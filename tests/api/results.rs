@@ -146,8 +146,16 @@ async fn a_deterministic_failure_fails_at_once_without_retry(backend: Backend) {
     )
     .await;
     assert_eq!(problem["detail"], "diverged at step 5");
-    tokio::time::sleep(Duration::from_millis(300)).await;
-    assert_eq!(app.probe.started(), 1, "a deterministic failure is not retried");
+    // Jobs are claimed oldest first: a retry of the failed job would start before a job
+    // submitted after its failure.
+    let later = app.submit(json!({"steps": 2})).await;
+    assert_eq!(app.wait_until_finished(&later).await["status"], "successful");
+    assert_eq!(
+        *app.probe.runs.lock().unwrap(),
+        [10, 2],
+        "a deterministic failure is not retried"
+    );
+    assert_eq!(app.status(&job).await["status"], "failed");
     assert_eq!(app.queue.get("default", &job).await.unwrap().unwrap().attempt, 1);
 }
 

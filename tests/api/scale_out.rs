@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 
 use chocmodal::processes::Registry;
 use chocmodal::service::WorkerService;
+use chocmodal::service::clock::ManualClock;
 use serde_json::{Value, json};
 use sqlx::Connection;
 use tokio::sync::oneshot;
@@ -62,9 +63,11 @@ async fn concurrent_claimers_never_take_the_same_job(backend: Backend) {
 /// Every process runs lease recovery: passes that overlap must not requeue (or count)
 /// a job twice.
 async fn concurrent_recovery_passes_requeue_each_lost_job_once(backend: Backend) {
+    let clock = Arc::new(ManualClock::starting_now());
     let app = spawn_app_on(backend, |config| {
         config.workers = 0;
         config.maintenance_interval = Duration::from_secs(3600);
+        config.clock = clock.clone();
     })
     .await;
     let mut lost = HashSet::new();
@@ -73,7 +76,7 @@ async fn concurrent_recovery_passes_requeue_each_lost_job_once(backend: Backend)
         let claimed = app.queue.claim("dead-worker", Duration::ZERO).await.unwrap();
         lost.insert(claimed.unwrap().lease.job_id);
     }
-    tokio::time::sleep(Duration::from_millis(5)).await;
+    clock.advance(Duration::from_millis(1));
     let mut passes = tokio::task::JoinSet::new();
     for _ in 0..4 {
         let queue = app.queue.clone();
@@ -274,7 +277,10 @@ const LONG_JOB_SECONDS_SIMULATED: f64 = 15.0;
 /// of any job, from any process, would show.
 #[tokio::test]
 async fn killing_a_worker_mid_job_loses_no_job_and_completes_none_twice() {
-    if crate::postgres::skipped() {
+    if crate::postgres::skipped(concat!(
+        module_path!(),
+        "::killing_a_worker_mid_job_loses_no_job_and_completes_none_twice"
+    )) {
         return;
     }
     let url = crate::postgres::fresh_database().await;

@@ -270,8 +270,19 @@ async fn dismissing_a_sweep_dismisses_its_queued_and_running_runs(backend: Backe
         assert!(Instant::now() < deadline, "running runs did not stop");
         tokio::time::sleep(Duration::from_millis(20)).await;
     }
-    tokio::time::sleep(Duration::from_millis(300)).await;
-    assert_eq!(app.probe.started(), 2, "no dismissed run may start");
+    // Runs are claimed oldest first: had a dismissed run stayed claimable, it would
+    // start before the single run of a sweep created after it.
+    let later = app
+        .create_sweep(sweep(
+            json!({"steps": 7}),
+            json!([{"pointer": "/steps", "values": [7]}]),
+        ))
+        .await;
+    app.wait_for_sweep(&later, &["successful"], Duration::from_secs(20))
+        .await;
+    let runs = app.probe.runs.lock().unwrap().clone();
+    assert_eq!(runs.len(), 3, "no dismissed run may start: {runs:?}");
+    assert_eq!(runs[2], 7, "no dismissed run may start: {runs:?}");
 }
 
 async fn a_failed_run_of_a_fail_fast_sweep_dismisses_the_rest_and_fails_the_sweep(backend: Backend) {
