@@ -268,7 +268,7 @@ fn check_costs(prepared: &Prepared) -> Result<StepSize, InvalidInputs> {
             "/inputs/solver/duration",
             format!(
                 "{steps:.3e} steps of {dt:e} s over this row is too much work ({work:.3e} > {MAX_WORK:e}){}",
-                inputs::step_hint(&prepared.settings)
+                inputs::step_hint(&step, prepared.settings.tolerance)
             ),
         ));
     }

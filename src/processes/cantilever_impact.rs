@@ -340,7 +340,7 @@ fn check_costs(prepared: &Prepared) -> Result<StepSize, InvalidInputs> {
                 "needs {:.3e} steps of {dt:e} s, above the limit of {:e}{}",
                 duration / dt,
                 inputs::MAX_STEPS,
-                inputs::step_hint(&prepared.settings)
+                inputs::step_hint(&step, prepared.settings.tolerance)
             ),
         ));
     }

@@ -432,15 +432,20 @@ pub fn resolve_step(
         .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())]))
 }
 
-/// What to add to a "too many steps" refusal: under `auto`, that the tolerance drives
-/// the step.
-pub fn step_hint(settings: &crate::physics::integrate::Settings) -> String {
-    match settings.time_step {
-        TimeStep::Auto => format!(
-            " (time_step \"auto\" chose this step for solver.tolerance {:e}: a larger tolerance takes fewer steps)",
-            settings.tolerance
+/// What to add to a "too many steps" refusal: under `auto`, what set the step and what
+/// would lengthen it.
+pub fn step_hint(step: &crate::physics::integrate::StepSize, tolerance: f64) -> String {
+    use crate::physics::integrate::StepLimit;
+    match step.limited_by {
+        StepLimit::Given => String::new(),
+        StepLimit::FastestMotion | StepLimit::Stability => format!(
+            " (time_step \"auto\" chose this step for solver.tolerance {tolerance:e}: a larger tolerance takes fewer steps)"
         ),
-        TimeStep::Fixed(_) => String::new(),
+        StepLimit::Excitation => {
+            " (time_step \"auto\" resolves the excitation: its shortest sample interval or \
+             pulse sets this step)"
+                .to_owned()
+        }
     }
 }
 
