@@ -8,7 +8,8 @@ pub mod cli;
 /// Request bodies as JSON values, with pointer-bearing errors (numbers out of range).
 pub mod json_body;
 /// Pure numerics: beams, modal bases, contacts, explicit integration, reference solution.
-pub mod physics;
+/// Its own crate (`crates/physics`), so its purity is the compiler's to enforce.
+pub use chocmodal_physics as physics;
 /// JSON pointers of serde paths (a leaf: nothing else in the crate is imported).
 pub mod pointer;
 /// RFC 9457 problem details shared by the HTTP API and the CLI.

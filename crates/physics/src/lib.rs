@@ -63,7 +63,7 @@ pub fn decimal(value: f64) -> f64 {
 }
 
 /// Checks that `value` is finite and strictly positive; records an issue otherwise.
-pub(crate) fn require_positive(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
+pub fn require_positive(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
     if !value.is_finite() {
         issues.push(InputIssue::new(field, "must be a finite number"));
     } else if value <= 0.0 {
@@ -72,7 +72,7 @@ pub(crate) fn require_positive(issues: &mut Vec<InputIssue>, field: &str, value:
 }
 
 /// Checks that `value` is finite and non-negative; records an issue otherwise.
-pub(crate) fn require_non_negative(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
+pub fn require_non_negative(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
     if !value.is_finite() {
         issues.push(InputIssue::new(field, "must be a finite number"));
     } else if value < 0.0 {

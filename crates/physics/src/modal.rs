@@ -300,8 +300,8 @@ pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::beam::tests::default_tube;
-    use crate::physics::beam::{Section, Support};
+    use crate::beam::tests::default_tube;
+    use crate::beam::{Section, Support};
 
     /// Roots λᵢ of 1 + cos λ cosh λ = 0 (clamped-free Euler-Bernoulli beam).
     const CLAMPED_FREE_ROOTS: [f64; 5] = [

@@ -3,9 +3,9 @@
 //! force, and the energy balance of a damped, excited multi-contact row.
 
 use super::*;
-use crate::physics::beam::tests::default_tube;
-use crate::physics::contact::Body;
-use crate::physics::loads::Table;
+use crate::beam::tests::default_tube;
+use crate::contact::Body;
+use crate::loads::Table;
 
 fn basis(elements: usize, modes: usize) -> ModalBasis {
     ModalBasis::compute(&default_tube(elements), modes).expect("valid beam")

@@ -26,7 +26,7 @@
 
 use super::Simulation;
 use super::step_size::{StepSize, scheme_order};
-use crate::physics::stability::Scheme;
+use crate::stability::Scheme;
 
 /// Peaks are held to this multiple of the tolerance (1 % at the default 10⁻³).
 pub const PEAK_TOLERANCE_FACTOR: f64 = 10.0;

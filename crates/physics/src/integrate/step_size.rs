@@ -2,7 +2,7 @@
 //! a step for accuracy within stability.
 //!
 //! **Stability.** ω_max is the highest angular frequency of the modal system with every
-//! contact closed ([`crate::physics::stability`]); a scheme is stable for
+//! contact closed ([`crate::stability`]); a scheme is stable for
 //! ω_max Δt ≤ its limit (2 for central difference).
 //!
 //! **Accuracy (`auto`).** A stable step is not an accurate one: at 0.8 × the critical
@@ -30,8 +30,8 @@
 //! --ignored --nocapture`).
 
 use super::{Model, Settings, SimulationError, TimeStep};
-use crate::physics::loads::BaseAcceleration;
-use crate::physics::stability::{Scheme, max_angular_frequency};
+use crate::loads::BaseAcceleration;
+use crate::stability::{Scheme, max_angular_frequency};
 
 /// Steps per period of the fastest motion at the default tolerance (10⁻³).
 pub const STEPS_PER_PERIOD: f64 = 50.0;

@@ -46,8 +46,8 @@ use super::{
     ContactStatistics, EnergyBalance, Model, PeakDeflection, PinExtreme, Settings, Simulation,
     SimulationError, StepSize,
 };
-use crate::physics::contact::Body;
-use crate::physics::stability::Scheme;
+use crate::contact::Body;
+use crate::stability::Scheme;
 
 pub(super) struct Integrator<'m> {
     arch: pulp::Arch,
@@ -763,7 +763,7 @@ impl<'m> Integrator<'m> {
                 if w.abs() > extreme.max_abs_deflection {
                     *extreme = PinExtreme {
                         max_abs_deflection: w.abs(),
-                        height: crate::physics::decimal(node as f64 * element_length),
+                        height: crate::decimal(node as f64 * element_length),
                         time: t,
                     };
                 }

@@ -8,9 +8,9 @@
 //! copied from our own output.
 
 use super::*;
-use crate::physics::beam::{BeamSpec, Section, Support};
-use crate::physics::contact::Body;
-use crate::physics::loads::Table;
+use crate::beam::{BeamSpec, Section, Support};
+use crate::contact::Body;
+use crate::loads::Table;
 
 /// A row of identical pins between two walls.
 #[derive(Debug, Clone)]

@@ -225,16 +225,16 @@ mod tests {
     use std::ops::ControlFlow;
 
     use super::*;
-    use crate::physics::beam::tests::default_tube;
-    use crate::physics::beam::{BeamSpec, Support};
-    use crate::physics::contact::{Body, Contact};
-    use crate::physics::integrate::{
+    use crate::beam::tests::default_tube;
+    use crate::beam::{BeamSpec, Support};
+    use crate::contact::{Body, Contact};
+    use crate::integrate::{
         Check, DEFAULT_TOLERANCE, Model, Settings, Simulation, SimulationError, StepLimit, StepSize,
         TimeStep, critical_time_step, run_resolved, simulate,
     };
-    use crate::physics::loads::{BaseAcceleration, PointForce, Table};
-    use crate::physics::modal::ModalBasis;
-    use crate::physics::stability::Scheme;
+    use crate::loads::{BaseAcceleration, PointForce, Table};
+    use crate::modal::ModalBasis;
+    use crate::stability::Scheme;
 
     /// Static flexibility G(a, b) = Σᵢ ψᵢ(a) ψᵢ(b) / ωᵢ² of a basis (m/N): the deflection
     /// at a under a unit force at b, as the modal basis represents it.
