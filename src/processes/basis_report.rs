@@ -2,13 +2,14 @@
 //! (eigenmodes, static-correction pseudo-modes and their heights) and what it cost.
 
 use serde::Serialize;
+use utoipa::ToSchema;
 
 use crate::physics::integrate::{Model, critical_time_step};
 use crate::physics::modal::ModalBasis;
 use crate::physics::stability::Scheme;
 
 /// The basis of a run, as reported in its results.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 pub struct BasisReport {
     /// `none` or `contacts`, as used.
     pub static_correction: &'static str,
@@ -29,7 +30,7 @@ pub struct BasisReport {
 }
 
 /// What the basis costs the run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 pub struct BasisCost {
     /// Modal coordinates per pin (modes + pseudo-modes).
     pub modal_dofs_per_pin: usize,

@@ -3,72 +3,365 @@
 //! released from bent shapes. The generator form is expanded to the explicit contact
 //! list, which the results echo.
 
-use serde_json::json;
+use serde::Serialize;
+use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
-use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
-use super::inputs::{self, at};
-use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
+use super::bundle_inputs::{BodyInput, BundleInputs, ContactInput};
+use super::inputs::{self, SolverDefaults, at};
+use super::report::{EnergyReport, QualityReport};
+use super::simulation::{HistoryOutput, Output, Simulation};
+use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::Contact;
-use crate::physics::integrate::{Check, Model, Settings, StepSize, run_resolved, step_counts};
+use crate::physics::integrate::{Model, Settings, StepSize, run_resolved};
 use crate::physics::modal::ModalBasis;
 
 /// Most pins in one row.
 pub const MAX_PINS: usize = 2000;
-/// Largest pins × modes × steps (about a minute of computation).
-pub const MAX_WORK: f64 = 2e11;
-/// Largest number of history values (samples × columns) per history.
-pub const MAX_HISTORY_VALUES: f64 = 5e7;
 /// Default history interval (s).
 pub const DEFAULT_OUTPUT_INTERVAL: f64 = 1e-4;
 
+/// Validated inputs, ready to run.
 #[derive(Debug)]
-struct Prepared {
+pub struct Plan {
     inputs: BundleInputs,
     pins: usize,
     contacts: Vec<Contact>,
     basis: ModalBasis,
     settings: Settings,
+    step: StepSize,
 }
 
-impl Prepared {
+impl Plan {
     fn model(&self) -> Model<'_> {
-        let tips = &self.inputs.initial.tip_displacements;
-        Model {
-            basis: &self.basis,
-            pins: self.pins,
-            damping_ratios: self.inputs.pin.damping_ratios_for(self.basis.modes()),
-            contacts: self.contacts.clone(),
-            initial_tip_displacements: tips.clone(),
-            base_acceleration: self
-                .inputs
-                .excitation
-                .base_acceleration
-                .as_ref()
-                .map(|b| b.physics()),
-            point_forces: self
-                .inputs
-                .excitation
-                .point_forces
-                .iter()
-                .map(|f| f.physics())
-                .collect(),
+        row_model(&self.inputs, self.pins, &self.contacts, &self.basis)
+    }
+}
+
+/// The row as the integrator sees it.
+fn row_model<'a>(
+    inputs: &BundleInputs,
+    pins: usize,
+    contacts: &[Contact],
+    basis: &'a ModalBasis,
+) -> Model<'a> {
+    Model {
+        basis,
+        pins,
+        damping_ratios: inputs.pin.damping_ratios_for(basis.modes()),
+        contacts: contacts.to_vec(),
+        initial_tip_displacements: inputs.initial.tip_displacements.clone(),
+        base_acceleration: inputs.excitation.base_acceleration.as_ref().map(|b| b.physics()),
+        point_forces: inputs
+            .excitation
+            .point_forces
+            .iter()
+            .map(|f| f.physics())
+            .collect(),
+    }
+}
+
+/// The results document of `bundle-dynamics`.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct BundleResults {
+    /// Every contact (the expanded list for the generator form) and its statistics,
+    /// accumulated at every step.
+    pub contacts: Vec<ContactResult>,
+    /// The largest force over all contacts; null without contacts.
+    pub max_contact_force: Option<PeakForce>,
+    /// Total closures over all contacts.
+    pub impacts: u64,
+    /// Per pin, its largest deflection.
+    pub pins: Vec<PinResult>,
+    pub energy: EnergyReport,
+    /// Step used (s).
+    pub time_step: f64,
+    /// Critical step with every contact closed (s).
+    pub critical_time_step: f64,
+    /// Steps taken.
+    pub steps: u64,
+    /// Time between two history samples (s).
+    pub output_interval: f64,
+    pub quality: QualityReport,
+    /// Frequencies of the pin's basis (Hz), eigenmodes then pseudo-modes.
+    pub frequencies_hz: Vec<f64>,
+    pub basis: BasisReport,
+    /// The generator form's expansion (absent for the explicit form).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub expansion: Option<Expansion>,
+}
+
+/// One contact and its statistics.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct ContactResult {
+    #[serde(flatten)]
+    pub contact: ContactInput,
+    /// Largest force (N).
+    pub max_force: f64,
+    /// Its time (s); 0 when the contact never closed.
+    pub max_force_time: f64,
+    /// Closures after a separation (the first counts).
+    pub impacts: u64,
+    /// Total time closed (s).
+    pub contact_time: f64,
+    /// ∫ F dt (N·s).
+    pub impulse: f64,
+    /// Time of the first closure (s), interpolated between steps; null if none.
+    pub first_impact_time: Option<f64>,
+    /// Largest penetration (m); ≤ 0 when the contact never closed (smallest clearance).
+    pub max_penetration: f64,
+}
+
+/// The largest contact force of the run.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+pub struct PeakForce {
+    /// Contact index.
+    pub contact: usize,
+    /// Force (N).
+    pub force: f64,
+    /// Time (s).
+    pub time: f64,
+}
+
+/// One pin's largest deflections.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct PinResult {
+    pub pin: usize,
+    /// max |w| (m) over the mesh nodes at every output time.
+    pub max_abs_deflection: f64,
+    /// Height where it occurred (m).
+    pub height: f64,
+    /// When (s).
+    pub time: f64,
+    /// Per output height, the deflection of largest magnitude over every step (the
+    /// extreme of its `displacements_peaks` column).
+    pub peak_deflections: Vec<PeakDeflectionResult>,
+}
+
+/// The deflection of largest magnitude at one height, over every step.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+pub struct PeakDeflectionResult {
+    /// Height (m).
+    pub height: f64,
+    /// Signed deflection (m).
+    pub deflection: f64,
+    /// The end of the output interval that holds it (s).
+    pub time: f64,
+}
+
+/// The explicit model the generator form expands to.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct Expansion {
+    pub pins: usize,
+    pub contacts: Vec<ContactInput>,
+}
+
+impl From<&Contact> for ContactInput {
+    fn from(c: &Contact) -> Self {
+        ContactInput {
+            left: BodyInput::from(c.left),
+            right: BodyInput::from(c.right),
+            height: c.height,
+            gap: c.gap,
+            stiffness: c.stiffness,
+            damping: c.damping,
         }
     }
+}
 
-    /// What the run costs: pins × modes modal DOFs and every contact at each step;
-    /// histories `contact_forces` (time + one column per contact) and `displacements`
-    /// (time + one column per pin and output height).
-    fn estimate(&self, step: &StepSize) -> WorkEstimate {
-        let (steps, every) = step_counts(self.settings.duration, step, self.settings.output_interval);
-        // Each history and its peaks.
-        let columns = 2 * ((1 + self.contacts.len()) + (1 + self.pins * self.settings.output_heights.len()));
-        // The step-halving check takes twice the steps of the run.
-        let check = match self.settings.check {
-            Check::StepHalving => 3.0,
-            Check::None => 1.0,
+/// The `bundle-dynamics` process.
+#[derive(Debug, Default)]
+pub struct BundleDynamics;
+
+impl Simulation for BundleDynamics {
+    const ID: &'static str = "bundle-dynamics";
+    const TITLE: &'static str = "Row of pins rattling between two wrapper walls";
+    const DESCRIPTION: &'static str = "Integrates a row of identical pins (one shared modal basis) with penalty point contacts between \
+         pins and against the walls, under a base acceleration of the wrapper, initial releases and point \
+         forces. Returns per-contact statistics (peak force, impacts, contact time, impulse), per-pin \
+         extremes, the energy balance, and contact-force and deflection histories.";
+    const HISTORIES: &'static [HistoryOutput] = &[
+        HistoryOutput {
+            name: "contact_forces",
+            title: "Contact forces (N)",
+            description: "CSV columns time (s), c0, c1, ... in contact order",
+        },
+        HistoryOutput {
+            name: "displacements",
+            title: "Pin deflections (m)",
+            description: "CSV columns time (s), p0, p1, ... (pin tips; `p<pin>@<height>` for other heights)",
+        },
+        HistoryOutput {
+            name: "contact_forces_peaks",
+            title: "Contact force peaks (N)",
+            description: "As contact_forces, each value the largest force reached at any step of its output \
+                          interval: the maximum of column c<k> is contact k's max_force",
+        },
+        HistoryOutput {
+            name: "displacements_peaks",
+            title: "Pin deflection peaks (m)",
+            description: "As displacements, each value the deflection of largest magnitude (signed) reached at \
+                          any step of its output interval",
+        },
+    ];
+
+    type Inputs = BundleInputs;
+    type Results = BundleResults;
+    type Plan = Plan;
+
+    fn prepare(inputs: BundleInputs) -> Result<Plan, InvalidInputs> {
+        let length = inputs.pin.length;
+        let mut errors: Vec<FieldError> = at("/inputs/pin", inputs.pin.validate());
+
+        let (pins, contacts) = match (&inputs.bundle, inputs.pins, &inputs.contacts) {
+            (Some(generator), None, None) => {
+                let layout = generator.layout();
+                match layout.expand(length) {
+                    Ok(contacts) => (generator.pins, contacts),
+                    Err(issues) => {
+                        errors.extend(at("/inputs/bundle", issues));
+                        (generator.pins, vec![])
+                    }
+                }
+            }
+            (None, Some(pins), contacts) => {
+                if !(1..=MAX_PINS).contains(&pins) {
+                    errors.push(FieldError::new(
+                        "/inputs/pins",
+                        format!("must be between 1 and {MAX_PINS}"),
+                    ));
+                }
+                let contacts: Vec<Contact> = contacts.iter().flatten().map(ContactInput::contact).collect();
+                if pins >= 1 {
+                    for (k, contact) in contacts.iter().enumerate() {
+                        errors.extend(at(
+                            &format!("/inputs/contacts/{k}"),
+                            contact.validate(pins, length),
+                        ));
+                    }
+                }
+                (pins, contacts)
+            }
+            (Some(_), _, _) => {
+                let field = if inputs.pins.is_some() {
+                    "/inputs/pins"
+                } else {
+                    "/inputs/contacts"
+                };
+                return Err(InvalidInputs(vec![FieldError::new(
+                    field,
+                    "give either `pins` and `contacts`, or `bundle`, not both",
+                )]));
+            }
+            (None, None, _) => {
+                return Err(InvalidInputs(vec![FieldError::new(
+                    "/inputs/pins",
+                    "is required (or use the `bundle` generator form)",
+                )]));
+            }
         };
-        let generated = self.inputs.bundle.is_some();
+        if pins > MAX_PINS {
+            errors.push(FieldError::new(
+                "/inputs/bundle/pins",
+                format!("must be at most {MAX_PINS}"),
+            ));
+        }
+
+        let tips = &inputs.initial.tip_displacements;
+        if !tips.is_empty() && tips.len() != pins {
+            errors.push(FieldError::new(
+                "/inputs/initial/tip_displacements",
+                format!("needs one value per pin ({pins}), got {}", tips.len()),
+            ));
+        }
+        for (p, tip) in tips.iter().enumerate() {
+            if !tip.is_finite() {
+                errors.push(FieldError::new(
+                    format!("/inputs/initial/tip_displacements/{p}"),
+                    "must be a finite number",
+                ));
+            }
+        }
+        if tips.iter().any(|t| *t != 0.0) && inputs.pin.supports.top != super::inputs::SupportInput::Free {
+            errors.push(FieldError::new(
+                "/inputs/initial/tip_displacements",
+                "a tip release needs a free top",
+            ));
+        }
+        if let Some(base) = &inputs.excitation.base_acceleration {
+            errors.extend(at(
+                "/inputs/excitation/base_acceleration",
+                base.physics().validate(),
+            ));
+        }
+        for (k, force) in inputs.excitation.point_forces.iter().enumerate() {
+            let prefix = format!("/inputs/excitation/point_forces/{k}");
+            if force.pin >= pins {
+                errors.push(FieldError::new(
+                    format!("{prefix}/pin"),
+                    format!("pin {} does not exist", force.pin),
+                ));
+            }
+            if !(force.height.is_finite() && (0.0..=length).contains(&force.height)) {
+                errors.push(FieldError::new(
+                    format!("{prefix}/height"),
+                    format!("must be within the pin, 0 to {length} m"),
+                ));
+            }
+            errors.extend(at(&prefix, force.physics().force.validate("force")));
+        }
+
+        let solver = inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
+        inputs::check_output_interval(inputs.output.interval, &mut errors);
+        let heights = inputs.output.heights.clone().unwrap_or_else(|| vec![length]);
+        if heights.is_empty() {
+            errors.push(FieldError::new(
+                "/inputs/output/heights",
+                "must list at least one height",
+            ));
+        }
+        for (k, h) in heights.iter().enumerate() {
+            if !(h.is_finite() && (0.0..=length).contains(h)) {
+                errors.push(FieldError::new(
+                    format!("/inputs/output/heights/{k}"),
+                    format!("must be within the pin, 0 to {length} m"),
+                ));
+            }
+        }
+        if !errors.is_empty() {
+            return Err(InvalidInputs(errors));
+        }
+
+        // One static correction per distinct contact height, shared by every pin.
+        let contact_heights: Vec<f64> = contacts.iter().map(|c| c.height).collect();
+        let basis = inputs.pin.basis(&contact_heights, "/inputs/pin")?;
+        let settings = Settings {
+            scheme: solver.scheme,
+            time_step: solver.time_step,
+            tolerance: solver.tolerance,
+            check: solver.check,
+            duration: solver.duration,
+            output_interval: Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
+            output_heights: heights,
+        };
+        let step = inputs::resolve_step(&row_model(&inputs, pins, &contacts, &basis), &settings)?;
+        Ok(Plan {
+            inputs,
+            pins,
+            contacts,
+            basis,
+            settings,
+            step,
+        })
+    }
+
+    /// pins × modes modal DOFs and every contact at each step; histories
+    /// `contact_forces` (time + one column per contact) and `displacements` (time + one
+    /// column per pin and output height), and their peaks.
+    fn estimate(plan: &Plan) -> WorkEstimate {
+        let (stepping, samples) = inputs::stepping(&plan.settings, &plan.step);
+        let columns = 2 * ((1 + plan.contacts.len()) + (1 + plan.pins * plan.settings.output_heights.len()));
+        let generated = plan.inputs.bundle.is_some();
         let (pins, contacts) = if generated {
             ("/inputs/bundle/pins", "/inputs/bundle/levels")
         } else {
@@ -79,14 +372,13 @@ impl Prepared {
             "/inputs/output/interval".to_owned(),
             pins.to_owned(),
         ];
-        if self.inputs.output.heights.is_some() {
+        if plan.inputs.output.heights.is_some() {
             history_drivers.push("/inputs/output/heights".to_owned());
         }
         WorkEstimate {
-            steps: check * steps as f64,
-            modal_dofs: (self.pins * self.basis.modes()) as f64,
-            contacts: self.contacts.len() as f64,
-            history_values: (steps / every + 1) as f64 * columns as f64,
+            modal_dofs: (plan.pins * plan.basis.modes()) as f64,
+            contacts: plan.contacts.len() as f64,
+            history_values: samples * columns as f64,
             work_drivers: [
                 "/inputs/solver/duration",
                 "/inputs/solver/time_step",
@@ -97,326 +389,85 @@ impl Prepared {
             .map(str::to_owned)
             .to_vec(),
             history_drivers,
+            ..stepping
         }
     }
-}
 
-/// Validated inputs and the step they run with.
-#[derive(Debug)]
-struct Plan {
-    prepared: Prepared,
-    step: StepSize,
-}
-
-fn prepare(json: &serde_json::Value) -> Result<Plan, InvalidInputs> {
-    let inputs: BundleInputs = inputs::parse(json)?;
-    let length = inputs.pin.length;
-    let mut errors: Vec<FieldError> = at("/inputs/pin", inputs.pin.validate());
-
-    let (pins, contacts) = match (&inputs.bundle, inputs.pins, &inputs.contacts) {
-        (Some(generator), None, None) => {
-            let layout = generator.layout();
-            match layout.expand(length) {
-                Ok(contacts) => (generator.pins, contacts),
-                Err(issues) => {
-                    errors.extend(at("/inputs/bundle", issues));
-                    (generator.pins, vec![])
-                }
-            }
-        }
-        (None, Some(pins), contacts) => {
-            if !(1..=MAX_PINS).contains(&pins) {
-                errors.push(FieldError::new(
-                    "/inputs/pins",
-                    format!("must be between 1 and {MAX_PINS}"),
-                ));
-            }
-            let contacts: Vec<Contact> = contacts.iter().flatten().map(ContactInput::contact).collect();
-            if pins >= 1 {
-                for (k, contact) in contacts.iter().enumerate() {
-                    errors.extend(at(
-                        &format!("/inputs/contacts/{k}"),
-                        contact.validate(pins, length),
-                    ));
-                }
-            }
-            (pins, contacts)
-        }
-        (Some(_), _, _) => {
-            let field = if inputs.pins.is_some() {
-                "/inputs/pins"
-            } else {
-                "/inputs/contacts"
-            };
-            return Err(InvalidInputs(vec![FieldError::new(
-                field,
-                "give either `pins` and `contacts`, or `bundle`, not both",
-            )]));
-        }
-        (None, None, _) => {
-            return Err(InvalidInputs(vec![FieldError::new(
-                "/inputs/pins",
-                "is required (or use the `bundle` generator form)",
-            )]));
-        }
-    };
-    if pins > MAX_PINS {
-        errors.push(FieldError::new(
-            "/inputs/bundle/pins",
-            format!("must be at most {MAX_PINS}"),
-        ));
-    }
-
-    let tips = &inputs.initial.tip_displacements;
-    if !tips.is_empty() && tips.len() != pins {
-        errors.push(FieldError::new(
-            "/inputs/initial/tip_displacements",
-            format!("needs one value per pin ({pins}), got {}", tips.len()),
-        ));
-    }
-    for (p, tip) in tips.iter().enumerate() {
-        if !tip.is_finite() {
-            errors.push(FieldError::new(
-                format!("/inputs/initial/tip_displacements/{p}"),
-                "must be a finite number",
-            ));
-        }
-    }
-    if tips.iter().any(|t| *t != 0.0) && inputs.pin.supports.top != super::inputs::SupportInput::Free {
-        errors.push(FieldError::new(
-            "/inputs/initial/tip_displacements",
-            "a tip release needs a free top",
-        ));
-    }
-    if let Some(base) = &inputs.excitation.base_acceleration {
-        errors.extend(at(
-            "/inputs/excitation/base_acceleration",
-            base.physics().validate(),
-        ));
-    }
-    for (k, force) in inputs.excitation.point_forces.iter().enumerate() {
-        let prefix = format!("/inputs/excitation/point_forces/{k}");
-        if force.pin >= pins {
-            errors.push(FieldError::new(
-                format!("{prefix}/pin"),
-                format!("pin {} does not exist", force.pin),
-            ));
-        }
-        if !(force.height.is_finite() && (0.0..=length).contains(&force.height)) {
-            errors.push(FieldError::new(
-                format!("{prefix}/height"),
-                format!("must be within the pin, 0 to {length} m"),
-            ));
-        }
-        errors.extend(at(&prefix, force.physics().force.validate("force")));
-    }
-
-    let solver = inputs::solver(inputs.solver.fields(), &mut errors);
-    inputs::check_output_interval(inputs.output.interval, &mut errors);
-    let heights = inputs.output.heights.clone().unwrap_or_else(|| vec![length]);
-    if heights.is_empty() {
-        errors.push(FieldError::new(
-            "/inputs/output/heights",
-            "must list at least one height",
-        ));
-    }
-    for (k, h) in heights.iter().enumerate() {
-        if !(h.is_finite() && (0.0..=length).contains(h)) {
-            errors.push(FieldError::new(
-                format!("/inputs/output/heights/{k}"),
-                format!("must be within the pin, 0 to {length} m"),
-            ));
-        }
-    }
-    if !errors.is_empty() {
-        return Err(InvalidInputs(errors));
-    }
-
-    // One static correction per distinct contact height, shared by every pin.
-    let contact_heights: Vec<f64> = contacts.iter().map(|c| c.height).collect();
-    let basis = inputs.pin.basis(&contact_heights, "/inputs/pin")?;
-    let settings = Settings {
-        scheme: solver.scheme,
-        time_step: solver.time_step,
-        tolerance: solver.tolerance,
-        check: solver.check,
-        duration: inputs.solver.duration,
-        output_interval: Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
-        output_heights: heights,
-    };
-    let prepared = Prepared {
-        inputs,
-        pins,
-        contacts,
-        basis,
-        settings,
-    };
-    let step = check_costs(&prepared)?;
-    Ok(Plan { prepared, step })
-}
-
-fn check_costs(prepared: &Prepared) -> Result<StepSize, InvalidInputs> {
-    let model = prepared.model();
-    let step = inputs::resolve_step(&model, &prepared.settings)?;
-    let dt = step.time_step;
-    let duration = prepared.settings.duration;
-    let steps = duration / dt;
-    let mut errors = Vec::new();
-    let work = steps * (prepared.pins * prepared.basis.modes() + prepared.contacts.len()) as f64;
-    if steps > inputs::MAX_STEPS || work > MAX_WORK {
-        errors.push(FieldError::new(
-            "/inputs/solver/duration",
-            format!(
-                "{steps:.3e} steps of {dt:e} s over this row is too much work ({work:.3e} > {MAX_WORK:e}){}",
-                inputs::step_hint(&step, prepared.settings.tolerance)
-            ),
-        ));
-    }
-    let interval = prepared.settings.output_interval.unwrap_or(dt).max(dt);
-    let columns =
-        (prepared.contacts.len()).max(prepared.pins * prepared.settings.output_heights.len()) as f64;
-    if duration / interval * columns > MAX_HISTORY_VALUES {
-        errors.push(FieldError::new(
-            "/inputs/output/interval",
-            format!(
-                "histories would hold {:.3e} values, above {MAX_HISTORY_VALUES:e}: sample less often",
-                duration / interval * columns
-            ),
-        ));
-    }
-    if errors.is_empty() {
-        Ok(step)
-    } else {
-        Err(InvalidInputs(errors))
-    }
-}
-
-/// The `bundle-dynamics` process.
-#[derive(Debug, Default)]
-pub struct BundleDynamics;
-
-impl Process for BundleDynamics {
-    fn id(&self) -> &'static str {
-        "bundle-dynamics"
-    }
-
-    fn title(&self) -> &'static str {
-        "Row of pins rattling between two wrapper walls"
-    }
-
-    fn description(&self) -> &'static str {
-        "Integrates a row of identical pins (one shared modal basis) with penalty point contacts between \
-         pins and against the walls, under a base acceleration of the wrapper, initial releases and point \
-         forces. Returns per-contact statistics (peak force, impacts, contact time, impulse), per-pin \
-         extremes, the energy balance, and contact-force and deflection histories."
-    }
-
-    fn inputs_description(&self) -> serde_json::Value {
-        inputs::ogc_inputs(&inputs::schema_of::<BundleInputs>())
-    }
-
-    fn outputs_description(&self) -> serde_json::Value {
-        json!({
-            "contact_forces": {"title": "Contact forces (N)", "description": "CSV columns time (s), c0, c1, ... in contact order",
-                               "schema": {"type": "string", "contentMediaType": "text/csv"}},
-            "displacements": {"title": "Pin deflections (m)", "description": "CSV columns time (s), p0, p1, ... (pin tips; `p<pin>@<height>` for other heights)",
-                              "schema": {"type": "string", "contentMediaType": "text/csv"}},
-            "contact_forces_peaks": {"title": "Contact force peaks (N)", "description": "As contact_forces, each value the largest force reached at any step of its output interval: the maximum of column c<k> is contact k's max_force",
-                               "schema": {"type": "string", "contentMediaType": "text/csv"}},
-            "displacements_peaks": {"title": "Pin deflection peaks (m)", "description": "As displacements, each value the deflection of largest magnitude (signed) reached at any step of its output interval",
-                              "schema": {"type": "string", "contentMediaType": "text/csv"}},
-        })
-    }
-
-    fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs> {
-        prepare(inputs).map(|plan| plan.prepared.estimate(&plan.step))
-    }
-
-    fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
+    fn metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
         bundle_metrics(document)
     }
 
-    fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
-        let Plan { prepared, step } = prepare(inputs)?;
-        let model = prepared.model();
-        let assessed = run_resolved(&model, &prepared.settings, &step, progress)?;
+    fn run(plan: Plan, progress: &mut ProgressFn<'_>) -> Result<Output<BundleResults>, RunError> {
+        let model = plan.model();
+        let assessed = run_resolved(&model, &plan.settings, &plan.step, progress)?;
         let (simulation, quality) = (assessed.simulation, assessed.quality);
 
-        let contacts: Vec<serde_json::Value> = prepared
+        let contacts: Vec<ContactResult> = plan
             .contacts
             .iter()
             .zip(&simulation.contact_statistics)
-            .map(|(c, s)| {
-                json!({
-                    "left": body_json(c.left), "right": body_json(c.right), "height": c.height, "gap": c.gap,
-                    "stiffness": c.stiffness, "damping": c.damping,
-                    "max_force": s.max_force, "max_force_time": s.max_force_time, "impacts": s.impacts,
-                    "contact_time": s.contact_time, "impulse": s.impulse, "first_impact_time": s.first_impact_time,
-                    "max_penetration": s.max_penetration,
-                })
+            .map(|(c, s)| ContactResult {
+                contact: c.into(),
+                max_force: s.max_force,
+                max_force_time: s.max_force_time,
+                impacts: s.impacts,
+                contact_time: s.contact_time,
+                impulse: s.impulse,
+                first_impact_time: s.first_impact_time,
+                max_penetration: s.max_penetration,
             })
             .collect();
-        let peak = simulation
+        let max_contact_force = simulation
             .contact_statistics
             .iter()
             .enumerate()
             .max_by(|a, b| a.1.max_force.total_cmp(&b.1.max_force))
-            .map(|(k, s)| json!({"contact": k, "force": s.max_force, "time": s.max_force_time}));
-        let pins: Vec<serde_json::Value> = simulation
+            .map(|(k, s)| PeakForce {
+                contact: k,
+                force: s.max_force,
+                time: s.max_force_time,
+            });
+        let heights = &plan.settings.output_heights;
+        let pins: Vec<PinResult> = simulation
             .pin_extremes
             .iter()
             .enumerate()
-            .map(|(p, e)| {
-                // Per output height, the deflection of largest magnitude over every step
-                // (the extreme of its `displacements_peaks` column).
-                let peaks: Vec<serde_json::Value> = prepared
-                    .settings
-                    .output_heights
+            .map(|(p, e)| PinResult {
+                pin: p,
+                max_abs_deflection: e.max_abs_deflection,
+                height: e.height,
+                time: e.time,
+                peak_deflections: heights
                     .iter()
                     .zip(&simulation.peak_deflections)
-                    .map(|(height, per_pin)| {
-                        json!({"height": height, "deflection": per_pin[p].deflection, "time": per_pin[p].time})
+                    .map(|(height, per_pin)| PeakDeflectionResult {
+                        height: *height,
+                        deflection: per_pin[p].deflection,
+                        time: per_pin[p].time,
                     })
-                    .collect();
-                json!({"pin": p, "max_abs_deflection": e.max_abs_deflection, "height": e.height, "time": e.time,
-                       "peak_deflections": peaks})
+                    .collect(),
             })
             .collect();
-        let mut document = json!({
-            "contacts": contacts,
-            "max_contact_force": peak,
-            "impacts": simulation.contact_statistics.iter().map(|s| s.impacts).sum::<u64>(),
-            "pins": pins,
-            "energy": {
-                "kinetic": simulation.energy.kinetic, "strain": simulation.energy.strain,
-                "contact": simulation.energy.contact, "dissipated_modal": simulation.energy.dissipated_modal,
-                "dissipated_contact": simulation.energy.dissipated_contact,
-                "external_work": simulation.energy.external_work, "initial": simulation.energy.initial,
-                "residual": simulation.energy.residual(), "relative_residual": simulation.energy.relative_residual(),
-            },
-            "time_step": simulation.step.time_step,
-            "critical_time_step": simulation.step.critical_time_step,
-            "steps": simulation.steps,
-            "output_interval": simulation.output_interval,
-            "quality": quality,
-            "frequencies_hz": prepared.basis.frequencies_hz(),
-            "basis": BasisReport::of(&model, prepared.settings.scheme, simulation.step.critical_time_step),
-        });
-        if prepared.inputs.bundle.is_some() {
-            let explicit: Vec<serde_json::Value> = prepared
-                .contacts
-                .iter()
-                .map(|c| {
-                    json!({"left": body_json(c.left), "right": body_json(c.right), "height": c.height,
-                                "gap": c.gap, "stiffness": c.stiffness, "damping": c.damping})
-                })
-                .collect();
-            document["expansion"] = json!({"pins": prepared.pins, "contacts": explicit});
-        }
-        Ok(RunOutput {
-            document,
-            histories: histories(&prepared, simulation),
-        })
+        let results = BundleResults {
+            contacts,
+            max_contact_force,
+            impacts: simulation.contact_statistics.iter().map(|s| s.impacts).sum(),
+            pins,
+            energy: simulation.energy.into(),
+            time_step: simulation.step.time_step,
+            critical_time_step: simulation.step.critical_time_step,
+            steps: simulation.steps,
+            output_interval: simulation.output_interval,
+            quality: quality.into(),
+            frequencies_hz: plan.basis.frequencies_hz(),
+            basis: BasisReport::of(&model, plan.settings.scheme, simulation.step.critical_time_step),
+            expansion: plan.inputs.bundle.is_some().then(|| Expansion {
+                pins: plan.pins,
+                contacts: plan.contacts.iter().map(ContactInput::from).collect(),
+            }),
+        };
+        let histories = histories(&plan, simulation);
+        Ok(Output { results, histories })
     }
 }
 
@@ -442,7 +493,7 @@ fn bundle_metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Valu
     metrics
 }
 
-fn histories(prepared: &Prepared, simulation: crate::physics::integrate::Simulation) -> Vec<History> {
+fn histories(prepared: &Plan, simulation: crate::physics::integrate::Simulation) -> Vec<History> {
     let tips_only = prepared.inputs.output.heights.is_none();
     let mut displacement_series = Vec::new();
     for (h, per_pin) in simulation.deflections.into_iter().enumerate() {

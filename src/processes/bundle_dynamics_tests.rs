@@ -9,6 +9,7 @@ use serde_json::{Value, json};
 
 use super::*;
 use crate::processes::cantilever_impact::CantileverImpact;
+use crate::processes::{Process, RunOutput};
 
 fn pin() -> Value {
     json!({"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,

@@ -2,10 +2,10 @@
 //! form (`bundle`), excitation, initial state, solver and output, with their mapping to
 //! the physics types.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use super::inputs::{BeamInput, SchemeInput, TimeStepInput};
+use super::inputs::{BeamInput, SolverInput};
 use crate::physics::bundle::{BundleLayout, GapDistribution, GapState, Levels, LocalClosure};
 use crate::physics::contact::{Body, Contact};
 use crate::physics::loads::{BaseAcceleration, PointForce, Table};
@@ -33,7 +33,7 @@ pub struct BundleInputs {
 }
 
 /// A potential point contact between `left` and `right` ("wall" or a pin number).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactInput {
     pub left: BodyInput,
@@ -51,7 +51,7 @@ pub struct ContactInput {
 }
 
 /// "wall" or a pin number.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(untagged, expecting = "\"wall\" or a pin number")]
 pub enum BodyInput {
     Pin(usize),
@@ -59,7 +59,7 @@ pub enum BodyInput {
 }
 
 /// The keyword `wall`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum WallKeyword {
     Wall,
@@ -74,11 +74,13 @@ impl From<BodyInput> for Body {
     }
 }
 
-/// JSON form of a body in results: "wall" or the pin number.
-pub fn body_json(body: Body) -> serde_json::Value {
-    match body {
-        Body::Wall => serde_json::json!("wall"),
-        Body::Pin(p) => serde_json::json!(p),
+/// A body in results: "wall" or the pin number, as in the inputs.
+impl From<Body> for BodyInput {
+    fn from(value: Body) -> Self {
+        match value {
+            Body::Pin(p) => BodyInput::Pin(p),
+            Body::Wall => BodyInput::Wall(WallKeyword::Wall),
+        }
     }
 }
 
@@ -350,65 +352,6 @@ impl PointForceInput {
             },
         }
     }
-}
-
-/// Explicit integration settings.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct SolverInput {
-    #[serde(default)]
-    pub scheme: SchemeInput,
-    /// Tchamwa–Wielgosz parameter φ in [1, 2] (default 1.1).
-    pub phi: Option<f64>,
-    /// Time step (s) or "auto" (the default): chosen for accuracy at `tolerance` within
-    /// stability, a whole number of steps per output interval.
-    #[serde(default = "auto")]
-    pub time_step: TimeStepInput,
-    /// Simulated duration (s), default 0.2 s.
-    #[serde(default = "default_duration")]
-    pub duration: f64,
-    /// Relative accuracy target in (0, 1), default 1e-3: `auto` picks its step so that
-    /// the energy balance closes within it and peaks are within 10 × it, and
-    /// `quality.verdict` judges against it. Larger values trade accuracy for speed (sweeps).
-    #[serde(default = "super::inputs::default_tolerance")]
-    #[schema(default = 1e-3, exclusive_minimum = 0.0, exclusive_maximum = 1.0)]
-    pub tolerance: f64,
-    /// Accuracy check: `step_halving` (default; the run repeated at Δt/2, three times the
-    /// cost) or `none` (cheap sweeps).
-    #[serde(default)]
-    pub check: super::inputs::CheckInput,
-}
-impl SolverInput {
-    /// The fields the shared solver checks read.
-    pub fn fields(&self) -> super::inputs::SolverFields {
-        super::inputs::SolverFields {
-            scheme: self.scheme,
-            phi: self.phi,
-            time_step: self.time_step,
-            duration: self.duration,
-            tolerance: self.tolerance,
-            check: self.check,
-        }
-    }
-}
-
-impl Default for SolverInput {
-    fn default() -> Self {
-        Self {
-            scheme: SchemeInput::default(),
-            phi: None,
-            time_step: auto(),
-            duration: default_duration(),
-            tolerance: super::inputs::default_tolerance(),
-            check: super::inputs::CheckInput::default(),
-        }
-    }
-}
-fn auto() -> TimeStepInput {
-    TimeStepInput::Keyword(super::inputs::AutoKeyword::Auto)
-}
-fn default_duration() -> f64 {
-    0.2
 }
 
 /// History sampling.

@@ -6,6 +6,7 @@ use std::ops::ControlFlow;
 use serde_json::{Value, json};
 
 use super::*;
+use crate::processes::{Process, RunOutput};
 
 fn default_inputs() -> Value {
     json!({

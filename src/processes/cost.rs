@@ -2,9 +2,12 @@
 //!
 //! Every process returns a [`WorkEstimate`] from [`super::Process::validate`]: the number
 //! of time steps, the modal degrees of freedom and contacts updated at each step, and
-//! the values its histories will hold, with the input fields that drive each figure. A
-//! service compares it with its [`CostLimits`] before queueing anything; the CLI runs
-//! without them (the processes' own absolute limits still apply everywhere).
+//! the values its histories will hold, with the input fields that drive each figure.
+//!
+//! One kind of ceiling, [`CostLimits`], checked in one place for every process
+//! ([`super::simulation`]): [`CostLimits::ABSOLUTE`], what chocmodal runs at all (the
+//! CLI included; a refusal is a plain invalid-inputs error), and a service's own, lower
+//! ceilings (`--max-work`, `--max-history-values`; a refusal is `too-costly`).
 //!
 //! Work is counted in "updates": steps × (pins × modes + contacts), the two loops of an
 //! explicit step. On the development VM an update costs about 6 ns (`row17`: 1.0e8
@@ -12,6 +15,8 @@
 
 use super::FieldError;
 
+/// Most time steps of one pass of a run (the step-halving check's passes not counted).
+pub const MAX_STEPS: f64 = 5e7;
 /// Default [`CostLimits::max_work`]: about two minutes on one laptop core.
 pub const DEFAULT_MAX_WORK: f64 = 2e10;
 /// Default [`CostLimits::max_history_values`]: 160 MB of f64 while the run lasts.
@@ -20,8 +25,14 @@ pub const DEFAULT_MAX_HISTORY_VALUES: f64 = 2e7;
 /// The cost of one run, estimated from its inputs before it runs.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct WorkEstimate {
-    /// Time steps of the integration (duration / time step).
+    /// Time steps of the whole run (duration / time step), every pass of the accuracy
+    /// check included.
     pub steps: f64,
+    /// Time steps of one pass (duration / time step): what [`CostLimits::max_steps`]
+    /// bounds.
+    pub pass_steps: f64,
+    /// What set the step, added to a refusal for too many steps (empty for a given step).
+    pub step_note: String,
     /// Modal degrees of freedom updated at each step: pins × modes.
     pub modal_dofs: f64,
     /// Contacts evaluated at each step.
@@ -45,6 +56,8 @@ impl WorkEstimate {
 /// Ceilings on the estimated cost of one run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CostLimits {
+    /// Largest [`WorkEstimate::pass_steps`].
+    pub max_steps: f64,
     /// Largest [`WorkEstimate::work`].
     pub max_work: f64,
     /// Largest [`WorkEstimate::history_values`].
@@ -54,6 +67,7 @@ pub struct CostLimits {
 impl Default for CostLimits {
     fn default() -> Self {
         Self {
+            max_steps: MAX_STEPS,
             max_work: DEFAULT_MAX_WORK,
             max_history_values: DEFAULT_MAX_HISTORY_VALUES,
         }
@@ -63,7 +77,7 @@ impl Default for CostLimits {
 /// One ceiling a run exceeds.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Excess {
-    /// `work` or `history_values`.
+    /// `steps`, `work` or `history_values`.
     pub quantity: String,
     /// The run's estimate.
     pub estimate: f64,
@@ -79,19 +93,53 @@ pub struct TooCostly {
 }
 
 impl CostLimits {
-    /// No ceiling at all (the CLI).
+    /// What chocmodal runs at all, the CLI included: 5e7 steps per pass, 6e11 updates
+    /// (about an hour on one core) and 1e8 history values (800 MB of f64).
+    pub const ABSOLUTE: CostLimits = CostLimits {
+        max_steps: MAX_STEPS,
+        max_work: 6e11,
+        max_history_values: 1e8,
+    };
+
+    /// No ceiling beyond [`CostLimits::ABSOLUTE`], which every run meets anyway (the CLI).
     pub fn unlimited() -> Self {
-        Self {
-            max_work: f64::INFINITY,
-            max_history_values: f64::INFINITY,
-        }
+        Self::ABSOLUTE
     }
 
     /// `Ok` when the estimate is within every ceiling; otherwise every ceiling exceeded,
-    /// with an error at each field that drives it.
+    /// with an error at each field that drives it. The messages name the service's
+    /// options that set the ceilings.
     pub fn check(&self, estimate: &WorkEstimate) -> Result<(), TooCostly> {
+        self.check_with(estimate, "this service's limit", |flag| format!(" (`{flag}`)"))
+    }
+
+    /// [`CostLimits::check`] against [`CostLimits::ABSOLUTE`], worded as chocmodal's own limit.
+    pub fn check_absolute(estimate: &WorkEstimate) -> Result<(), TooCostly> {
+        Self::ABSOLUTE.check_with(estimate, "the limit", |_| String::new())
+    }
+
+    fn check_with(
+        &self,
+        estimate: &WorkEstimate,
+        whose: &str,
+        option: impl Fn(&str) -> String,
+    ) -> Result<(), TooCostly> {
         let mut exceeded = Vec::new();
         let mut errors = Vec::new();
+        if estimate.pass_steps > self.max_steps {
+            exceeded.push(Excess {
+                quantity: "steps".into(),
+                estimate: estimate.pass_steps,
+                limit: self.max_steps,
+            });
+            errors.push(FieldError::new(
+                "/inputs/solver/duration",
+                format!(
+                    "needs {:.3e} time steps, above {whose} of {:e}{}",
+                    estimate.pass_steps, self.max_steps, estimate.step_note
+                ),
+            ));
+        }
         let work = estimate.work();
         if work > self.max_work {
             exceeded.push(Excess {
@@ -101,9 +149,14 @@ impl CostLimits {
             });
             let detail = format!(
                 "the run would take {work:.3e} updates ({:.3e} steps × ({} modal DOFs + {} contacts)), \
-                 above this service's limit of {:.3e} (`--max-work`): shorten the duration, lengthen \
-                 the time step, or use fewer modes, pins or contacts",
-                estimate.steps, estimate.modal_dofs, estimate.contacts, self.max_work
+                 above {whose} of {:.3e}{}: shorten the duration, lengthen \
+                 the time step, or use fewer modes, pins or contacts{}",
+                estimate.steps,
+                estimate.modal_dofs,
+                estimate.contacts,
+                self.max_work,
+                option("--max-work"),
+                estimate.step_note
             );
             errors.extend(
                 estimate
@@ -119,9 +172,11 @@ impl CostLimits {
                 limit: self.max_history_values,
             });
             let detail = format!(
-                "the histories would hold {:.3e} values, above this service's limit of {:.3e} \
-                 (`--max-history-values`): sample less often or over a shorter duration",
-                estimate.history_values, self.max_history_values
+                "the histories would hold {:.3e} values, above {whose} of {:.3e}{}: \
+                 sample less often or over a shorter duration",
+                estimate.history_values,
+                self.max_history_values,
+                option("--max-history-values")
             );
             errors.extend(
                 estimate
@@ -145,11 +200,13 @@ mod tests {
     fn estimate() -> WorkEstimate {
         WorkEstimate {
             steps: 1e6,
+            pass_steps: 1e6,
             modal_dofs: 340.0,
             contacts: 180.0,
             history_values: 4e5,
             work_drivers: vec!["/inputs/solver/duration".into(), "/inputs/pin/modes".into()],
             history_drivers: vec!["/inputs/output/interval".into()],
+            ..WorkEstimate::default()
         }
     }
 
@@ -161,6 +218,7 @@ mod tests {
     #[test]
     fn an_estimate_within_the_ceilings_passes() {
         let limits = CostLimits {
+            max_steps: 1e6,
             max_work: 5.2e8,
             max_history_values: 4e5,
         };
@@ -171,6 +229,7 @@ mod tests {
     #[test]
     fn each_ceiling_exceeded_names_its_drivers_the_estimate_and_the_limit() {
         let limits = CostLimits {
+            max_steps: 1e6,
             max_work: 1e8,
             max_history_values: 1e5,
         };
@@ -196,6 +255,26 @@ mod tests {
             refused.errors[0].detail.contains("1.000e8"),
             "{:?}",
             refused.errors[0]
+        );
+    }
+
+    #[test]
+    fn too_many_steps_point_at_the_duration_and_say_what_set_the_step() {
+        let mut estimate = estimate();
+        estimate.pass_steps = 6e7;
+        estimate.step_note = " (auto chose it)".into();
+        let refused = CostLimits::check_absolute(&estimate).unwrap_err();
+        assert_eq!(refused.exceeded[0].quantity, "steps");
+        assert_eq!(refused.errors[0].pointer, "/inputs/solver/duration");
+        assert!(
+            refused.errors[0].detail.ends_with("(auto chose it)"),
+            "{:?}",
+            refused.errors
+        );
+        assert!(
+            !refused.errors[0].detail.contains("service"),
+            "{:?}",
+            refused.errors
         );
     }
 }

@@ -13,10 +13,16 @@ pub mod cantilever_impact;
 pub mod cost;
 pub mod inputs;
 pub mod metrics;
+/// The shared parts of results documents (quality, energy) as serialized types.
+pub mod report;
+/// A process described by its types, and the one adapter to [`Process`].
+pub mod simulation;
 pub mod strict_json;
 
 #[cfg(test)]
 mod robustness_tests;
+#[cfg(test)]
+mod simulation_tests;
 #[cfg(test)]
 mod static_correction_tests;
 
@@ -24,6 +30,7 @@ use std::ops::ControlFlow;
 use std::sync::Arc;
 
 pub use cost::{CostLimits, TooCostly, WorkEstimate};
+pub use simulation::{HistoryOutput, Output, Simulation};
 
 /// One problem with the inputs: where (JSON pointer into the request body) and why.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -142,7 +149,8 @@ impl From<crate::physics::integrate::SimulationError> for RunError {
 /// `ControlFlow::Break(())` stops the run promptly with [`RunError::Cancelled`].
 pub type ProgressFn<'a> = dyn FnMut(f64) -> ControlFlow<()> + 'a;
 
-/// A computation the service can queue and the CLI can run.
+/// A computation the service can queue and the CLI can run: any [`Simulation`] is one;
+/// implement this directly only for a process that is not typed (the tests' fakes).
 pub trait Process: Send + Sync + std::fmt::Debug {
     /// Stable identifier used in URLs (`cantilever-impact`).
     fn id(&self) -> &'static str;
@@ -166,6 +174,11 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     /// of its arrays worth a column.
     fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
         metrics::flatten_scalars(document)
+    }
+    /// The OpenAPI schemas of its inputs and results documents, with every schema they
+    /// reference, for the service's OpenAPI document (none by default).
+    fn schemas(&self, schemas: &mut Vec<(String, utoipa::openapi::RefOr<utoipa::openapi::Schema>)>) {
+        let _ = schemas;
     }
 }
 

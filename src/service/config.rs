@@ -267,6 +267,7 @@ impl ServiceConfig {
             metrics_public: args.metrics_public,
             insecure: args.insecure,
             limits: CostLimits {
+                max_steps: crate::processes::cost::MAX_STEPS,
                 max_work: args.max_work,
                 max_history_values: args.max_history_values,
             },

@@ -154,6 +154,7 @@ impl Process for CountSteps {
             history_values: 3.0 * inputs.steps as f64,
             work_drivers: vec!["/inputs/steps".into()],
             history_drivers: vec!["/inputs/steps".into()],
+            ..WorkEstimate::default()
         })
     }
 

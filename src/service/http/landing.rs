@@ -125,13 +125,13 @@ pub async fn metrics(State(state): State<AppState>) -> Result<Response, ApiError
 #[utoipa::path(get, path = "/openapi.json", operation_id = "getOpenApi", tag = "Capabilities",
     responses((status = 200, description = "This API's OpenAPI document", body = Object,
         content_type = "application/vnd.oai.openapi+json;version=3.1")))]
-pub async fn openapi_document() -> Response {
+pub async fn openapi_document(State(state): State<AppState>) -> Response {
     (
         [(
             header::CONTENT_TYPE,
             HeaderValue::from_static("application/vnd.oai.openapi+json;version=3.1"),
         )],
-        openapi::json(),
+        openapi::json_for(&state.registry),
     )
         .into_response()
 }

@@ -176,59 +176,7 @@ pub struct Results {
     #[schema(value_type = Object)]
     pub outputs: serde_json::Value,
     /// How right the result is (every process; see docs/accuracy.md).
-    pub quality: QualityReport,
-}
-
-/// The `quality` section of every results document: how right the result is.
-#[derive(Debug, Serialize, ToSchema)]
-pub struct QualityReport {
-    /// |kinetic + strain + contact + dissipated − external work − initial| over the largest
-    /// energy involved, at the end of the run (dimensionless).
-    pub energy_residual: f64,
-    /// Time step over the critical step with every contact closed (dimensionless).
-    pub time_step_over_critical: f64,
-    /// 2π / (ω_max Δt): steps per period of the fastest motion with the contacts closed,
-    /// the shortest contact period resolved. `auto` uses 50 at the default tolerance.
-    pub steps_per_contact_period: f64,
-    /// The relative tolerance the verdict was judged against (`solver.tolerance`).
-    pub tolerance: f64,
-    /// What set the step: `given` (a fixed step), or for `auto` `fastest_motion`,
-    /// `excitation` or `stability`.
-    #[schema(pattern = "^(given|fastest_motion|excitation|stability)$")]
-    pub time_step_limited_by: String,
-    /// The run repeated at Δt/2 (`solver.check: "step_halving"`); null with `"none"`.
-    pub step_halving: Option<StepHalvingReport>,
-    /// `good`: within the tolerance by every measure; `doubtful`: some measure outside it,
-    /// none by far; `poor`: do not use the numbers (energy residual > 10 × tolerance, an
-    /// estimated peak error > 20 × tolerance, or fewer than 8 steps per contact period).
-    #[schema(pattern = "^(good|doubtful|poor)$")]
-    pub verdict: String,
-    /// One sentence per measure outside the tolerance (empty when `good`).
-    pub reasons: Vec<String>,
-}
-
-/// The step-halving check: the whole run repeated at half the step.
-#[derive(Debug, Serialize, ToSchema)]
-pub struct StepHalvingReport {
-    /// Step of the repeated run (s).
-    pub time_step: f64,
-    /// |F(Δt) − F(Δt/2)| / F(Δt/2) of the peak contact force over all contacts and steps.
-    pub peak_force_change: f64,
-    /// The same for the peak |deflection| at the output heights.
-    pub peak_displacement_change: f64,
-    /// |n(Δt) − n(Δt/2)| / max(n(Δt/2), 1) of the total impact count.
-    pub impact_count_change: f64,
-    /// Estimated relative error of the reported peak force: 2ᵖ/(2ᵖ − 1) × its change (4/3
-    /// for central difference, Richardson).
-    pub estimated_peak_force_error: f64,
-    /// Estimated relative error of the reported peak deflection.
-    pub estimated_peak_displacement_error: f64,
-    /// Steps taken by the check.
-    pub steps: u64,
-    /// Wall time of the check (s).
-    pub seconds: f64,
-    /// Steps of the check over steps of the run (2).
-    pub relative_cost: f64,
+    pub quality: crate::processes::report::QualityReport,
 }
 
 /// One named column of a history.

@@ -18,6 +18,7 @@ use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
 use utoipa::{Modify, OpenApi};
 
 use super::{job_inputs, jobs, landing, models, processes, results, spectra, sweep_models, sweeps};
+use crate::processes::Registry;
 use crate::service::queue::JobStatus;
 
 /// A field at fault in an execution request.
@@ -211,8 +212,8 @@ impl Modify for ResourceLinks {
         models::ProcessDescription,
         models::ExecuteRequest,
         models::Results,
-        models::QualityReport,
-        models::StepHalvingReport,
+        crate::processes::report::QualityReport,
+        crate::processes::report::StepHalvingReport,
         models::HistoryDocument,
         models::Series,
         spectra::SpectrumDocument,
@@ -228,8 +229,6 @@ impl Modify for ResourceLinks {
         sweep_models::SweepRequestSchema,
         sweep_models::SweepResults,
         // The `inputs` of each shipped process (also served by `/processes/{id}`).
-        crate::processes::cantilever_impact::CantileverInputs,
-        crate::processes::bundle_inputs::BundleInputs,
     )),
     tags(
         (name = "Capabilities", description = "What this service is and offers"),
@@ -242,9 +241,30 @@ impl Modify for ResourceLinks {
 )]
 pub struct ApiDoc;
 
-/// The OpenAPI document as pretty JSON, ending with a newline (the committed file's form).
+/// The OpenAPI document of a service offering `registry`'s processes: the routes, and
+/// each process's inputs and results schemas (from their types) in the components.
+pub fn document(registry: &Registry) -> utoipa::openapi::OpenApi {
+    let mut openapi = ApiDoc::openapi();
+    let mut schemas = Vec::new();
+    for process in registry.all() {
+        process.schemas(&mut schemas);
+    }
+    let components = openapi.components.get_or_insert_with(Default::default);
+    for (name, schema) in schemas {
+        components.schemas.entry(name).or_insert(schema);
+    }
+    openapi
+}
+
+/// The OpenAPI document of the builtin processes as pretty JSON, ending with a newline
+/// (the committed file's form).
 pub fn json() -> String {
-    let mut text = ApiDoc::openapi()
+    json_for(&Registry::builtin())
+}
+
+/// [`document`] as pretty JSON, ending with a newline.
+pub fn json_for(registry: &Registry) -> String {
+    let mut text = document(registry)
         .to_pretty_json()
         .expect("the OpenAPI document serializes");
     text.push('\n');

@@ -1,0 +1,147 @@
+//! A process described by its types: [`Simulation`], and the one adapter that makes any
+//! of them a [`Process`] the service and the CLI can drive.
+//!
+//! A simulation says what its inputs and results are (serde + OpenAPI schema from the
+//! same types), how inputs become a validated [`Simulation::Plan`] (every problem with
+//! its JSON pointer), what a plan costs, and how it runs. The adapter does the rest, the
+//! same way for every process: strict parsing with pointer repair
+//! ([`super::inputs::parse`]), the absolute cost ceilings ([`CostLimits::ABSOLUTE`]),
+//! the OGC descriptions of inputs and outputs, the results document and its schema.
+
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+use utoipa::openapi::{RefOr, Schema};
+use utoipa::{PartialSchema, ToSchema};
+
+use super::{
+    CostLimits, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate, inputs,
+};
+
+/// One history a simulation writes: served as `/jobs/{id}/results/{name}` (CSV or JSON).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HistoryOutput {
+    /// Output name (`tip_displacement`).
+    pub name: &'static str,
+    pub title: &'static str,
+    /// Its columns and units.
+    pub description: &'static str,
+}
+
+/// What a run of a simulation produces: its typed results and its histories.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Output<R> {
+    pub results: R,
+    /// One per [`Simulation::HISTORIES`] entry, by name.
+    pub histories: Vec<History>,
+}
+
+/// A computation described by types. Implement this (and add one line to
+/// [`super::Registry::builtin`]); the blanket `impl Process for S` does the rest.
+pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
+    /// Stable identifier used in URLs (`cantilever-impact`).
+    const ID: &'static str;
+    /// One-line title.
+    const TITLE: &'static str;
+    /// A paragraph for the process list.
+    const DESCRIPTION: &'static str;
+    /// The histories a run writes.
+    const HISTORIES: &'static [HistoryOutput];
+
+    /// The `inputs` object of an execution request (unknown fields refused).
+    type Inputs: DeserializeOwned + ToSchema;
+    /// The results document, without its `outputs` links (the adapter adds them).
+    type Results: Serialize + ToSchema;
+    /// Validated inputs, ready to run (the step resolved, the basis built).
+    type Plan: Send;
+
+    /// Checks the inputs and builds the plan; every problem found, with its pointer
+    /// (starting with `/inputs`).
+    fn prepare(inputs: Self::Inputs) -> Result<Self::Plan, InvalidInputs>;
+    /// What running the plan will cost (compared with the ceilings before anything runs).
+    fn estimate(plan: &Self::Plan) -> WorkEstimate;
+    /// Runs the plan; `progress` gets the fraction done and may cancel.
+    fn run(plan: Self::Plan, progress: &mut ProgressFn<'_>) -> Result<Output<Self::Results>, RunError>;
+    /// The metric columns of a sweep's results table for one results document: the
+    /// numbers and booleans of nested objects ([`super::metrics::flatten_scalars`]) by
+    /// default; a simulation adds entries of its arrays worth a column.
+    fn metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
+        super::metrics::flatten_scalars(document)
+    }
+}
+
+/// Parses, prepares and checks against the absolute ceilings.
+fn plan<S: Simulation>(json: &serde_json::Value) -> Result<(S::Plan, WorkEstimate), InvalidInputs> {
+    let inputs: S::Inputs = inputs::parse(json)?;
+    let plan = S::prepare(inputs)?;
+    let estimate = S::estimate(&plan);
+    CostLimits::check_absolute(&estimate).map_err(|refused| InvalidInputs(refused.errors))?;
+    Ok((plan, estimate))
+}
+
+impl<S: Simulation> Process for S {
+    fn id(&self) -> &'static str {
+        S::ID
+    }
+
+    fn title(&self) -> &'static str {
+        S::TITLE
+    }
+
+    fn description(&self) -> &'static str {
+        S::DESCRIPTION
+    }
+
+    fn inputs_description(&self) -> serde_json::Value {
+        inputs::ogc_inputs(&inputs::schema_of::<S::Inputs>())
+    }
+
+    fn outputs_description(&self) -> serde_json::Value {
+        S::HISTORIES
+            .iter()
+            .map(|h| {
+                (
+                    h.name.to_owned(),
+                    serde_json::json!({"title": h.title, "description": h.description,
+                                       "schema": {"type": "string", "contentMediaType": "text/csv"}}),
+                )
+            })
+            .collect::<serde_json::Map<_, _>>()
+            .into()
+    }
+
+    fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs> {
+        plan::<S>(inputs).map(|(_, estimate)| estimate)
+    }
+
+    fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
+        let (plan, _) = plan::<S>(inputs)?;
+        let output = S::run(plan, progress)?;
+        let document = serde_json::to_value(&output.results)
+            .map_err(|e| RunError::Failed(format!("results document: {e}")))?;
+        debug_assert_eq!(
+            output
+                .histories
+                .iter()
+                .map(|h| h.name.as_str())
+                .collect::<Vec<_>>(),
+            S::HISTORIES.iter().map(|h| h.name).collect::<Vec<_>>(),
+            "{} writes the histories it declares",
+            S::ID
+        );
+        Ok(RunOutput {
+            document,
+            histories: output.histories,
+        })
+    }
+
+    fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
+        S::metrics(document)
+    }
+
+    fn schemas(&self, schemas: &mut Vec<(String, RefOr<Schema>)>) {
+        schemas.push((S::Inputs::name().into_owned(), S::Inputs::schema()));
+        S::Inputs::schemas(schemas);
+        schemas.push((S::Results::name().into_owned(), S::Results::schema()));
+        S::Results::schemas(schemas);
+    }
+}
