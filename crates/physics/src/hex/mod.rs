@@ -1,0 +1,31 @@
+//! Geometry of a wire-wrapped hexagonal bundle (BRIEF §12, issue 18): expands a dozen
+//! numbers ([`HexLayout`]: rings, pitch, diameters, wire lead and start angle, wrapper)
+//! into the pins' centres and the explicit list of wire contacts ([`HexContact`]) with
+//! their normals in the transverse plane and nominal clearances. Pure geometry: nothing
+//! here integrates anything.
+//!
+//! Where each convention is defined:
+//! - pin numbering, rings, sectors, neighbour pairs: `lattice`;
+//! - the wrapper's flats, which pins face them, the wall clearance: `wrapper`;
+//! - the wire helix, the levels and the endpoint rule (0 < z ≤ L): `helix`;
+//! - the contact bodies, normal direction and order: `contacts`.
+//!
+//! Frame: x, y transverse, z along the pins from their feet, right-handed; angles in
+//! radians, counter-clockwise from +x seen from above.
+
+mod contacts;
+mod helix;
+mod lattice;
+mod layout;
+mod vector;
+mod wrapper;
+
+pub use contacts::{Body, HexContact};
+pub use helix::{ANGLE_SNAP_TOLERANCE, Aim, Handedness, Helix, Level};
+pub use lattice::{Axial, Direction, Lattice, NeighbourPair, pair_count, pin_count};
+pub use layout::{HexBundle, HexLayout, MAX_LEVELS, MAX_RINGS};
+pub use vector::Vec2;
+pub use wrapper::{Flat, minimum_flat_to_flat, wall_clearance};
+
+#[cfg(test)]
+mod tests;
