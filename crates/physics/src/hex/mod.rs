@@ -8,13 +8,15 @@
 //! - pin numbering, rings, sectors, neighbour pairs: `lattice`;
 //! - the wrapper's flats, which pins face them, the wall clearance: `wrapper`;
 //! - the wire helix, the levels and the endpoint rule (0 < z ≤ L): `helix`;
-//! - the contact bodies, normal direction and order: `contacts`.
+//! - the contact bodies, normal direction and order: `contacts`;
+//! - penetration, force and sliding-velocity signs: `kinematics`.
 //!
 //! Frame: x, y transverse, z along the pins from their feet, right-handed; angles in
 //! radians, counter-clockwise from +x seen from above.
 
 mod contacts;
 mod helix;
+mod kinematics;
 mod lattice;
 mod layout;
 mod vector;
@@ -22,6 +24,9 @@ mod wrapper;
 
 pub use contacts::{Body, HexContact};
 pub use helix::{ANGLE_SNAP_TOLERANCE, Aim, Handedness, Helix, Level};
+pub use kinematics::{
+    PairForces, contact_forces, penetration, penetration_rate, tangential_velocity, wear_power,
+};
 pub use lattice::{Axial, Direction, Lattice, NeighbourPair, pair_count, pin_count};
 pub use layout::{HexBundle, HexLayout, MAX_LEVELS, MAX_RINGS};
 pub use vector::Vec2;
