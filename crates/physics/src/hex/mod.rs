@@ -1,20 +1,22 @@
 //! Geometry of a wire-wrapped hexagonal bundle (BRIEF §12, issue 18): expands a dozen
 //! numbers ([`HexLayout`]: rings, pitch, diameters, wire lead and start angle, wrapper)
 //! into the pins' centres and the explicit list of wire contacts ([`HexContact`]) with
-//! their normals in the transverse plane and nominal clearances. Pure geometry: nothing
-//! here integrates anything.
+//! their normals in the transverse plane and nominal clearances, then sets their gaps
+//! ([`HexGaps`]). Pure geometry: nothing here integrates anything.
 //!
 //! Where each convention is defined:
 //! - pin numbering, rings, sectors, neighbour pairs: `lattice`;
 //! - the wrapper's flats, which pins face them, the wall clearance: `wrapper`;
 //! - the wire helix, the levels and the endpoint rule (0 < z ≤ L): `helix`;
 //! - the contact bodies, normal direction and order: `contacts`;
-//! - penetration, force and sliding-velocity signs: `kinematics`.
+//! - penetration, force and sliding-velocity signs: `kinematics`;
+//! - gap states, zones, offsets: `gaps`.
 //!
 //! Frame: x, y transverse, z along the pins from their feet, right-handed; angles in
 //! radians, counter-clockwise from +x seen from above.
 
 mod contacts;
+mod gaps;
 mod helix;
 mod kinematics;
 mod lattice;
@@ -23,6 +25,10 @@ mod vector;
 mod wrapper;
 
 pub use contacts::{Body, HexContact};
+pub use gaps::{
+    FlatOffset, HexGapState, HexGaps, PinZone, ZoneClosure, close_zone, nominal_gaps, offset_toward_flat,
+    random_gaps, uniform_gaps,
+};
 pub use helix::{ANGLE_SNAP_TOLERANCE, Aim, Handedness, Helix, Level};
 pub use kinematics::{
     PairForces, contact_forces, penetration, penetration_rate, tangential_velocity, wear_power,
