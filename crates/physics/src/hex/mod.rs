@@ -10,7 +10,8 @@
 //! - the wire helix, the levels and the endpoint rule (0 < z ≤ L): `helix`;
 //! - the contact bodies, normal direction and order: `contacts`;
 //! - penetration, force and sliding-velocity signs: `kinematics`;
-//! - gap states, zones, offsets: `gaps`.
+//! - gap states, zones, offsets: `gaps`;
+//! - special cases for the equivalence checks (a row along any angle, one pin): `special`.
 //!
 //! Frame: x, y transverse, z along the pins from their feet, right-handed; angles in
 //! radians, counter-clockwise from +x seen from above.
@@ -21,6 +22,7 @@ mod helix;
 mod kinematics;
 mod lattice;
 mod layout;
+mod special;
 mod vector;
 mod wrapper;
 
@@ -35,6 +37,7 @@ pub use kinematics::{
 };
 pub use lattice::{Axial, Direction, Lattice, NeighbourPair, pair_count, pin_count};
 pub use layout::{HexBundle, HexLayout, MAX_LEVELS, MAX_RINGS};
+pub use special::{RowEquivalent, row_along, single_pin_in_wrapper};
 pub use vector::Vec2;
 pub use wrapper::{Flat, minimum_flat_to_flat, wall_clearance};
 
