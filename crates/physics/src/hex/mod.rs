@@ -4,27 +4,38 @@
 //! their normals in the transverse plane and nominal clearances, then sets their gaps
 //! ([`HexGaps`]). Pure geometry: nothing here integrates anything.
 //!
-//! Where each convention is defined:
-//! - pin numbering, rings, sectors, neighbour pairs: `lattice`;
-//! - the wrapper's flats, which pins face them, the wall clearance: `wrapper`;
-//! - the wire helix, the levels and the endpoint rule (0 < z ≤ L): `helix`;
-//! - the contact bodies, normal direction and order: `contacts`;
-//! - penetration, force and sliding-velocity signs: `kinematics`;
-//! - gap states, zones, offsets: `gaps`;
-//! - special cases for the equivalence checks (a row along any angle, one pin): `special`.
+//! Each submodule's doc holds its conventions (their items are re-exported here):
+//! - pin numbering, rings, sectors, neighbour pairs: [`lattice`];
+//! - the wrapper's flats, which pins face them, the wall clearance: [`wrapper`];
+//! - the wire helix, the levels and the endpoint rule (0 < z ≤ L): [`helix`];
+//! - the contact bodies, normal direction and order: [`contacts`];
+//! - penetration, force and sliding-velocity signs: [`kinematics`];
+//! - gap states, zones, offsets: [`gaps`];
+//! - special cases for the equivalence checks (a row along any angle, one pin): [`special`].
 //!
 //! Frame: x, y transverse, z along the pins from their feet, right-handed; angles in
 //! radians, counter-clockwise from +x seen from above.
+//!
+//! [`HexLayout`]: crate::hex::HexLayout
+//! [`HexContact`]: crate::hex::HexContact
+//! [`HexGaps`]: crate::hex::HexGaps
+//! [`lattice`]: crate::hex::lattice
+//! [`wrapper`]: crate::hex::wrapper
+//! [`helix`]: crate::hex::helix
+//! [`contacts`]: crate::hex::contacts
+//! [`kinematics`]: crate::hex::kinematics
+//! [`gaps`]: crate::hex::gaps
+//! [`special`]: crate::hex::special
 
-mod contacts;
-mod gaps;
-mod helix;
-mod kinematics;
-mod lattice;
-mod layout;
-mod special;
-mod vector;
-mod wrapper;
+pub mod contacts;
+pub mod gaps;
+pub mod helix;
+pub mod kinematics;
+pub mod lattice;
+pub mod layout;
+pub mod special;
+pub mod vector;
+pub mod wrapper;
 
 pub use contacts::{Body, HexContact};
 pub use gaps::{
