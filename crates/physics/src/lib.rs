@@ -9,6 +9,8 @@
 pub mod beam;
 pub mod bundle;
 pub mod contact;
+/// Wire-wrapped hexagonal bundle geometry: lattice, wrapper, wire-helix contacts, gap states.
+pub mod hex;
 pub mod integrate;
 pub mod loads;
 pub mod modal;
