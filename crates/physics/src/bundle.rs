@@ -83,6 +83,44 @@ pub enum GapDistribution {
     Normal { mean: f64, std: f64 },
 }
 
+impl GapDistribution {
+    /// Checks the law's parameters, at `gaps/distribution/<field>` (the row's and the
+    /// hexagonal bundle's gap states alike).
+    pub fn validate(&self, issues: &mut Vec<InputIssue>) {
+        match *self {
+            GapDistribution::Uniform { low, high } => {
+                require_non_negative(issues, "gaps/distribution/low", low);
+                require_non_negative(issues, "gaps/distribution/high", high);
+                if low > high {
+                    issues.push(InputIssue::new(
+                        "gaps/distribution/high",
+                        format!("must be ≥ low ({low}), got {high}"),
+                    ));
+                }
+            }
+            GapDistribution::Normal { mean, std } => {
+                let before = issues.len();
+                if !mean.is_finite() {
+                    issues.push(InputIssue::new(
+                        "gaps/distribution/mean",
+                        "must be a finite number",
+                    ));
+                }
+                require_non_negative(issues, "gaps/distribution/std", std);
+                if issues.len() == before && (std == 0.0 && mean < 0.0 || -mean > MAX_TRUNCATION * std) {
+                    issues.push(InputIssue::new(
+                        "gaps/distribution/mean",
+                        format!(
+                            "truncation at 0 would discard almost all of the law: need mean ≥ \
+                         −{MAX_TRUNCATION}·std (and ≥ 0 when std = 0)"
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+}
+
 /// Gaps of the contacts in levels [first_level, last_level] (indices, inclusive) that
 /// touch a pin in [first_pin, last_pin] are multiplied by `factor` (≥ 0; 0 closes them,
 /// e.g. after irradiation swelling; > 1 opens them).
@@ -300,37 +338,7 @@ impl BundleLayout {
                     .collect();
                 push_list_issues(issues, "gaps/values", bad);
             }
-            GapState::Random { distribution, .. } => match *distribution {
-                GapDistribution::Uniform { low, high } => {
-                    require_non_negative(issues, "gaps/distribution/low", low);
-                    require_non_negative(issues, "gaps/distribution/high", high);
-                    if low > high {
-                        issues.push(InputIssue::new(
-                            "gaps/distribution/high",
-                            format!("must be ≥ low ({low}), got {high}"),
-                        ));
-                    }
-                }
-                GapDistribution::Normal { mean, std } => {
-                    let before = issues.len();
-                    if !mean.is_finite() {
-                        issues.push(InputIssue::new(
-                            "gaps/distribution/mean",
-                            "must be a finite number",
-                        ));
-                    }
-                    require_non_negative(issues, "gaps/distribution/std", std);
-                    if issues.len() == before && (std == 0.0 && mean < 0.0 || -mean > MAX_TRUNCATION * std) {
-                        issues.push(InputIssue::new(
-                            "gaps/distribution/mean",
-                            format!(
-                                "truncation at 0 would discard almost all of the law: need \
-                                 mean ≥ −{MAX_TRUNCATION}·std (and ≥ 0 when std = 0)"
-                            ),
-                        ));
-                    }
-                }
-            },
+            GapState::Random { distribution, .. } => distribution.validate(issues),
         }
     }
 

@@ -19,7 +19,7 @@ use super::contacts::{Body, HexContact};
 use super::lattice::Lattice;
 use super::layout::HexBundle;
 use super::wrapper::Flat;
-use crate::bundle::{GapDistribution, MAX_TRUNCATION};
+use crate::bundle::GapDistribution;
 use crate::random::GapRng;
 use crate::{InputIssue, require_non_negative};
 
@@ -317,42 +317,7 @@ impl HexGaps {
                     ));
                 }
             }
-            HexGapState::Random { distribution, .. } => validate_distribution(distribution, issues),
-        }
-    }
-}
-
-/// The row's rules for a gap law (`bundle.rs`), at the same field paths.
-fn validate_distribution(distribution: &GapDistribution, issues: &mut Vec<InputIssue>) {
-    match *distribution {
-        GapDistribution::Uniform { low, high } => {
-            require_non_negative(issues, "gaps/distribution/low", low);
-            require_non_negative(issues, "gaps/distribution/high", high);
-            if low > high {
-                issues.push(InputIssue::new(
-                    "gaps/distribution/high",
-                    format!("must be ≥ low ({low}), got {high}"),
-                ));
-            }
-        }
-        GapDistribution::Normal { mean, std } => {
-            let before = issues.len();
-            if !mean.is_finite() {
-                issues.push(InputIssue::new(
-                    "gaps/distribution/mean",
-                    "must be a finite number",
-                ));
-            }
-            require_non_negative(issues, "gaps/distribution/std", std);
-            if issues.len() == before && (std == 0.0 && mean < 0.0 || -mean > MAX_TRUNCATION * std) {
-                issues.push(InputIssue::new(
-                    "gaps/distribution/mean",
-                    format!(
-                        "truncation at 0 would discard almost all of the law: need mean ≥ \
-                         −{MAX_TRUNCATION}·std (and ≥ 0 when std = 0)"
-                    ),
-                ));
-            }
+            HexGapState::Random { distribution, .. } => distribution.validate(issues),
         }
     }
 }
