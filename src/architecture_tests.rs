@@ -155,11 +155,18 @@ fn the_physics_crate_depends_on_numerics_only_and_does_no_io() {
             dependencies.insert(line.split(['=', ' ', '.']).next().unwrap_or_default().to_owned());
         }
     }
-    let allowed: BTreeSet<String> = ["faer", "rustfft", "pulp", "serde", "thiserror"]
+    // utoipa: optional (feature `schema`), the report types' OpenAPI schemas.
+    let allowed: BTreeSet<String> = ["faer", "rustfft", "pulp", "serde", "thiserror", "utoipa"]
         .into_iter()
         .map(String::from)
         .collect();
     assert!(!dependencies.is_empty(), "no dependency found in {manifest}");
+    assert!(
+        manifest
+            .lines()
+            .any(|l| l.starts_with("utoipa") && l.contains("optional = true")),
+        "the schema library stays optional in the physics crate"
+    );
     assert!(
         dependencies.is_subset(&allowed),
         "the physics crate depends on {:?}: only numerics belong there",

@@ -458,7 +458,7 @@ impl Simulation for BundleDynamics {
             critical_time_step: simulation.step.critical_time_step,
             steps: simulation.steps,
             output_interval: simulation.output_interval,
-            quality: quality.into(),
+            quality,
             frequencies_hz: plan.basis.frequencies_hz(),
             basis: BasisReport::of(&model, plan.settings.scheme, simulation.step.critical_time_step),
             expansion: plan.inputs.bundle.is_some().then(|| Expansion {

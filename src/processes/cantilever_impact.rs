@@ -524,7 +524,7 @@ impl Simulation for CantileverImpact {
                 threshold: AGREEMENT_THRESHOLD,
                 agrees: f_err < AGREEMENT_THRESHOLD,
             },
-            quality: quality.into(),
+            quality,
         };
         let contact_force = simulation.contact_forces[0].clone();
         let pair = |name: &str, numerical: Vec<f64>, reference: Vec<f64>| History {

@@ -45,6 +45,7 @@ pub struct PeakDeflection {
 /// Energy balance of the row in the wrapper frame (J). With exact integration,
 /// kinetic + strain + contact + dissipated − external_work = initial.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct EnergyBalance {
     /// ½ Σ q̇ᵢ² (modal, M̄ = I).
     pub kinetic: f64,

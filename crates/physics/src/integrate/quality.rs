@@ -72,18 +72,20 @@ impl Verdict {
     }
 }
 
-/// The results of the step-halving check.
+/// The step-halving check: the whole run repeated at half the step.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema), schema(as = StepHalvingReport))]
 pub struct StepHalving {
     /// Step of the repeated run (s).
     pub time_step: f64,
-    /// |F(Δt) − F(Δt/2)| / F(Δt/2) of the peak contact force (0 when no contact closes).
+    /// |F(Δt) − F(Δt/2)| / F(Δt/2) of the peak contact force over all contacts and steps.
     pub peak_force_change: f64,
-    /// The same for the peak deflection at the output heights.
+    /// The same for the peak |deflection| at the output heights.
     pub peak_displacement_change: f64,
     /// |n(Δt) − n(Δt/2)| / max(n(Δt/2), 1) of the total impact count.
     pub impact_count_change: f64,
-    /// Estimated relative error of the reported peak force (Richardson, see the module).
+    /// Estimated relative error of the reported peak force: 2ᵖ/(2ᵖ − 1) × its change (4/3
+    /// for central difference, Richardson).
     pub estimated_peak_force_error: f64,
     /// Estimated relative error of the reported peak deflection.
     pub estimated_peak_displacement_error: f64,
@@ -91,27 +93,37 @@ pub struct StepHalving {
     pub steps: u64,
     /// Wall time of the check (s).
     pub seconds: f64,
-    /// Steps of the check over steps of the run (2 for the whole run at Δt/2).
+    /// Steps of the check over steps of the run (2).
     pub relative_cost: f64,
 }
 
-/// How right a run is.
+/// The `quality` section of every results document: how right the result is.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema), schema(as = QualityReport))]
 pub struct Quality {
-    /// |energy balance residual| / largest energy involved.
+    /// |kinetic + strain + contact + dissipated − external work − initial| over the largest
+    /// energy involved, at the end of the run (dimensionless).
     pub energy_residual: f64,
-    /// Δt / critical step.
+    /// Time step over the critical step with every contact closed (dimensionless).
     pub time_step_over_critical: f64,
-    /// Steps per period of the fastest motion with the contacts closed, 2π/(ω_max Δt):
-    /// the shortest contact period resolved.
+    /// 2π / (ω_max Δt): steps per period of the fastest motion with the contacts closed,
+    /// the shortest contact period resolved. `auto` uses 50 at the default tolerance.
     pub steps_per_contact_period: f64,
-    /// The tolerance the verdict was judged against.
+    /// The relative tolerance the verdict was judged against (`solver.tolerance`).
     pub tolerance: f64,
-    /// What set the step: `given`, or for `auto` `fastest_motion`, `excitation` or
-    /// `stability`.
+    /// What set the step: `given` (a fixed step), or for `auto` `fastest_motion`,
+    /// `excitation` or `stability`.
+    #[cfg_attr(
+        feature = "schema",
+        schema(value_type = String, pattern = "^(given|fastest_motion|excitation|stability)$")
+    )]
     pub time_step_limited_by: super::step_size::StepLimit,
-    /// `None` when `solver.check` is `none`.
+    /// The run repeated at Δt/2 (`solver.check: "step_halving"`); null with `"none"`.
     pub step_halving: Option<StepHalving>,
+    /// `good`: within the tolerance by every measure; `doubtful`: some measure outside it,
+    /// none by far; `poor`: do not use the numbers (energy residual > 10 × tolerance, an
+    /// estimated peak error > 20 × tolerance, or fewer than 8 steps per contact period).
+    #[cfg_attr(feature = "schema", schema(value_type = String, pattern = "^(good|doubtful|poor)$"))]
     pub verdict: Verdict,
     /// One sentence per measure outside the tolerance (empty when `good`).
     pub reasons: Vec<String>,
