@@ -5,7 +5,7 @@
 //! Data flows one way: [`http`] validates an execution request with the process and
 //! [`queue`]s a job; a [`worker`] claims it, runs the process, and stores the results
 //! document and the compressed histories ([`store`]); [`http`] serves them, thinned on
-//! request ([`thinning`]).
+//! request ([`thinning`]), and their spectra ([`spectrum_table`]).
 
 pub mod auth;
 pub mod clock;
@@ -15,6 +15,7 @@ pub mod http;
 pub mod metrics;
 pub mod queue;
 mod server;
+pub mod spectrum_table;
 mod startup;
 pub mod store;
 pub mod telemetry;

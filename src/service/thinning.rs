@@ -18,22 +18,39 @@ pub fn select(
     t_end: Option<f64>,
     max_points: Option<usize>,
 ) -> History {
-    let first = t_start.map_or(0, |t| history.time.partition_point(|&x| x < t));
-    let end = t_end.map_or(history.time.len(), |t| history.time.partition_point(|&x| x <= t));
-    let end = end.max(first);
-    let rows: Vec<usize> = match max_points {
-        Some(max) if end - first > max => peak_rows(history, first, end, max),
-        _ => (first..end).collect(),
-    };
+    let rows = window_rows(&history.time, &history.series, t_start, t_end, max_points);
     History {
         name: history.name.clone(),
         time: rows.iter().map(|&i| history.time[i]).collect(),
-        series: history
-            .series
-            .iter()
-            .map(|(name, values)| (name.clone(), rows.iter().map(|&i| values[i]).collect()))
-            .collect(),
+        series: pick_rows(&history.series, &rows),
     }
+}
+
+/// The rows of the samples at `axis` (times, or frequencies of a spectrum, increasing)
+/// with `start <= x <= end` (either bound optional), thinned to about `max_points` rows
+/// keeping the extremes of every one of `series` when there are more; ascending.
+pub fn window_rows(
+    axis: &[f64],
+    series: &[(String, Vec<f64>)],
+    start: Option<f64>,
+    end: Option<f64>,
+    max_points: Option<usize>,
+) -> Vec<usize> {
+    let first = start.map_or(0, |t| axis.partition_point(|&x| x < t));
+    let end = end.map_or(axis.len(), |t| axis.partition_point(|&x| x <= t));
+    let end = end.max(first);
+    match max_points {
+        Some(max) if end - first > max => peak_rows(series, first, end, max),
+        _ => (first..end).collect(),
+    }
+}
+
+/// Each of `columns` at `rows` only.
+pub fn pick_rows(columns: &[(String, Vec<f64>)], rows: &[usize]) -> Vec<(String, Vec<f64>)> {
+    columns
+        .iter()
+        .map(|(name, values)| (name.clone(), rows.iter().map(|&i| values[i]).collect()))
+        .collect()
 }
 
 /// How many of the samples at `axis` (times, or frequencies of a spectrum) lie in
@@ -73,8 +90,8 @@ pub fn pick_series(history: History, names: Option<&str>) -> Result<History, Str
 }
 
 /// Row indices in `first..end` keeping each series' min and max per bucket, ascending.
-fn peak_rows(history: &History, first: usize, end: usize, max_points: usize) -> Vec<usize> {
-    let per_bucket = 2 * history.series.len().max(1);
+fn peak_rows(series: &[(String, Vec<f64>)], first: usize, end: usize, max_points: usize) -> Vec<usize> {
+    let per_bucket = 2 * series.len().max(1);
     let buckets = (max_points / per_bucket).max(1);
     let len = end - first;
     let mut rows = Vec::with_capacity(buckets * per_bucket);
@@ -85,10 +102,10 @@ fn peak_rows(history: &History, first: usize, end: usize, max_points: usize) -> 
             continue;
         }
         let start = rows.len();
-        if history.series.is_empty() {
+        if series.is_empty() {
             rows.extend([lo, hi - 1]);
         }
-        for (_, values) in &history.series {
+        for (_, values) in series {
             let (mut min_at, mut max_at) = (lo, lo);
             for i in lo..hi {
                 // NaN never wins a comparison, so it is never picked as an extreme.

@@ -43,6 +43,21 @@ pub const COST_AXES: [(&str, bool); 3] = [
 /// Metric column of a run's quality verdict (`good`, `doubtful`, `poor`).
 pub const VERDICT: &str = "quality.verdict";
 
+/// The aggregates of a sweep's results (`aggregates` of its results document); which
+/// ones depend on its design and its runs' metrics.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct Aggregates {
+    /// Grids whose runs report f_err: the validity map ([`calibration`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<Value>,
+    /// Runs that carry a quality verdict: the counts ([`quality_counts`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quality: Option<QualityCounts>,
+    /// Random designs: statistics per grid cell of the list axes ([`cell_statistics`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub statistics: Option<Value>,
+}
+
 /// How many successful runs got each verdict.
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
 pub struct VerdictCounts {

@@ -10,19 +10,29 @@
 //! cell of the list axes gets the same `samples` draws. Run `k` of a sweep is cell
 //! `k / samples`, sample `k % samples`.
 //!
-//! - [`spec`]: parsing the request, with JSON pointers into it for every problem;
+//! - [`request`]: the request as one serde type, also its OpenAPI schema ([`member`]:
+//!   its members as given, so that every problem is reported at once);
+//! - [`spec`]: checking the request, with JSON pointers into it for every problem;
+//! - [`admission`]: from a request to the runs to queue, or a typed refusal;
+//! - [`definition`]: the request as stored with the sweep, read back for its results;
 //! - [`sampling`]: the seeded uniforms and the laws' quantiles;
 //! - [`pointer`]: writing a value at a JSON pointer;
 //! - [`table`]: one row per run, metrics flattened with dots, as JSON or CSV;
 //! - [`aggregate`]: statistics of random sweeps, validity maps of calibration grids.
 
+pub mod admission;
 pub mod aggregate;
+pub mod definition;
+pub mod member;
 pub mod pointer;
+pub mod request;
 pub mod sampling;
 pub mod spec;
 pub mod table;
 
-pub use spec::{Axis, AxisValues, Design, InvalidRuns, Policy, SweepError, SweepSpec};
+pub use definition::SweepDefinition;
+pub use request::{AxisKind, Design, InvalidRuns, Policy, SweepAxis, SweepRequest};
+pub use spec::{Axis, AxisValues, SweepError, SweepSpec};
 
 use serde_json::Value;
 

@@ -125,3 +125,45 @@ fn sweeps_over_the_run_limit_are_refused_before_expansion() {
         })
     );
 }
+
+#[test]
+fn members_of_the_wrong_type_are_all_named_at_once() {
+    let errors = match parse(
+        &json!({"process": 3, "inputs": [], "design": {"grid": null}, "seed": -1,
+            "policy": "sometimes", "invalid_runs": null,
+            "axes": [{"pointer": 1, "values": [1]}, 5, {"pointer": "/a", "linspace": ["0", 1, 3]},
+                     {"pointer": "/b", "normal": {"mean": 0, "sd": 1}}]}),
+        100,
+    ) {
+        Err(SweepError::Invalid(errors)) => errors,
+        other => panic!("{other:?}"),
+    };
+    let pointers: Vec<&str> = errors.iter().map(|e| e.pointer.as_str()).collect();
+    assert_eq!(
+        pointers,
+        [
+            "/process",
+            "/inputs",
+            "/axes/0/pointer",
+            "/axes/1",
+            "/axes/2/linspace",
+            "/axes/3/normal/sd",
+            "/design",
+            "/seed",
+            "/policy",
+            "/invalid_runs",
+        ]
+    );
+    assert_eq!(errors[4].detail, "start and stop must be numbers");
+}
+
+#[test]
+fn a_body_that_is_no_object_is_refused_whole() {
+    assert_eq!(
+        parse(&json!([{"process": "p"}]), 100),
+        Err(SweepError::Invalid(vec![crate::processes::FieldError::new(
+            "",
+            "the body must be a JSON object"
+        )]))
+    );
+}

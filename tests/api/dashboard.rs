@@ -8,9 +8,10 @@
 //! verdict as a badge with its reasons (a poor one too), and the force plots draw the
 //! peak-per-interval envelope whose maximum is the reported peak force.
 //!
-//! Screenshots go to `target/dashboard-screenshots/<page>.png`. Chromium is required:
-//! without it the test fails. `CHOCMODAL_SKIP_BROWSER_TESTS=1` skips these tests, each
-//! printing `SKIPPED: <test> (...)` to stderr; under `CI=true` it fails them instead.
+//! Screenshots go to `target/dashboard-screenshots/<page>.png`. Without Chromium, or with
+//! `CHOCMODAL_SKIP_BROWSER_TESTS=1`, these tests are ignored (`build.rs` looks when the
+//! package is built); under `CI=true` they are not: they fail, saying how to install
+//! Chromium, and the skip variable fails them too (see `skip.rs`).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -23,12 +24,9 @@ use serde_json::{Value, json};
 
 use crate::helpers::{TestApp, spawn_app_with_processes};
 
-/// Headless Chromium for `test`, or `None` when browser tests are explicitly skipped
-/// (said on stderr; refused under CI, see [`crate::skip`]).
-fn chromium(test: &str) -> Option<PathBuf> {
-    if crate::skip::requested("CHOCMODAL_SKIP_BROWSER_TESTS", test, "needs headless Chromium") {
-        return None;
-    }
+/// Headless Chromium for `test` (a skip asked for under CI fails it, see [`crate::skip`]).
+fn chromium(test: &str) -> PathBuf {
+    crate::skip::refuse_under_ci("CHOCMODAL_SKIP_BROWSER_TESTS", test, "needs headless Chromium");
     let candidates = std::env::var_os("CHOCMODAL_CHROMIUM")
         .map(PathBuf::from)
         .into_iter()
@@ -41,13 +39,13 @@ fn chromium(test: &str) -> Option<PathBuf> {
             .map(PathBuf::from),
         );
     let found = candidates.into_iter().find(|path| path.is_file());
-    Some(found.unwrap_or_else(|| {
+    found.unwrap_or_else(|| {
         panic!(
             "the dashboard tests need headless Chromium: install Debian's `chromium` package \
              (`apt-get install chromium`; .ci/run does it), point CHOCMODAL_CHROMIUM at a \
-             Chromium binary, or set CHOCMODAL_SKIP_BROWSER_TESTS=1 to skip them"
+             Chromium binary, or set CHOCMODAL_SKIP_BROWSER_TESTS=1 to ignore them (outside CI)"
         )
-    }))
+    })
 }
 
 fn screenshot_dir() -> PathBuf {
@@ -169,13 +167,15 @@ async fn execute(app: &TestApp, process: &str, body: &Value) -> String {
 }
 
 #[tokio::test]
+#[cfg_attr(
+    chocmodal_skip_browser_tests,
+    ignore = "needs headless Chromium: none found at build time, or CHOCMODAL_SKIP_BROWSER_TESTS=1 (build.rs)"
+)]
 async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_browser() {
-    let Some(browser) = chromium(concat!(
+    let browser = chromium(concat!(
         module_path!(),
         "::the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_browser"
-    )) else {
-        return;
-    };
+    ));
     let app =
         spawn_app_with_processes(vec![Arc::new(CantileverImpact), Arc::new(BundleDynamics)], |_| {}).await;
     let within = Duration::from_secs(60);
@@ -489,13 +489,15 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
 /// asked for without a token is its shell with a 401), and the page's scripts, refused
 /// by the API, ask for the team's token instead of showing empty tables.
 #[tokio::test]
+#[cfg_attr(
+    chocmodal_skip_browser_tests,
+    ignore = "needs headless Chromium: none found at build time, or CHOCMODAL_SKIP_BROWSER_TESTS=1 (build.rs)"
+)]
 async fn with_tokens_the_dashboard_asks_for_one() {
-    let Some(browser) = chromium(concat!(
+    let browser = chromium(concat!(
         module_path!(),
         "::with_tokens_the_dashboard_asks_for_one"
-    )) else {
-        return;
-    };
+    ));
     let tokens = chocmodal::service::auth::TokenTable::parse("alpha alpha-token-0123456789\n").unwrap();
     let app = crate::helpers::spawn_app_with(|config| config.auth = Some(tokens)).await;
 

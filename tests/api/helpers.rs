@@ -38,10 +38,12 @@ macro_rules! on_both_backends {
         mod postgres {
             $(
                 #[tokio::test]
+                #[cfg_attr(
+                    chocmodal_skip_postgres_tests,
+                    ignore = "needs PostgreSQL: none found at build time, or CHOCMODAL_SKIP_POSTGRES_TESTS=1 (build.rs)"
+                )]
                 async fn $test() {
-                    if $crate::postgres::skipped(concat!(module_path!(), "::", stringify!($test))) {
-                        return;
-                    }
+                    $crate::postgres::refuse_skip_under_ci(concat!(module_path!(), "::", stringify!($test)));
                     super::$test($crate::helpers::Backend::Postgres).await
                 }
             )+

@@ -9,10 +9,10 @@
 //! directory. Each test then gets its own `CREATE DATABASE`.
 //!
 //! `CHOCMODAL_TEST_DATABASE_URL=postgres://user@host/db` uses that server instead (the
-//! user must be allowed to create databases). Without PostgreSQL binaries the
-//! PostgreSQL tests fail, saying how to install them, unless
-//! `CHOCMODAL_SKIP_POSTGRES_TESTS=1`: then each prints `SKIPPED: <test> (...)` to stderr,
-//! and under `CI=true` that variable fails them instead (see `skip.rs`).
+//! user must be allowed to create databases). Without either, or with
+//! `CHOCMODAL_SKIP_POSTGRES_TESTS=1`, the PostgreSQL tests are ignored (`build.rs` looks
+//! when the package is built); under `CI=true` they are not: they fail, saying how to
+//! install PostgreSQL, and the skip variable fails them too (see `skip.rs`).
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -27,10 +27,10 @@ pub const SKIP_VARIABLE: &str = "CHOCMODAL_SKIP_POSTGRES_TESTS";
 /// A server to use instead of a throwaway cluster.
 pub const URL_VARIABLE: &str = "CHOCMODAL_TEST_DATABASE_URL";
 
-/// True when the PostgreSQL test `test` is skipped on request (it says so on stderr);
-/// panics when asked to skip under CI (see [`crate::skip`]).
-pub fn skipped(test: &str) -> bool {
-    crate::skip::requested(SKIP_VARIABLE, test, "needs a PostgreSQL server")
+/// Panics when the PostgreSQL test `test` is asked to be skipped under CI (see
+/// [`crate::skip`]).
+pub fn refuse_skip_under_ci(test: &str) {
+    crate::skip::refuse_under_ci(SKIP_VARIABLE, test, "needs a PostgreSQL server")
 }
 
 struct Server {
@@ -91,8 +91,8 @@ fn start_cluster() -> Result<Server, String> {
             "the PostgreSQL server binaries (initdb, postgres) are in neither \
              /usr/lib/postgresql/<version>/bin nor PATH. Install them (`apt-get install -y \
              postgresql`, as .ci/run does), or set {URL_VARIABLE}=postgres://user@host/db to use \
-             a server where that user may create databases, or set {SKIP_VARIABLE}=1 to skip \
-             the PostgreSQL tests"
+             a server where that user may create databases, or set {SKIP_VARIABLE}=1 to ignore \
+             the PostgreSQL tests (outside CI)"
         )
     })?;
     let root = id(&["-u"])? == 0;

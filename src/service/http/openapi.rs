@@ -225,8 +225,8 @@ impl Modify for ResourceLinks {
         sweep_models::RunCounts,
         sweep_models::SweepStatus,
         sweep_models::SweepList,
-        sweep_models::SweepAxisSchema,
-        sweep_models::SweepRequestSchema,
+        crate::sweep::SweepAxis,
+        crate::sweep::SweepRequest,
         sweep_models::SweepResults,
         // The `inputs` of each shipped process (also served by `/processes/{id}`).
     )),

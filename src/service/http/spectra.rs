@@ -13,10 +13,10 @@ use super::error::ApiError;
 use super::extract::ApiQuery;
 use super::history_view::{Format, capped_max_points, require_finite, respond};
 use super::models::Series;
-use crate::physics::spectrum::{periodogram, spectral_error};
+use crate::physics::spectrum::spectral_error;
 use crate::problem::Problem;
-use crate::processes::History;
 use crate::service::auth::Tenant;
+use crate::service::spectrum_table::SpectrumTable;
 use crate::service::{store, thinning};
 
 /// Query of `GET /jobs/{jobId}/results/{output}/spectrum`.
@@ -143,52 +143,32 @@ fn render(stored: &store::StoredHistory, query: &SpectrumQuery, format: Format) 
     let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
     let history = thinning::pick_series(history, query.series.as_deref()).map_err(Problem::invalid_query)?;
     let dt = sample_interval(&history.time);
-    let mut spectra = History {
-        name: history.name.clone(),
-        time: Vec::new(),
-        series: Vec::with_capacity(history.series.len()),
-    };
-    for (name, values) in &history.series {
-        let psd = periodogram(values, dt)
-            .map_err(|e| unprocessable(format!("`{}`, series `{name}`: {e}", history.name)))?;
-        spectra.time = psd.frequencies;
-        spectra.series.push((name.clone(), psd.power_density));
-    }
+    let spectrum = SpectrumTable::of(&history, dt).map_err(unprocessable)?;
     let comparison = match history.series.as_slice() {
         [(a, first), (b, second), ..] => {
             let f_err = spectral_error(first, second)
                 .map_err(|e| unprocessable(format!("`{}`: {e}", history.name)))?;
-            let (gamma_a, gamma_b) = (&spectra.series[0].1, &spectra.series[1].1);
-            let worst = (0..gamma_a.len())
-                .max_by(|&i, &j| {
-                    (gamma_a[i] - gamma_b[i])
-                        .abs()
-                        .total_cmp(&(gamma_a[j] - gamma_b[j]).abs())
-                })
-                .unwrap_or(0);
             Some(SpectrumComparison {
                 series: [a.clone(), b.clone()],
                 f_err,
-                frequency: spectra.time.get(worst).copied().unwrap_or(0.0),
+                frequency: spectrum.largest_difference().unwrap_or(0.0),
             })
         }
         _ => None,
     };
-    let selected = thinning::select(&spectra, query.f_min, query.f_max, query.max_points);
+    let selected = spectrum.select(query.f_min, query.f_max, query.max_points);
     if format == Format::Csv {
-        // The shared CSV writer names its first column `time`; here it holds frequencies.
-        let text = selected.to_csv();
-        return Ok(format!("frequency{}", text.strip_prefix("time").unwrap_or(&text)).into_bytes());
+        return Ok(selected.to_csv().into_bytes());
     }
-    let in_window = thinning::count_in_window(&spectra.time, query.f_min, query.f_max);
+    let in_window = thinning::count_in_window(&spectrum.frequency, query.f_min, query.f_max);
     let document = SpectrumDocument {
         output: selected.name,
         sample_interval: dt,
         samples: history.time.len(),
-        points: selected.time.len(),
-        total_points: spectra.time.len(),
-        thinned: selected.time.len() < in_window,
-        frequency: selected.time,
+        points: selected.frequency.len(),
+        total_points: spectrum.frequency.len(),
+        thinned: selected.frequency.len() < in_window,
+        frequency: selected.frequency,
         series: Series::from_columns(selected.series),
         comparison,
     };

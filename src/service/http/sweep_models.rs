@@ -149,65 +149,6 @@ pub struct SweepList {
     pub links: Vec<Link>,
 }
 
-/// One axis of a sweep: a JSON pointer into the inputs and exactly one of `values`,
-/// `linspace`, `logspace` (list axes) or `uniform`, `normal`, `lognormal` (random axes).
-#[derive(Debug, ToSchema)]
-#[schema(as = SweepAxis)]
-#[allow(dead_code)]
-pub struct SweepAxisSchema {
-    /// JSON pointer into the process inputs, e.g. `/contact/rk`; it must exist in the
-    /// base inputs or be creatable there (missing object members are created).
-    pointer: String,
-    /// Explicit values, any JSON.
-    #[schema(value_type = Option<Vec<Object>>)]
-    values: Option<Vec<serde_json::Value>>,
-    /// `[start, stop, count]`: count evenly spaced values, both ends included.
-    linspace: Option<Vec<f64>>,
-    /// `[start, stop, count]`: count geometrically spaced values (not exponents), start and stop > 0.
-    logspace: Option<Vec<f64>>,
-    /// `[low, high]`: uniform draws on [low, high).
-    uniform: Option<Vec<f64>>,
-    /// `{"mean", "std"}`: normal draws.
-    #[schema(value_type = Option<Object>)]
-    normal: Option<serde_json::Value>,
-    /// `{"mean", "std"}` of the natural logarithm of the value: lognormal draws.
-    #[schema(value_type = Option<Object>)]
-    lognormal: Option<serde_json::Value>,
-}
-
-/// A sweep request. Integer targets (an integer in the base inputs, or integer bounds)
-/// receive generated numbers rounded to integers.
-#[derive(Debug, ToSchema)]
-#[schema(as = SweepRequest, example = json!({
-    "process": "cantilever-impact",
-    "inputs": {"beam": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
-                        "section": {"type": "tube", "outer_diameter": 0.010, "inner_diameter": 0.009}},
-               "release": {"tip_displacement": 0.001},
-               "solver": {"time_step": 1e-5, "duration": 0.02}},
-    "axes": [{"pointer": "/contact/rk", "values": [0.1, 10.0]}]}))]
-#[allow(dead_code)]
-pub struct SweepRequestSchema {
-    /// Process id, e.g. `cantilever-impact`.
-    process: String,
-    /// Base inputs of every run (see the process description).
-    #[schema(value_type = Object)]
-    inputs: serde_json::Value,
-    axes: Vec<SweepAxisSchema>,
-    /// `grid` (default with list axes only), `monte_carlo` (default with a random axis)
-    /// or `latin_hypercube`.
-    design: Option<String>,
-    /// Draws per grid cell of the list axes; required with random axes.
-    samples: Option<u64>,
-    /// Seed of the random draws (default 0): the same seed gives the same runs on every machine.
-    seed: Option<u64>,
-    /// `continue` (default) or `fail_fast`: the first failed run dismisses the others.
-    policy: Option<String>,
-    /// `refuse` (default): any invalid generated run refuses the whole sweep (422);
-    /// `record`: invalid runs are recorded as failed jobs with their `invalid-inputs`
-    /// problem, never queued, and the valid ones run (maps across a stability limit).
-    invalid_runs: Option<String>,
-}
-
 /// The results of a sweep: one row per ended run, and aggregates.
 #[derive(Debug, Serialize, ToSchema)]
 pub struct SweepResults {

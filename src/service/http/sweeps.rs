@@ -1,13 +1,10 @@
 //! `/sweeps`: submit a sweep (validated whole before anything is queued), its status,
 //! the sweep list, dismissal, and its results table with aggregates.
 
-use std::sync::Arc;
-
 use axum::Json;
 use axum::extract::{Extension, Path, State};
 use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
-use serde_json::{Value, json};
 
 use super::AppState;
 use super::conditional::tagged;
@@ -17,16 +14,14 @@ use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
 use super::models::Link;
 use super::sweep_models::{SweepList, SweepResults, SweepStatus};
 use crate::problem::Problem;
-use crate::processes::{CostLimits, FieldError, InvalidInputs, Process, TooCostly};
+use crate::processes::{InvalidInputs, Process, TooCostly};
 use crate::service::auth::Tenant;
 use crate::service::queue::sweep_create::{NewRun, NewSweep};
+use crate::service::queue::sweep_read::SweepRun;
 use crate::service::queue::{Admission, SweepRecord};
-use crate::sweep::spec::{self, SweepError};
-use crate::sweep::table::{self, RunRecord};
-use crate::sweep::{Design, InvalidRuns, SweepSpec, aggregate};
-
-/// At most this many field errors are reported for the runs of one sweep.
-const MAX_RUN_ERRORS: usize = 100;
+use crate::sweep::admission::{self, AdmissionLimits, Admitted, MAX_RUN_ERRORS, Refusal};
+use crate::sweep::table::RunRecord;
+use crate::sweep::{SweepDefinition, SweepError};
 
 /// Submit a sweep
 ///
@@ -38,7 +33,7 @@ const MAX_RUN_ERRORS: usize = 100;
 /// Every run must also be within the service's cost ceilings (422 `too-costly`, with
 /// the same run pointers), and the runs must fit in the tenant's queue (429).
 #[utoipa::path(post, path = "/sweeps", operation_id = "createSweep", tag = "Sweeps",
-    request_body(content = super::sweep_models::SweepRequestSchema, description = "The process, base inputs and axes"),
+    request_body(content = crate::sweep::SweepRequest, description = "The process, base inputs and axes"),
     responses(
         (status = 201, description = "Sweep queued", body = SweepStatus,
             headers(("Location" = String, description = "`/sweeps/{sweepId}`"))),
@@ -57,24 +52,26 @@ pub async fn create(
     body: Result<JsonBody, ApiError>,
 ) -> Result<Response, ApiError> {
     let JsonBody(body) = body?;
-    let spec = spec::parse(&body, state.max_sweep_runs).map_err(|error| match error {
-        SweepError::Invalid(errors) => Problem::invalid_inputs(&InvalidInputs(errors)),
-        SweepError::TooLarge { runs, limit } => Problem::sweep_too_large(runs, limit),
-    })?;
-    let process = state
-        .registry
-        .get(&spec.process)
-        .ok_or_else(|| Problem::no_such_process(&spec.process))?;
-    let spec = Arc::new(spec);
-    // Expansion and validation of thousands of runs is CPU work: off the runtime.
-    let runs = {
-        let spec = spec.clone();
-        let limits = state.limits;
-        tokio::task::spawn_blocking(move || expand_and_validate(&spec, process.as_ref(), &limits))
+    let registry = state.registry.clone();
+    let limits = AdmissionLimits {
+        max_runs: state.max_sweep_runs,
+        cost: state.limits,
+    };
+    // Expanding and validating thousands of runs is CPU work: off the runtime.
+    let Admitted { spec, runs } =
+        tokio::task::spawn_blocking(move || admission::admit(&body, &registry, &limits))
             .await
-            .map_err(|e| ApiError::Internal(format!("sweep validation panicked: {e}")))?
-    }?;
-    let definition = definition(&spec, &body);
+            .map_err(|e| ApiError::Internal(format!("sweep admission panicked: {e}")))?
+            .map_err(refusal)?;
+    let definition =
+        serde_json::to_value(spec.definition()).map_err(|e| ApiError::Internal(e.to_string()))?;
+    let runs: Vec<NewRun> = runs
+        .into_iter()
+        .map(|run| NewRun {
+            inputs: run.inputs,
+            invalid: run.invalid.as_ref().map(Problem::invalid_inputs),
+        })
+        .collect();
     let admission = state
         .queue
         .create_sweep(
@@ -112,156 +109,34 @@ pub async fn create(
     Ok((StatusCode::CREATED, headers, Json(status)).into_response())
 }
 
-/// The normalized definition stored with the sweep: the request with its defaults made explicit.
-fn definition(spec: &SweepSpec, body: &Value) -> Value {
-    json!({
-        "process": spec.process,
-        "inputs": spec.inputs,
-        "axes": body.get("axes").cloned().unwrap_or(Value::Null),
-        "design": spec.design.as_str(),
-        "samples": spec.samples,
-        "seed": spec.seed,
-        "policy": spec.policy.as_str(),
-        "invalid_runs": spec.invalid_runs.as_str(),
-    })
-}
-
-/// Why a generated run cannot be queued.
-#[derive(Debug)]
-enum Refusal {
-    Invalid(InvalidInputs),
-    TooCostly(TooCostly),
-}
-
-/// Every run, or the 422 naming the invalid runs (unless they are to be recorded) or
-/// the runs above the cost ceilings (always refused). Runs are validated in parallel,
-/// one chunk per core.
-fn expand_and_validate(
-    spec: &SweepSpec,
-    process: &dyn Process,
-    limits: &CostLimits,
-) -> Result<Vec<NewRun>, ApiError> {
-    let runs = spec.expand();
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(runs.len().max(1));
-    let chunk = runs.len().div_ceil(threads).max(1);
-    let refusals: Vec<(usize, Refusal)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = runs
-            .chunks(chunk)
-            .map(|runs| {
-                scope.spawn(move || {
-                    runs.iter()
-                        .filter_map(|run| {
-                            let refusal = match process.validate(&run.inputs) {
-                                Err(invalid) => Refusal::Invalid(invalid),
-                                Ok(estimate) => Refusal::TooCostly(limits.check(&estimate).err()?),
-                            };
-                            Some((run.index, refusal))
-                        })
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join())
-            .collect::<Result<Vec<_>, _>>()
-            .map(|chunks| chunks.into_iter().flatten().collect())
-    })
-    .map_err(|_| ApiError::Internal("a process's validation panicked".into()))?;
-    let mut failures: Vec<(usize, InvalidInputs)> = Vec::new();
-    let mut costly: Vec<(usize, TooCostly)> = Vec::new();
-    for (index, refusal) in refusals {
-        match refusal {
-            Refusal::Invalid(invalid) => failures.push((index, invalid)),
-            Refusal::TooCostly(refused) => costly.push((index, refused)),
+/// The problem document of a refused sweep.
+fn refusal(refusal: Refusal) -> ApiError {
+    let problem = match refusal {
+        Refusal::Request(SweepError::Invalid(errors)) => Problem::invalid_inputs(&InvalidInputs(errors)),
+        Refusal::Request(SweepError::TooLarge { runs, limit }) => Problem::sweep_too_large(runs, limit),
+        Refusal::NoSuchProcess(id) => Problem::no_such_process(&id),
+        Refusal::InvalidRuns(refused) => {
+            let mut problem = Problem::invalid_inputs(&InvalidInputs(refused.errors));
+            problem.detail = format!(
+                "{} of {} runs have invalid inputs (first run {}); nothing was queued; see `errors` (at most {MAX_RUN_ERRORS})",
+                refused.refused, refused.runs, refused.first
+            );
+            problem
         }
-    }
-    if !costly.is_empty() {
-        costly.sort_by_key(|(index, _)| *index);
-        let errors = run_errors(
-            spec,
-            &runs,
-            costly
-                .iter()
-                .map(|(index, refused)| (*index, refused.errors.as_slice())),
-        );
-        let mut problem = Problem::too_costly(&TooCostly {
-            exceeded: costly[0].1.exceeded.clone(),
-            errors,
-        });
-        problem.detail = format!(
-            "{} of {} runs are above this service's cost ceilings (first run {}: {}); nothing was queued; \
-             see `errors` (at most {MAX_RUN_ERRORS})",
-            costly.len(),
-            runs.len(),
-            costly[0].0,
-            problem.detail
-        );
-        return Err(problem.into());
-    }
-    if failures.is_empty() || spec.invalid_runs == InvalidRuns::Record {
-        let mut failures = failures.into_iter().collect::<std::collections::HashMap<_, _>>();
-        return Ok(runs
-            .into_iter()
-            .map(|run| NewRun {
-                invalid: failures
-                    .remove(&run.index)
-                    .map(|invalid| Problem::invalid_inputs(&invalid)),
-                inputs: run.inputs,
-            })
-            .collect());
-    }
-    failures.sort_by_key(|(index, _)| *index);
-    let invalid_runs = failures.len();
-    let errors = run_errors(
-        spec,
-        &runs,
-        failures
-            .iter()
-            .map(|(index, invalid)| (*index, invalid.0.as_slice())),
-    );
-    let mut problem = Problem::invalid_inputs(&InvalidInputs(errors));
-    problem.detail = format!(
-        "{invalid_runs} of {} runs have invalid inputs (first run {}); nothing was queued; see `errors` (at most {MAX_RUN_ERRORS})",
-        runs.len(),
-        failures[0].0
-    );
-    Err(problem.into())
-}
-
-/// The errors of generated runs, re-pointed into the sweep (`/runs/{run}/inputs/...`)
-/// with each run's axis values in the detail; at most [`MAX_RUN_ERRORS`].
-fn run_errors<'a>(
-    spec: &SweepSpec,
-    runs: &[crate::sweep::Run],
-    refused: impl Iterator<Item = (usize, &'a [FieldError])>,
-) -> Vec<FieldError> {
-    refused
-        .flat_map(|(index, errors)| {
-            let values: Vec<String> = spec
-                .axes
-                .iter()
-                .map(|axis| {
-                    let value = runs[index]
-                        .inputs
-                        .pointer(&axis.pointer)
-                        .cloned()
-                        .unwrap_or(Value::Null);
-                    format!("{} = {value}", axis.pointer)
-                })
-                .collect();
-            errors.iter().map(move |error| {
-                let within = error.pointer.strip_prefix("/inputs").unwrap_or(&error.pointer);
-                FieldError::new(
-                    format!("/runs/{index}/inputs{within}"),
-                    format!("{} (run {index}: {})", error.detail, values.join(", ")),
-                )
-            })
-        })
-        .take(MAX_RUN_ERRORS)
-        .collect()
+        Refusal::TooCostly { runs, exceeded } => {
+            let mut problem = Problem::too_costly(&TooCostly {
+                exceeded,
+                errors: runs.errors,
+            });
+            problem.detail = format!(
+                "{} of {} runs are above this service's cost ceilings (first run {}: {}); nothing was queued; \
+                 see `errors` (at most {MAX_RUN_ERRORS})",
+                runs.refused, runs.runs, runs.first, problem.detail
+            );
+            problem
+        }
+    };
+    problem.into()
 }
 
 async fn sweep_status(
@@ -462,58 +337,18 @@ pub async fn results(
 fn render_results(
     record: &SweepRecord,
     status: SweepStatus,
-    runs: Vec<crate::service::queue::sweep_read::SweepRun>,
+    runs: Vec<SweepRun>,
     process: Option<&dyn Process>,
     csv: bool,
 ) -> Result<Vec<u8>, ApiError> {
-    let definition: Value = serde_json::from_str(&record.definition).unwrap_or(Value::Null);
-    let axes = definition["axes"].as_array().cloned().unwrap_or_default();
-    let pointer = |axis: &Value| axis["pointer"].as_str().unwrap_or_default().to_owned();
-    let is_list = |axis: &Value| {
-        ["values", "linspace", "logspace"]
-            .iter()
-            .any(|k| axis.get(k).is_some())
-    };
-    let pointers: Vec<String> = axes.iter().map(pointer).collect();
-    let records: Vec<RunRecord> = runs
-        .into_iter()
-        .map(|run| {
-            let document: Option<Value> = run
-                .results
-                .as_deref()
-                .and_then(|text| serde_json::from_str(text).ok());
-            let metrics = match (&document, process) {
-                (Some(document), Some(process)) => process.summary_metrics(document),
-                (Some(document), None) => crate::processes::metrics::flatten_scalars(document),
-                (None, _) => Vec::new(),
-            };
-            RunRecord {
-                run: usize::try_from(run.run).unwrap_or(0),
-                job: run.job_id,
-                status: run.status.as_str().to_owned(),
-                inputs: serde_json::from_str(&run.inputs).unwrap_or(Value::Null),
-                metrics,
-            }
-        })
-        .collect();
-    let table = table::build(&pointers, &records);
+    let definition = SweepDefinition::from_stored(&record.definition)
+        .map_err(|e| ApiError::Internal(format!("sweep {}: stored definition unreadable: {e}", record.id)))?;
+    let records: Vec<RunRecord> = runs.into_iter().map(|run| run_record(run, process)).collect();
+    let table = definition.table(&records);
     if csv {
         return Ok(table.to_csv().into_bytes());
     }
-    let list_axes: Vec<String> = axes.iter().filter(|a| is_list(a)).map(pointer).collect();
-    let mut aggregates = match Design::parse(&record.design) {
-        Some(Design::Grid) => match aggregate::calibration(&table, &pointers) {
-            Some(map) => json!({ "calibration": map }),
-            None => json!({}),
-        },
-        _ => {
-            let random_axes: Vec<String> = axes.iter().filter(|a| !is_list(a)).map(pointer).collect();
-            json!({ "statistics": aggregate::cell_statistics(&table, &list_axes, &random_axes) })
-        }
-    };
-    if let Some(quality) = aggregate::quality_counts(&table, &list_axes) {
-        aggregates["quality"] = json!(quality);
-    }
+    let aggregates = definition.aggregates(&table);
     let href = format!("/sweeps/{}", record.id);
     let document = SweepResults {
         sweep_id: record.id.clone(),
@@ -521,7 +356,8 @@ fn render_results(
         runs: record.runs,
         columns: table.columns,
         rows: table.rows,
-        aggregates,
+        // Through a JSON value: its members sorted, as they always were.
+        aggregates: serde_json::to_value(&aggregates).map_err(|e| ApiError::Internal(e.to_string()))?,
         links: vec![
             Link::new(format!("{href}/results"), "self", "application/json"),
             Link::new(format!("{href}/results?format=csv"), "alternate", "text/csv"),
@@ -529,4 +365,25 @@ fn render_results(
         ],
     };
     serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
+}
+
+/// What the results table needs of an ended run: its stored inputs, and the scalar
+/// metrics of its stored results document (none when it has none).
+fn run_record(run: SweepRun, process: Option<&dyn Process>) -> RunRecord {
+    let document: Option<serde_json::Value> = run
+        .results
+        .as_deref()
+        .and_then(|text| serde_json::from_str(text).ok());
+    let metrics = match (&document, process) {
+        (Some(document), Some(process)) => process.summary_metrics(document),
+        (Some(document), None) => crate::processes::metrics::flatten_scalars(document),
+        (None, _) => Vec::new(),
+    };
+    RunRecord {
+        run: usize::try_from(run.run).unwrap_or(0),
+        job: run.job_id,
+        status: run.status.as_str().to_owned(),
+        inputs: serde_json::from_str(&run.inputs).unwrap_or(serde_json::Value::Null),
+        metrics,
+    }
 }

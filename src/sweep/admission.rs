@@ -1,0 +1,336 @@
+//! Sweep admission: from a request body to the runs to queue, or the reason why none is.
+//!
+//! A sweep is admitted whole or not at all. Its request is checked ([`spec::parse`]),
+//! its process looked up, its axes expanded into runs, and every run's inputs validated
+//! by the process as an execution request's would be, its estimated cost compared with
+//! the service's ceilings. A run above a ceiling refuses the sweep; an invalid run
+//! refuses it too, unless the request says `invalid_runs: record` (the run is then
+//! kept, failed, with its problem, and never reaches a worker). The runs are validated
+//! in parallel, one chunk per core: a sweep has up to thousands of them.
+//!
+//! No IO, no async: the HTTP layer runs this off its runtime and turns a [`Refusal`]
+//! into its problem document.
+
+use std::collections::HashMap;
+
+use serde_json::Value;
+
+use super::spec::{self, SweepError, SweepSpec};
+use super::{InvalidRuns, Run};
+use crate::processes::cost::Excess;
+use crate::processes::{CostLimits, FieldError, InvalidInputs, Process, Registry, TooCostly};
+
+/// At most this many field errors are reported for the runs of one sweep.
+pub const MAX_RUN_ERRORS: usize = 100;
+
+/// What a service accepts in one sweep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdmissionLimits {
+    /// Most runs in one sweep.
+    pub max_runs: usize,
+    /// Ceilings on each run's estimated cost.
+    pub cost: CostLimits,
+}
+
+/// An admitted sweep: its checked request and every run, in run order.
+#[derive(Debug, Clone)]
+pub struct Admitted {
+    pub spec: SweepSpec,
+    pub runs: Vec<AdmittedRun>,
+}
+
+/// One run of an admitted sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdmittedRun {
+    /// The run's complete inputs.
+    pub inputs: Value,
+    /// Why the process refuses them, for a run recorded as failed (`invalid_runs: record`).
+    pub invalid: Option<InvalidInputs>,
+}
+
+/// Why a sweep is not admitted; each variant's doc says its HTTP status and problem type.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Refusal {
+    /// 422 `invalid-inputs` (the request, by pointers into it) or `sweep-too-large`.
+    Request(SweepError),
+    /// 404 `no-such-process`: no process with this id.
+    NoSuchProcess(String),
+    /// 422 `invalid-inputs`: generated runs the process refuses (`invalid_runs: refuse`).
+    InvalidRuns(RefusedRuns),
+    /// 422 `too-costly`: runs above the cost ceilings, with the ceilings the first one
+    /// exceeds.
+    TooCostly {
+        runs: RefusedRuns,
+        exceeded: Vec<Excess>,
+    },
+}
+
+/// The refused runs of a sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RefusedRuns {
+    /// How many runs are refused,
+    pub refused: usize,
+    /// of how many in the sweep;
+    pub runs: usize,
+    /// the number of the first one refused.
+    pub first: usize,
+    /// Their errors, pointed into the sweep (`/runs/{run}/inputs/...`), each detail
+    /// naming the run's axis values; at most [`MAX_RUN_ERRORS`].
+    pub errors: Vec<FieldError>,
+}
+
+/// Admits the sweep requested by `body`, or says why not.
+pub fn admit(body: &Value, registry: &Registry, limits: &AdmissionLimits) -> Result<Admitted, Refusal> {
+    let spec = spec::parse(body, limits.max_runs).map_err(Refusal::Request)?;
+    let process = registry
+        .get(&spec.process)
+        .ok_or_else(|| Refusal::NoSuchProcess(spec.process.clone()))?;
+    let runs = admit_runs(&spec, process.as_ref(), &limits.cost)?;
+    Ok(Admitted { spec, runs })
+}
+
+/// Why the process does not take a generated run as it is.
+#[derive(Debug)]
+enum RunProblem {
+    Invalid(InvalidInputs),
+    TooCostly(TooCostly),
+}
+
+/// Every run of `spec`, or the refusal naming the runs above the cost ceilings (always
+/// refused) or the invalid ones (unless they are to be recorded).
+fn admit_runs(
+    spec: &SweepSpec,
+    process: &dyn Process,
+    limits: &CostLimits,
+) -> Result<Vec<AdmittedRun>, Refusal> {
+    let runs = spec.expand();
+    let problems = validate_in_parallel(&runs, process, limits);
+    let mut invalid: Vec<(usize, InvalidInputs)> = Vec::new();
+    let mut costly: Vec<(usize, TooCostly)> = Vec::new();
+    for (index, problem) in problems {
+        match problem {
+            RunProblem::Invalid(inputs) => invalid.push((index, inputs)),
+            RunProblem::TooCostly(refused) => costly.push((index, refused)),
+        }
+    }
+    if !costly.is_empty() {
+        costly.sort_by_key(|(index, _)| *index);
+        let exceeded = costly[0].1.exceeded.clone();
+        let runs = refused_runs(
+            spec,
+            &runs,
+            costly
+                .iter()
+                .map(|(index, refused)| (*index, refused.errors.as_slice())),
+        );
+        return Err(Refusal::TooCostly { runs, exceeded });
+    }
+    if invalid.is_empty() || spec.invalid_runs == InvalidRuns::Record {
+        let mut invalid: HashMap<usize, InvalidInputs> = invalid.into_iter().collect();
+        return Ok(runs
+            .into_iter()
+            .map(|run| AdmittedRun {
+                invalid: invalid.remove(&run.index),
+                inputs: run.inputs,
+            })
+            .collect());
+    }
+    invalid.sort_by_key(|(index, _)| *index);
+    Err(Refusal::InvalidRuns(refused_runs(
+        spec,
+        &runs,
+        invalid
+            .iter()
+            .map(|(index, inputs)| (*index, inputs.0.as_slice())),
+    )))
+}
+
+/// The problem of each run the process refuses or that is above a ceiling, by run
+/// number (in no particular order); one chunk of runs per core.
+fn validate_in_parallel(
+    runs: &[Run],
+    process: &dyn Process,
+    limits: &CostLimits,
+) -> Vec<(usize, RunProblem)> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(runs.len().max(1));
+    let chunk = runs.len().div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = runs
+            .chunks(chunk)
+            .map(|runs| {
+                scope.spawn(move || {
+                    runs.iter()
+                        .filter_map(|run| {
+                            let problem = match process.validate(&run.inputs) {
+                                Err(invalid) => RunProblem::Invalid(invalid),
+                                Ok(estimate) => RunProblem::TooCostly(limits.check(&estimate).err()?),
+                            };
+                            Some((run.index, problem))
+                        })
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            // A process's validation that panics is a bug: the caller sees the panic.
+            .flat_map(|handle| {
+                handle
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
+            .collect()
+    })
+}
+
+/// The refused runs `refused` (by run number, in order, with their errors) of `runs`.
+fn refused_runs<'a>(
+    spec: &SweepSpec,
+    runs: &[Run],
+    refused: impl ExactSizeIterator<Item = (usize, &'a [FieldError])> + Clone,
+) -> RefusedRuns {
+    let count = refused.len();
+    let first = refused.clone().next().map_or(0, |(index, _)| index);
+    RefusedRuns {
+        refused: count,
+        runs: runs.len(),
+        first,
+        errors: run_errors(spec, runs, refused),
+    }
+}
+
+/// The errors of generated runs, re-pointed into the sweep (`/runs/{run}/inputs/...`)
+/// with each run's axis values in the detail; at most [`MAX_RUN_ERRORS`].
+fn run_errors<'a>(
+    spec: &SweepSpec,
+    runs: &[Run],
+    refused: impl Iterator<Item = (usize, &'a [FieldError])>,
+) -> Vec<FieldError> {
+    refused
+        .flat_map(|(index, errors)| {
+            let values: Vec<String> = spec
+                .axes
+                .iter()
+                .map(|axis| {
+                    let value = runs[index]
+                        .inputs
+                        .pointer(&axis.pointer)
+                        .cloned()
+                        .unwrap_or(Value::Null);
+                    format!("{} = {value}", axis.pointer)
+                })
+                .collect();
+            errors.iter().map(move |error| {
+                let within = error.pointer.strip_prefix("/inputs").unwrap_or(&error.pointer);
+                FieldError::new(
+                    format!("/runs/{index}/inputs{within}"),
+                    format!("{} (run {index}: {})", error.detail, values.join(", ")),
+                )
+            })
+        })
+        .take(MAX_RUN_ERRORS)
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::json;
+
+    use super::*;
+
+    fn calibration() -> Value {
+        serde_json::from_str(include_str!("../../examples/sweep-calibration.json")).unwrap()
+    }
+
+    fn limits() -> AdmissionLimits {
+        AdmissionLimits {
+            max_runs: 10_000,
+            cost: CostLimits::default(),
+        }
+    }
+
+    #[test]
+    fn every_run_is_admitted_in_order_and_invalid_ones_are_recorded() {
+        let admitted = admit(&calibration(), &Registry::builtin(), &limits()).unwrap();
+        assert_eq!(admitted.runs.len(), 32);
+        assert_eq!(admitted.runs[5].inputs["solver"]["time_step"], json!(1e-5));
+        assert_eq!(admitted.runs[5].inputs["contact"]["rk"], json!(1.0));
+        let invalid = admitted.runs.iter().filter(|run| run.invalid.is_some()).count();
+        assert!(
+            (1..32).contains(&invalid),
+            "{invalid} of 32 runs invalid: the grid crosses the stability limit"
+        );
+    }
+
+    #[test]
+    fn invalid_runs_refuse_the_sweep_unless_recorded_naming_each_run() {
+        let mut body = calibration();
+        body["invalid_runs"] = json!("refuse");
+        let Err(Refusal::InvalidRuns(refused)) = admit(&body, &Registry::builtin(), &limits()) else {
+            panic!("the calibration grid has invalid runs");
+        };
+        assert_eq!(refused.runs, 32);
+        let first = format!("/runs/{}/inputs/", refused.first);
+        assert!(
+            refused.errors[0].pointer.starts_with(&first),
+            "{:?}",
+            refused.errors[0]
+        );
+        assert!(
+            refused.errors[0].detail.contains("/contact/rk = "),
+            "{:?}",
+            refused.errors[0]
+        );
+    }
+
+    #[test]
+    fn a_run_above_a_ceiling_always_refuses_the_sweep() {
+        let limits = AdmissionLimits {
+            cost: CostLimits {
+                max_work: 1.0,
+                ..CostLimits::default()
+            },
+            ..limits()
+        };
+        let valid = admit(&calibration(), &Registry::builtin(), &super::tests::limits())
+            .unwrap()
+            .runs
+            .iter()
+            .filter(|run| run.invalid.is_none())
+            .count();
+        let Err(Refusal::TooCostly { runs, exceeded }) = admit(&calibration(), &Registry::builtin(), &limits)
+        else {
+            panic!("every valid run is above a work ceiling of 1 update");
+        };
+        // Invalid runs have no estimate: the valid ones are refused, even when recorded.
+        assert_eq!((runs.refused, runs.runs, runs.first), (valid, 32, 0));
+        assert!(runs.errors.len() <= MAX_RUN_ERRORS);
+        assert!(runs.errors.iter().all(|e| e.pointer.starts_with("/runs/")));
+        assert_eq!(exceeded[0].quantity, "work");
+    }
+
+    #[test]
+    fn the_request_is_checked_before_the_process_is_looked_up() {
+        let mut body = calibration();
+        body["process"] = json!("no-such");
+        assert_eq!(
+            admit(&body, &Registry::builtin(), &limits()).unwrap_err(),
+            Refusal::NoSuchProcess("no-such".into())
+        );
+        body["samples"] = json!(3);
+        assert!(matches!(
+            admit(&body, &Registry::builtin(), &limits()),
+            Err(Refusal::Request(SweepError::Invalid(_)))
+        ));
+        let small = AdmissionLimits {
+            max_runs: 10,
+            ..limits()
+        };
+        assert_eq!(
+            admit(&calibration(), &Registry::builtin(), &small).unwrap_err(),
+            Refusal::Request(SweepError::TooLarge { runs: 32, limit: 10 })
+        );
+    }
+}
