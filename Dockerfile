@@ -10,6 +10,7 @@ WORKDIR /src
 COPY Cargo.toml Cargo.lock ./
 COPY src src
 COPY crates crates
+COPY build.rs build.rs
 COPY migrations migrations
 # The dashboard embeds the shipped examples as templates of its submit page.
 COPY examples examples
