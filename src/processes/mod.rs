@@ -69,28 +69,30 @@ pub struct History {
 impl History {
     /// CSV text with a `time,<series...>` header, full precision.
     pub fn to_csv(&self) -> String {
-        let mut out = String::with_capacity(self.time.len() * (self.series.len() + 1) * 24);
-        out.push_str("time");
-        for (name, _) in &self.series {
-            out.push(',');
-            out.push_str(name);
-        }
-        out.push('\n');
-        for (row, t) in self.time.iter().enumerate() {
-            out.push_str(&format_number(*t));
-            for (_, values) in &self.series {
-                out.push(',');
-                out.push_str(&format_number(values[row]));
-            }
-            out.push('\n');
-        }
-        out
+        columns_csv("time", &self.time, &self.series)
     }
 }
 
-/// Shortest representation that parses back to the same f64.
-fn format_number(value: f64) -> String {
-    format!("{value:e}")
+/// CSV text of a key column (`time`, `frequency`) and named series of equal length, with
+/// a `<key>,<series...>` header; each number the shortest text that reads back as the
+/// same f64.
+pub fn columns_csv(key: &str, keys: &[f64], series: &[(String, Vec<f64>)]) -> String {
+    let mut out = String::with_capacity(keys.len() * (series.len() + 1) * 24);
+    out.push_str(key);
+    for (name, _) in series {
+        out.push(',');
+        out.push_str(name);
+    }
+    out.push('\n');
+    for (row, k) in keys.iter().enumerate() {
+        out.push_str(&format!("{k:e}"));
+        for (_, values) in series {
+            out.push(',');
+            out.push_str(&format!("{:e}", values[row]));
+        }
+        out.push('\n');
+    }
+    out
 }
 
 /// What a successful run produces.

@@ -64,23 +64,7 @@ impl SpectrumTable {
 
     /// CSV text with a `frequency,<series...>` header, full precision (as histories).
     pub fn to_csv(&self) -> String {
-        let mut out = String::with_capacity(self.frequency.len() * (self.series.len() + 1) * 24);
-        out.push_str("frequency");
-        for (name, _) in &self.series {
-            out.push(',');
-            out.push_str(name);
-        }
-        out.push('\n');
-        for (row, frequency) in self.frequency.iter().enumerate() {
-            // `{:e}`: the shortest text that reads back as the same f64, as `History::to_csv`.
-            out.push_str(&format!("{frequency:e}"));
-            for (_, values) in &self.series {
-                out.push(',');
-                out.push_str(&format!("{:e}", values[row]));
-            }
-            out.push('\n');
-        }
-        out
+        crate::processes::columns_csv("frequency", &self.frequency, &self.series)
     }
 }
 
