@@ -19,6 +19,10 @@
 //! whose mechanical energy exceeds what the initial energy and the external work can
 //! supply (or stops being finite) is stopped at once with [`SimulationError::Diverged`]:
 //! no NaN ever leaves this module.
+//!
+//! A run is three things with clear owners (see `stepper`): the layout (what does not
+//! change during the run: modal coefficients, shapes, contact indexing), the state (what
+//! the step advances) and the recorder (histories, statistics, energy).
 
 use std::ops::ControlFlow;
 
@@ -29,11 +33,6 @@ use super::stability::Scheme;
 pub use super::statistics::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme};
 pub use quality::{Check, Quality, StepHalving, Verdict};
 pub use step_size::{DEFAULT_TOLERANCE, StepLimit, StepSize, critical_time_step};
-
-/// Steps between two calls of the progress callback.
-const PROGRESS_EVERY: u64 = 4096;
-/// Steps between two divergence checks.
-const DIVERGENCE_CHECK_EVERY: u64 = 32;
 
 /// The row being integrated.
 #[derive(Debug, Clone)]
@@ -158,7 +157,7 @@ pub fn simulate(
     progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
 ) -> Result<Simulation, SimulationError> {
     let step = resolve_time_step(model, settings)?;
-    integrate_on(pulp::Arch::new(), model, settings, &step, progress)
+    stepper::integrate(pulp::Arch::new(), model, settings, &step, progress)
 }
 
 /// Integrates the model and assesses the result: the check of `settings.check` (the whole
@@ -192,7 +191,7 @@ pub fn run_resolved(
         Check::StepHalving => 1.0 / 3.0,
         Check::None => 1.0,
     };
-    let simulation = integrate_on(arch, model, settings, step, &mut |f| progress(share * f))?;
+    let simulation = stepper::integrate(arch, model, settings, step, &mut |f| progress(share * f))?;
     let step_halving = match settings.check {
         Check::None => None,
         Check::StepHalving => {
@@ -203,7 +202,7 @@ pub fn run_resolved(
                 output_interval: Some(simulation.output_interval),
                 ..settings.clone()
             };
-            let check = integrate_on(arch, model, &settings, &halved, &mut |f| {
+            let check = stepper::integrate(arch, model, &settings, &halved, &mut |f| {
                 progress(share + (1.0 - share) * f)
             })?;
             Some(quality::step_halving(
@@ -236,7 +235,7 @@ fn simulate_unchecked(
             },
         )?
     };
-    integrate_on(pulp::Arch::new(), model, settings, &step, &mut |_| {
+    stepper::integrate(pulp::Arch::new(), model, settings, &step, &mut |_| {
         ControlFlow::Continue(())
     })
 }
@@ -249,7 +248,7 @@ fn simulate_on(
     settings: &Settings,
 ) -> Result<Simulation, SimulationError> {
     let step = resolve_time_step(model, settings)?;
-    integrate_on(arch, model, settings, &step, &mut |_| ControlFlow::Continue(()))
+    stepper::integrate(arch, model, settings, &step, &mut |_| ControlFlow::Continue(()))
 }
 
 /// Steps of a run and the number of steps between two history samples (cost
@@ -259,48 +258,13 @@ pub fn step_counts(duration: f64, step: &StepSize, interval: Option<f64>) -> (u6
     (step.steps(duration), step.output_every(interval))
 }
 
-/// The time loop, with the step compiled for the SIMD level `arch`.
-fn integrate_on(
-    arch: pulp::Arch,
-    model: &Model<'_>,
-    settings: &Settings,
-    step: &StepSize,
-    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
-) -> Result<Simulation, SimulationError> {
-    let mut run = Integrator::new(arch, model, settings, step);
-    let (total_steps, output_every) = step_counts(settings.duration, step, settings.output_interval);
-    let interval = step.output_interval(settings.output_interval);
-    run.record_sample(0.0);
-    let mut n = 0;
-    while n < total_steps {
-        // Steps run in batches up to the next check, sample or progress call, all in
-        // one SIMD context.
-        let next = [DIVERGENCE_CHECK_EVERY, output_every, PROGRESS_EVERY]
-            .iter()
-            .map(|every| (n / every + 1) * every)
-            .fold(total_steps, u64::min);
-        run.steps(n + 1..=next);
-        n = next;
-        if n % DIVERGENCE_CHECK_EVERY == 0 || n == total_steps {
-            run.check_divergence(n as f64 * step.time_step)?;
-        }
-        if n % output_every == 0 {
-            // Exactly k × interval, not a sum of steps.
-            run.record_sample((n / output_every) as f64 * interval);
-        }
-        if n % PROGRESS_EVERY == 0 && progress(n as f64 / total_steps as f64).is_break() {
-            return Err(SimulationError::Cancelled);
-        }
-    }
-    Ok(run.finish(total_steps, interval))
-}
-
 mod kernels;
+mod layout;
 pub mod quality;
+mod recorder;
+mod state;
 pub mod step_size;
 mod stepper;
-
-use stepper::Integrator;
 
 #[cfg(test)]
 mod tests;
