@@ -10,7 +10,7 @@ use super::bundle_inputs::{BundleInputs, ContactInput, body_json};
 use super::inputs::{self, at};
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::contact::Contact;
-use crate::physics::integrate::{Check, Model, Settings, StepSize, run_resolved, step_counts};
+use crate::physics::integrate::{Check, Model, Settings, StepSize, step_counts};
 use crate::physics::modal::ModalBasis;
 
 /// Most pins in one row.
@@ -339,7 +339,8 @@ impl Process for BundleDynamics {
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
         let Plan { prepared, step } = prepare(inputs)?;
         let model = prepared.model();
-        let assessed = run_resolved(&model, &prepared.settings, &step, progress)?;
+        let assessed =
+            crate::physics::integrate::Plan::with_step(&model, &prepared.settings, step)?.run(progress)?;
         let (simulation, quality) = (assessed.simulation, assessed.quality);
 
         let contacts: Vec<serde_json::Value> = prepared

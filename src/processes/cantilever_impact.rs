@@ -12,7 +12,7 @@ use super::inputs::{self, BeamInput, SchemeInput, SupportInput, TimeStepInput, a
 use super::{FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
-use crate::physics::integrate::{Model, Settings, StepSize, run_resolved, step_counts};
+use crate::physics::integrate::{Model, Settings, StepSize, step_counts};
 use crate::physics::modal::ModalBasis;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
@@ -423,7 +423,8 @@ impl Process for CantileverImpact {
         let Plan { prepared, step } = prepare(inputs)?;
         let model = prepared.model();
         let mut numerical_progress = |fraction: f64| progress(0.9 * fraction);
-        let assessed = run_resolved(&model, &prepared.settings, &step, &mut numerical_progress)?;
+        let assessed = crate::physics::integrate::Plan::with_step(&model, &prepared.settings, step)?
+            .run(&mut numerical_progress)?;
         let (simulation, quality) = (assessed.simulation, assessed.quality);
         let solution = prepared
             .reference

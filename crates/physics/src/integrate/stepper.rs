@@ -48,8 +48,8 @@ const PROGRESS_EVERY: u64 = 4096;
 /// Steps between two divergence checks.
 const DIVERGENCE_CHECK_EVERY: u64 = 32;
 
-/// The time loop, with the step compiled for the SIMD level `arch`, at a step already
-/// resolved.
+/// The time loop, with the step compiled for the SIMD level `arch`. The model and
+/// settings must have been checked and the step resolved ([`super::Plan`]).
 pub(super) fn integrate(
     arch: pulp::Arch,
     model: &Model<'_>,
