@@ -13,7 +13,7 @@ use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryOutput, Output, Simulation};
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::Contact;
-use crate::physics::integrate::{Model, Settings, StepSize, run_resolved};
+use crate::physics::integrate::{self, Model, Settings, StepSize};
 use crate::physics::modal::ModalBasis;
 
 /// Most pins in one row.
@@ -399,7 +399,7 @@ impl Simulation for BundleDynamics {
 
     fn run(plan: Plan, progress: &mut ProgressFn<'_>) -> Result<Output<BundleResults>, RunError> {
         let model = plan.model();
-        let assessed = run_resolved(&model, &plan.settings, &plan.step, progress)?;
+        let assessed = integrate::Plan::with_step(&model, &plan.settings, plan.step)?.run(progress)?;
         let (simulation, quality) = (assessed.simulation, assessed.quality);
 
         let contacts: Vec<ContactResult> = plan

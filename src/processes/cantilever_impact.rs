@@ -13,7 +13,7 @@ use super::simulation::{HistoryOutput, Output, Simulation};
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
-use crate::physics::integrate::{Model, Settings, StepSize, run_resolved};
+use crate::physics::integrate::{self, Model, Settings, StepSize};
 use crate::physics::modal::ModalBasis;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
@@ -440,7 +440,8 @@ impl Simulation for CantileverImpact {
     fn run(plan: Plan, progress: &mut ProgressFn<'_>) -> Result<Output<CantileverResults>, RunError> {
         let model = plan.model();
         let mut numerical_progress = |fraction: f64| progress(0.9 * fraction);
-        let assessed = run_resolved(&model, &plan.settings, &plan.step, &mut numerical_progress)?;
+        let assessed =
+            integrate::Plan::with_step(&model, &plan.settings, plan.step)?.run(&mut numerical_progress)?;
         let (simulation, quality) = (assessed.simulation, assessed.quality);
         let solution = plan
             .reference

@@ -474,13 +474,20 @@ pub fn check_output_interval(interval: Option<f64>, errors: &mut Vec<FieldError>
 }
 
 /// The step a run will use, or a 422 on `/inputs/solver/time_step` naming both values
-/// when a given step exceeds the critical one.
+/// when a given step exceeds the critical one. The processes check their inputs first:
+/// a model the physics still refuses is a 422 on the whole `/inputs`.
 pub fn resolve_step(
     model: &crate::physics::integrate::Model<'_>,
     settings: &crate::physics::integrate::Settings,
 ) -> Result<crate::physics::integrate::StepSize, InvalidInputs> {
-    crate::physics::integrate::resolve_time_step(model, settings)
-        .map_err(|e| InvalidInputs(vec![FieldError::new("/inputs/solver/time_step", e.to_string())]))
+    use crate::physics::integrate::{Plan, SimulationError};
+    Plan::new(model, settings).map(|plan| *plan.step()).map_err(|e| {
+        let field = match e {
+            SimulationError::InvalidModel(_) | SimulationError::InvalidSettings(_) => "/inputs",
+            _ => "/inputs/solver/time_step",
+        };
+        InvalidInputs(vec![FieldError::new(field, e.to_string())])
+    })
 }
 
 /// The time-stepping part of a run's [`super::WorkEstimate`]: the steps of one pass and

@@ -50,10 +50,11 @@ impl Contact {
             if let Body::Pin(p) = body
                 && p >= pins
             {
-                issues.push(InputIssue::new(
-                    field,
-                    format!("pin {p} does not exist (pins are 0..{})", pins - 1),
-                ));
+                let reason = match pins {
+                    0 => format!("pin {p} does not exist (the row has no pin)"),
+                    _ => format!("pin {p} does not exist (pins are 0..{})", pins - 1),
+                };
+                issues.push(InputIssue::new(field, reason));
             }
         }
         if self.left == self.right {

@@ -229,8 +229,8 @@ mod tests {
     use crate::beam::{BeamSpec, Support};
     use crate::contact::{Body, Contact};
     use crate::integrate::{
-        Check, DEFAULT_TOLERANCE, Model, Settings, Simulation, SimulationError, StepLimit, StepSize,
-        TimeStep, critical_time_step, run_resolved, simulate,
+        Check, DEFAULT_TOLERANCE, Model, Plan, Settings, Simulation, SimulationError, TimeStep,
+        critical_time_step, simulate,
     };
     use crate::loads::{BaseAcceleration, PointForce, Table};
     use crate::modal::ModalBasis;
@@ -448,17 +448,11 @@ mod tests {
             below.err()
         );
         let dt = 1.01 * critical;
-        // Run past the refusal: claim the step is its own critical step.
-        let unchecked = StepSize {
-            time_step: dt,
-            critical_time_step: dt,
-            max_angular_frequency: 2.0 / dt,
-            limited_by: StepLimit::Given,
-        };
-        let above = run_resolved(&corrected, &settings(dt, duration), &unchecked, &mut |_| {
-            ControlFlow::Continue(())
-        })
-        .map(|assessed| assessed.simulation);
+        // Run past the refusal.
+        let settings = settings(dt, duration);
+        let above = Plan::unchecked(&corrected, &settings, dt)
+            .and_then(|plan| plan.run(&mut |_| ControlFlow::Continue(())))
+            .map(|assessed| assessed.simulation);
         assert!(
             matches!(above, Err(SimulationError::Diverged { .. })),
             "diverges at 1.01 × critical ({critical:e} s): {:?}",

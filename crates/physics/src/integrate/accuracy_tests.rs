@@ -7,10 +7,16 @@
 //! X* = X(h/20) + (X(h/20) − X(h/10)) / 3. Nothing here is compared with a number
 //! copied from our own output.
 
+use std::ops::ControlFlow;
+
 use super::*;
 use crate::beam::{BeamSpec, Section, Support};
 use crate::contact::Body;
+use crate::contact::Contact;
+use crate::loads::BaseAcceleration;
 use crate::loads::Table;
+use crate::modal::ModalBasis;
+use crate::stability::Scheme;
 
 /// A row of identical pins between two walls.
 #[derive(Debug, Clone)]
@@ -179,7 +185,9 @@ fn run_at(model: &Model<'_>, row: &Row, time_step: TimeStep, check: Check) -> As
         check,
         ..row.settings(time_step)
     };
-    run(model, &settings, &mut |_| ControlFlow::Continue(())).expect("the run succeeds")
+    Plan::new(model, &settings)
+        .and_then(|plan| plan.run(&mut |_| ControlFlow::Continue(())))
+        .expect("the run succeeds")
 }
 
 /// The Δt → 0 limit of (peak force, peak deflection) from runs at h/10 and h/20
@@ -345,7 +353,8 @@ fn unit_slips_never_diverge_under_auto() {
             output_interval: Some(settings.duration / 1000.0),
             ..settings
         };
-        let result = run(&model, &settings, &mut |_| ControlFlow::Continue(()));
+        let result =
+            Plan::new(&model, &settings).and_then(|plan| plan.run(&mut |_| ControlFlow::Continue(())));
         let assessed = result.unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(
             assessed.quality.energy_residual.is_finite()

@@ -13,73 +13,24 @@
 //! Tchamwa–Wielgosz: qₙ₊₁ = qₙ + Δt vₙ + φΔt² aₙ, vₙ₊₁ = vₙ + Δt aₙ, and all
 //! velocity-dependent forces use that vₙ₊₁, which is exact for the scheme.
 //!
-//! A step above the critical one ([`super::stability`]) is refused before running;
-//! `auto` picks one for accuracy ([`step_size`]), and [`run`] checks the result by
-//! repeating it at half the step ([`quality`]). A run
+//! One way in: [`Plan::new`] refuses a model or settings that cannot be integrated
+//! ([`Model::validate`], [`Settings::validate`]) and a step above the critical one
+//! ([`super::stability`]); `auto` picks one for accuracy ([`step_size`]), and
+//! [`Plan::run`] checks the result by repeating it at half the step ([`quality`]). A run
 //! whose mechanical energy exceeds what the initial energy and the external work can
 //! supply (or stops being finite) is stopped at once with [`SimulationError::Diverged`]:
 //! no NaN ever leaves this module.
+//!
+//! A run is three things with clear owners (see `stepper`): the layout (what does not
+//! change during the run: modal coefficients, shapes, contact indexing), the state (what
+//! the step advances) and the recorder (histories, statistics, energy).
 
-use std::ops::ControlFlow;
-
-use super::contact::Contact;
-use super::loads::{BaseAcceleration, PointForce};
-use super::modal::ModalBasis;
-use super::stability::Scheme;
 pub use super::statistics::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme};
+use crate::InputIssue;
+pub use model::{Model, Settings, TimeStep};
+pub use plan::Plan;
 pub use quality::{Check, Quality, StepHalving, Verdict};
 pub use step_size::{DEFAULT_TOLERANCE, StepLimit, StepSize, critical_time_step};
-
-/// Steps between two calls of the progress callback.
-const PROGRESS_EVERY: u64 = 4096;
-/// Steps between two divergence checks.
-const DIVERGENCE_CHECK_EVERY: u64 = 32;
-
-/// The row being integrated.
-#[derive(Debug, Clone)]
-pub struct Model<'a> {
-    /// Modal basis shared by every pin.
-    pub basis: &'a ModalBasis,
-    /// Number of pins (≥ 1).
-    pub pins: usize,
-    /// Modal damping ratio ξᵢ of each mode (length = modes).
-    pub damping_ratios: Vec<f64>,
-    pub contacts: Vec<Contact>,
-    /// Release of each pin from its static tip-load shape with this tip deflection (m);
-    /// empty means all at rest.
-    pub initial_tip_displacements: Vec<f64>,
-    pub base_acceleration: Option<BaseAcceleration>,
-    pub point_forces: Vec<PointForce>,
-}
-
-/// Time step choice.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum TimeStep {
-    /// This step (s); refused when above the critical step.
-    Fixed(f64),
-    /// Chosen for accuracy within stability ([`step_size`]).
-    Auto,
-}
-
-/// Integration settings.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Settings {
-    pub scheme: Scheme,
-    pub time_step: TimeStep,
-    /// Relative accuracy target of `auto` and of the quality verdict, in (0, 1)
-    /// ([`DEFAULT_TOLERANCE`]).
-    pub tolerance: f64,
-    /// The accuracy check run with [`run`] ([`simulate`] runs none).
-    pub check: Check,
-    /// Simulated duration (s).
-    pub duration: f64,
-    /// Time between two history samples (s), rounded to a whole number of steps (which
-    /// `auto` makes exact); `None` samples every step. Samples are at t = k·interval ≤
-    /// duration.
-    pub output_interval: Option<f64>,
-    /// Heights (m) where every pin's deflection is recorded.
-    pub output_heights: Vec<f64>,
-}
 
 /// Why a run produced no result.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -99,8 +50,21 @@ pub enum SimulationError {
         time_step: f64,
         critical_time_step: f64,
     },
+    #[error("the model cannot be integrated: {}", describe(.0))]
+    InvalidModel(Vec<InputIssue>),
+    #[error("the integration settings are invalid: {}", describe(.0))]
+    InvalidSettings(Vec<InputIssue>),
     #[error("cancelled")]
     Cancelled,
+}
+
+/// `field: reason; field: reason`.
+fn describe(issues: &[InputIssue]) -> String {
+    issues
+        .iter()
+        .map(|i| format!("{}: {}", i.field, i.reason))
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// Everything a run produces.
@@ -144,114 +108,6 @@ pub struct Assessed {
     pub quality: Quality,
 }
 
-/// The step a run will use, or why it cannot run.
-pub fn resolve_time_step(model: &Model<'_>, settings: &Settings) -> Result<StepSize, SimulationError> {
-    step_size::resolve(model, settings)
-}
-
-/// Integrates the model once, with no accuracy check. `progress` is called every few
-/// thousand steps with the fraction done; `ControlFlow::Break` stops the run with
-/// [`SimulationError::Cancelled`].
-pub fn simulate(
-    model: &Model<'_>,
-    settings: &Settings,
-    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
-) -> Result<Simulation, SimulationError> {
-    let step = resolve_time_step(model, settings)?;
-    integrate_on(pulp::Arch::new(), model, settings, &step, progress)
-}
-
-/// Integrates the model and assesses the result: the check of `settings.check` (the whole
-/// run again at Δt/2 for step halving), then the verdict ([`quality`]).
-pub fn run(
-    model: &Model<'_>,
-    settings: &Settings,
-    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
-) -> Result<Assessed, SimulationError> {
-    let step = resolve_time_step(model, settings)?;
-    run_resolved(model, settings, &step, progress)
-}
-
-/// [`run`] with a step already resolved by [`resolve_time_step`] (callers that validated
-/// the step first need not solve the stability eigenproblem twice).
-pub fn run_resolved(
-    model: &Model<'_>,
-    settings: &Settings,
-    step: &StepSize,
-    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
-) -> Result<Assessed, SimulationError> {
-    if step.time_step > step.critical_time_step * (1.0 + 1e-12) {
-        return Err(SimulationError::TimeStepAboveCritical {
-            time_step: step.time_step,
-            critical_time_step: step.critical_time_step,
-        });
-    }
-    let arch = pulp::Arch::new();
-    // The check takes twice the steps of the run: a third of the progress for the run.
-    let share = match settings.check {
-        Check::StepHalving => 1.0 / 3.0,
-        Check::None => 1.0,
-    };
-    let simulation = integrate_on(arch, model, settings, step, &mut |f| progress(share * f))?;
-    let step_halving = match settings.check {
-        Check::None => None,
-        Check::StepHalving => {
-            let started = std::time::Instant::now();
-            let halved = step.halved();
-            // The same samples, so that the repeated run costs no more memory per step.
-            let settings = Settings {
-                output_interval: Some(simulation.output_interval),
-                ..settings.clone()
-            };
-            let check = integrate_on(arch, model, &settings, &halved, &mut |f| {
-                progress(share + (1.0 - share) * f)
-            })?;
-            Some(quality::step_halving(
-                settings.scheme,
-                step,
-                quality::KeyFigures::of(&simulation),
-                quality::KeyFigures::of(&check),
-                (check.steps, simulation.steps, started.elapsed().as_secs_f64()),
-            ))
-        }
-    };
-    let quality = quality::assess(&simulation, step, settings.tolerance, step_halving);
-    Ok(Assessed { simulation, quality })
-}
-
-/// Runs with step `dt` whatever the critical step (tests probe instability with it).
-#[cfg(test)]
-fn simulate_unchecked(
-    model: &Model<'_>,
-    settings: &Settings,
-    dt: f64,
-) -> Result<Simulation, SimulationError> {
-    let step = StepSize {
-        time_step: dt,
-        ..resolve_time_step(
-            model,
-            &Settings {
-                time_step: TimeStep::Auto,
-                ..settings.clone()
-            },
-        )?
-    };
-    integrate_on(pulp::Arch::new(), model, settings, &step, &mut |_| {
-        ControlFlow::Continue(())
-    })
-}
-
-/// [`simulate`] at the SIMD level `arch` (tests compare the vector and scalar layouts).
-#[cfg(test)]
-fn simulate_on(
-    arch: pulp::Arch,
-    model: &Model<'_>,
-    settings: &Settings,
-) -> Result<Simulation, SimulationError> {
-    let step = resolve_time_step(model, settings)?;
-    integrate_on(arch, model, settings, &step, &mut |_| ControlFlow::Continue(()))
-}
-
 /// Steps of a run and the number of steps between two history samples (cost
 /// estimates): (⌊duration/Δt⌋ (never past the duration), round(interval/Δt) or 1 without
 /// an interval). A run records `steps / every + 1` samples.
@@ -259,48 +115,25 @@ pub fn step_counts(duration: f64, step: &StepSize, interval: Option<f64>) -> (u6
     (step.steps(duration), step.output_every(interval))
 }
 
-/// The time loop, with the step compiled for the SIMD level `arch`.
-fn integrate_on(
-    arch: pulp::Arch,
+/// [`Plan::new`] then [`Plan::run`], the simulation alone (the tests' shorthand).
+#[cfg(test)]
+pub(crate) fn simulate(
     model: &Model<'_>,
     settings: &Settings,
-    step: &StepSize,
-    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+    progress: &mut dyn FnMut(f64) -> std::ops::ControlFlow<()>,
 ) -> Result<Simulation, SimulationError> {
-    let mut run = Integrator::new(arch, model, settings, step);
-    let (total_steps, output_every) = step_counts(settings.duration, step, settings.output_interval);
-    let interval = step.output_interval(settings.output_interval);
-    run.record_sample(0.0);
-    let mut n = 0;
-    while n < total_steps {
-        // Steps run in batches up to the next check, sample or progress call, all in
-        // one SIMD context.
-        let next = [DIVERGENCE_CHECK_EVERY, output_every, PROGRESS_EVERY]
-            .iter()
-            .map(|every| (n / every + 1) * every)
-            .fold(total_steps, u64::min);
-        run.steps(n + 1..=next);
-        n = next;
-        if n % DIVERGENCE_CHECK_EVERY == 0 || n == total_steps {
-            run.check_divergence(n as f64 * step.time_step)?;
-        }
-        if n % output_every == 0 {
-            // Exactly k × interval, not a sum of steps.
-            run.record_sample((n / output_every) as f64 * interval);
-        }
-        if n % PROGRESS_EVERY == 0 && progress(n as f64 / total_steps as f64).is_break() {
-            return Err(SimulationError::Cancelled);
-        }
-    }
-    Ok(run.finish(total_steps, interval))
+    Ok(Plan::new(model, settings)?.run(progress)?.simulation)
 }
 
 mod kernels;
+mod layout;
+mod model;
+mod plan;
 pub mod quality;
+mod recorder;
+mod state;
 pub mod step_size;
 mod stepper;
-
-use stepper::Integrator;
 
 #[cfg(test)]
 mod tests;

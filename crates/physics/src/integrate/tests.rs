@@ -2,10 +2,16 @@
 //! analytic contact duration, convergence orders, the critical step against brute
 //! force, and the energy balance of a damped, excited multi-contact row.
 
+use std::ops::ControlFlow;
+
 use super::*;
 use crate::beam::tests::default_tube;
 use crate::contact::Body;
+use crate::contact::Contact;
 use crate::loads::Table;
+use crate::loads::{BaseAcceleration, PointForce};
+use crate::modal::ModalBasis;
+use crate::stability::Scheme;
 
 fn basis(elements: usize, modes: usize) -> ModalBasis {
     ModalBasis::compute(&default_tube(elements), modes).expect("valid beam")
@@ -204,7 +210,9 @@ fn critical_step_matches_brute_force_divergence() {
     let mut below = settings(Scheme::CentralDifference, 0.99 * critical, 2000.0 * critical);
     let stable = simulate(&model, &below, &mut |_| ControlFlow::Continue(()));
     assert!(stable.is_ok(), "stable below critical: {:?}", stable.err());
-    let above = simulate_unchecked(&model, &below, 1.01 * critical);
+    let above = Plan::unchecked(&model, &below, 1.01 * critical)
+        .and_then(|plan| plan.run(&mut |_| ControlFlow::Continue(())))
+        .map(|assessed| assessed.simulation);
     let Err(diverged @ SimulationError::Diverged { .. }) = above else {
         panic!("diverges above critical: {:?}", above.map(|s| s.energy));
     };
@@ -323,8 +331,10 @@ fn this_cpus_simd_level_and_the_scalar_fallback_agree() {
                 output_interval: Some(1e-4),
                 ..settings(scheme, 0.0, duration)
             };
-            let scalar = simulate_on(pulp::Arch::Scalar, &model, &settings).expect("scalar run");
-            let simd = simulate_on(pulp::Arch::new(), &model, &settings).expect("SIMD run");
+            let plan = Plan::new(&model, &settings).expect("a valid model");
+            let on = |arch| plan.run_on(arch, &mut |_| ControlFlow::Continue(()));
+            let scalar = on(pulp::Arch::Scalar).expect("scalar run").simulation;
+            let simd = on(pulp::Arch::new()).expect("SIMD run").simulation;
             let impacts: u64 = scalar.contact_statistics.iter().map(|s| s.impacts).sum();
             assert!(impacts > 2, "the case must exercise contacts: {impacts} impacts");
             let agree = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-9 * scale;

@@ -1,0 +1,238 @@
+//! What does not change during a run: the modal coefficients for the step, the shapes at
+//! the contact levels, output heights, point forces and nodes, and how the contacts are
+//! indexed (by lanes of the block-major level deflections, [`ContactLanes`]).
+//!
+//! Layout of the arrays the step runs on: pin-major. Each pin's modal coordinates are one
+//! contiguous row of `row` values (the modes rounded up to whole SIMD vectors; padded
+//! modes have ω = 0, Γ = 0, ψ = 0 and stay 0). A closed contact then reads and writes
+//! whole rows: its dashpot velocity ψ·ṽ is one contiguous dot product and its force
+//! projection one contiguous axpy. The deflections at the contact levels are block-major
+//! (a vector holds one pin's deflections at `lanes` consecutive levels, with a wall slot
+//! on each side: `[wall, pin 0, …, pin n−1, wall]`), and every per-contact array of the
+//! step is stored by lane and mapped back to contact order for samples and results.
+
+use super::kernels::{ContactLanes, Lanes, LevelShapes};
+use super::{Model, Settings, StepSize};
+use crate::contact::Body;
+use crate::stability::Scheme;
+
+/// The fixed data of one run at one step, for one SIMD level.
+pub(super) struct Layout<'m> {
+    pub model: &'m Model<'m>,
+    pub scheme: Scheme,
+    /// Δt (s), and the step it comes from (its critical step for the messages).
+    pub dt: f64,
+    pub step: StepSize,
+    /// f64 values per SIMD vector of the run's `pulp::Arch`.
+    pub lanes: usize,
+    /// Length of one pin's row: the modes rounded up to whole vectors.
+    pub row: usize,
+    /// Slots per block of the block-major deflections: `[wall, pin 0, …, pin n−1, wall]`.
+    pub stride: usize,
+    /// Per mode (padded to `row`): ωᵢ², 2ξᵢωᵢ, and for central difference 1/(1 + ξᵢωᵢΔt).
+    pub omega_squared: Vec<f64>,
+    pub damping: Vec<f64>,
+    pub implicit_damping_factor: Vec<f64>,
+    /// Γᵢ, padded to `row`.
+    pub participation: Vec<f64>,
+    /// The dashpots see ṽ = v + `dashpot_lookahead` · a right after the first half of
+    /// the update: ½Δt for central difference (ṽ = v½ + ½Δt aₙ), 0 for Tchamwa.
+    pub dashpot_lookahead: f64,
+    /// ψ at each distinct contact height (`levels × row`), and by blocks of levels for
+    /// [`super::kernels::level_deflections`].
+    pub level_shapes: Vec<f64>,
+    pub grouped_level_shapes: LevelShapes,
+    /// The contacts by lanes of the level deflections.
+    pub contacts: ContactLanes,
+    /// Per lane: what a closed contact needs, and the gap (∞ in empty lanes).
+    pub lane_contacts: Vec<LaneContact>,
+    pub gaps: Vec<f64>,
+    /// Offset (in vectors) of the row of zeros after the pins' rows in `v` and `a`,
+    /// read for a wall.
+    pub wall_row: usize,
+    /// ψ at each point force's height (padded to `row`).
+    pub point_force_shapes: Vec<Vec<f64>>,
+    /// Where pin 0's deflection at each output height is in the level deflections
+    /// (output heights that are no contact level are levels with no contact).
+    pub output_offsets: Vec<usize>,
+    /// Nodal deflection of each mode, for the pin extremes.
+    pub node_shapes: LevelShapes,
+    /// Created energy allowed per joule involved before declaring divergence
+    /// (see [`super::stepper`]'s divergence check).
+    pub divergence_allowance: f64,
+}
+
+/// A contact as its lane needs it; offsets are in SIMD vectors.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct LaneContact {
+    pub stiffness: f64,
+    pub dashpot: f64,
+    /// Offset of ψ at the contact's level in `level_shapes`.
+    pub shape: usize,
+    /// Offsets of the left and right body's rows in the state (`wall_row` for a wall).
+    pub left: usize,
+    pub right: usize,
+    /// Whether it can push at all (stiffness or dashpot > 0): only those count impacts.
+    pub active: bool,
+}
+
+/// `values` followed by `fill` up to `row`.
+fn padded(values: &[f64], row: usize, fill: f64) -> Vec<f64> {
+    let mut out = values.to_vec();
+    out.resize(row, fill);
+    out
+}
+
+/// Index of `value` in `levels`, appended if new.
+fn level_of(levels: &mut Vec<f64>, value: f64) -> usize {
+    match levels.iter().position(|h| *h == value) {
+        Some(level) => level,
+        None => {
+            levels.push(value);
+            levels.len() - 1
+        }
+    }
+}
+
+impl<'m> Layout<'m> {
+    /// The layout of `model` run with `settings` at `step`, for the SIMD level `arch`.
+    pub fn new(arch: pulp::Arch, model: &'m Model<'m>, settings: &Settings, step: &StepSize) -> Self {
+        let (dt, critical) = (step.time_step, step.critical_time_step);
+        let lanes = arch.dispatch(Lanes);
+        let basis = model.basis;
+        let (pins, modes) = (model.pins, basis.modes());
+        let row = modes.div_ceil(lanes) * lanes;
+        let omega = basis.angular_frequencies();
+        let damping: Vec<f64> = omega
+            .iter()
+            .zip(&model.damping_ratios)
+            .map(|(w, xi)| 2.0 * xi * w)
+            .collect();
+
+        let mut heights: Vec<f64> = Vec::new();
+        let contact_level: Vec<usize> = model
+            .contacts
+            .iter()
+            .map(|c| level_of(&mut heights, c.height))
+            .collect();
+        // The output heights are levels too (with no contact unless one is there).
+        let output_levels: Vec<usize> = settings
+            .output_heights
+            .iter()
+            .map(|h| level_of(&mut heights, *h))
+            .collect();
+        let shape_at = |height: f64| padded(&basis.deflection_at(height), row, 0.0);
+        let nodes = basis.model().elements + 1;
+        let contacts = &model.contacts;
+        // Offsets in vectors of one row of `row` values; a wall reads the row of zeros
+        // after the pins' rows.
+        let vectors = row / lanes;
+        let state_row = |body: Body| match body {
+            Body::Wall => vectors * pins,
+            Body::Pin(pin) => vectors * pin,
+        };
+        // A wall on the left reads the zero slot before the first pin, on the right the one
+        // after the last.
+        let stride = pins + 2;
+        let slot = |body: Body, wall: usize| match body {
+            Body::Wall => wall,
+            Body::Pin(pin) => 1 + pin,
+        };
+        let contact_lanes = ContactLanes::new(
+            contacts.iter().enumerate().map(|(c, contact)| {
+                (
+                    contact_level[c],
+                    slot(contact.left, 0),
+                    slot(contact.right, pins + 1),
+                )
+            }),
+            lanes,
+            stride,
+        );
+        let level_shapes: Vec<f64> = heights.iter().flat_map(|h| shape_at(*h)).collect();
+        let grouped_level_shapes = LevelShapes::new(&level_shapes, row, lanes);
+        let node_shapes = LevelShapes::new(
+            &(0..nodes)
+                .flat_map(|n| (0..row).map(move |i| if i < modes { basis.shape(i)[2 * n] } else { 0.0 }))
+                .collect::<Vec<_>>(),
+            row,
+            lanes,
+        );
+        let r2 = (dt / critical).powi(2);
+        Self {
+            model,
+            scheme: settings.scheme,
+            dt,
+            step: *step,
+            lanes,
+            row,
+            stride,
+            omega_squared: padded(&omega.iter().map(|w| w * w).collect::<Vec<_>>(), row, 0.0),
+            implicit_damping_factor: padded(
+                &damping
+                    .iter()
+                    .map(|c| match settings.scheme {
+                        Scheme::CentralDifference => 1.0 / (1.0 + 0.5 * c * dt),
+                        Scheme::Tchamwa { .. } => 1.0,
+                    })
+                    .collect::<Vec<_>>(),
+                row,
+                1.0,
+            ),
+            damping: padded(&damping, row, 0.0),
+            participation: padded(basis.participation(), row, 0.0),
+            dashpot_lookahead: match settings.scheme {
+                Scheme::CentralDifference => 0.5 * dt,
+                Scheme::Tchamwa { .. } => 0.0,
+            },
+            level_shapes,
+            grouped_level_shapes,
+            lane_contacts: contact_lanes.by_lane(
+                &contacts
+                    .iter()
+                    .enumerate()
+                    .map(|(c, contact)| LaneContact {
+                        stiffness: contact.stiffness,
+                        dashpot: contact.damping,
+                        shape: vectors * contact_level[c],
+                        left: state_row(contact.left),
+                        right: state_row(contact.right),
+                        active: contact.stiffness > 0.0 || contact.damping > 0.0,
+                    })
+                    .collect::<Vec<_>>(),
+                LaneContact::default(),
+            ),
+            wall_row: state_row(Body::Wall),
+            gaps: contact_lanes.by_lane(&contacts.iter().map(|c| c.gap).collect::<Vec<_>>(), f64::INFINITY),
+            contacts: contact_lanes,
+            point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
+            output_offsets: output_levels
+                .iter()
+                .map(|level| Self::level_offset(lanes, stride, *level))
+                .collect(),
+            node_shapes,
+            divergence_allowance: if r2 < 1.0 { 2.0 / (1.0 - r2) } else { 1.0 },
+        }
+    }
+
+    /// Index in the level deflections of pin 0 at `level` (block-major, the walls in
+    /// slots 0 and pins + 1); pin p is `lanes` × p further.
+    fn level_offset(lanes: usize, stride: usize, level: usize) -> usize {
+        ((level / lanes) * stride + 1) * lanes + level % lanes
+    }
+
+    /// Number of lanes of the per-lane contact arrays.
+    pub fn contact_lanes(&self) -> usize {
+        self.contacts.len()
+    }
+
+    /// Length of a block-major array of the pins' deflections at every level.
+    pub fn level_deflections_len(&self) -> usize {
+        self.grouped_level_shapes.blocks * self.stride * self.lanes
+    }
+
+    /// Length of a block-major array of the pins' deflections at every node.
+    pub fn node_deflections_len(&self) -> usize {
+        self.node_shapes.blocks * self.stride * self.lanes
+    }
+}

@@ -1,0 +1,419 @@
+//! What a run integrates ([`Model`]) and how ([`Settings`]), and every check on them that
+//! must pass before the time loop may start: an invalid model is refused with the
+//! offending fields named, never integrated into NaN or an index out of bounds.
+//!
+//! Field paths are slash paths relative to the checked struct (`contacts/3/right`,
+//! `point_forces/0/height`, `output_heights/1`), as everywhere in this crate.
+
+use crate::contact::Contact;
+use crate::loads::{BaseAcceleration, PointForce};
+use crate::modal::ModalBasis;
+use crate::stability::Scheme;
+use crate::{InputIssue, require_non_negative, require_positive};
+
+use super::quality::Check;
+
+/// The row being integrated.
+#[derive(Debug, Clone)]
+pub struct Model<'a> {
+    /// Modal basis shared by every pin.
+    pub basis: &'a ModalBasis,
+    /// Number of pins (≥ 1).
+    pub pins: usize,
+    /// Modal damping ratio ξᵢ of each mode (length = modes).
+    pub damping_ratios: Vec<f64>,
+    pub contacts: Vec<Contact>,
+    /// Release of each pin from its static tip-load shape with this tip deflection (m);
+    /// empty means all at rest.
+    pub initial_tip_displacements: Vec<f64>,
+    pub base_acceleration: Option<BaseAcceleration>,
+    pub point_forces: Vec<PointForce>,
+}
+
+impl Model<'_> {
+    /// Every problem that keeps this model from being integrated (empty when it can run):
+    /// at least one pin; one finite, non-negative damping ratio per mode of the basis;
+    /// contacts between existing, different bodies, within the pin, with valid gap,
+    /// stiffness and damping ([`Contact::validate`]); one finite initial tip deflection
+    /// per pin or none, and none but zeros without a free top (no tip-load shape to
+    /// release from); a valid excitation; point forces on existing pins, within the pin,
+    /// with valid tables.
+    pub fn validate(&self) -> Vec<InputIssue> {
+        let mut issues = Vec::new();
+        let (pins, modes, length) = (self.pins, self.basis.modes(), self.basis.length());
+        if pins == 0 {
+            issues.push(InputIssue::new("pins", "a row needs at least one pin"));
+        }
+        if self.damping_ratios.len() != modes {
+            issues.push(InputIssue::new(
+                "damping_ratios",
+                format!(
+                    "needs one ratio per mode of the basis ({modes}), got {}",
+                    self.damping_ratios.len()
+                ),
+            ));
+        }
+        for (i, xi) in self.damping_ratios.iter().enumerate() {
+            require_non_negative(&mut issues, &format!("damping_ratios/{i}"), *xi);
+        }
+        for (k, contact) in self.contacts.iter().enumerate() {
+            let prefix = format!("contacts/{k}");
+            issues.extend(
+                contact
+                    .validate(pins, length)
+                    .into_iter()
+                    .map(|i| i.within(&prefix)),
+            );
+        }
+        self.validate_release(&mut issues);
+        if let Some(base) = &self.base_acceleration {
+            issues.extend(base.validate().into_iter().map(|i| i.within("base_acceleration")));
+        }
+        for (k, point) in self.point_forces.iter().enumerate() {
+            let prefix = format!("point_forces/{k}");
+            if point.pin >= pins {
+                issues.push(InputIssue::new(
+                    format!("{prefix}/pin"),
+                    format!("pin {} does not exist (the row has {pins})", point.pin),
+                ));
+            }
+            if !(point.height.is_finite() && (0.0..=length).contains(&point.height)) {
+                issues.push(InputIssue::new(
+                    format!("{prefix}/height"),
+                    format!("must be within the pin, 0 to {length} m"),
+                ));
+            }
+            issues.extend(
+                point
+                    .force
+                    .validate("force")
+                    .into_iter()
+                    .map(|i| i.within(&prefix)),
+            );
+        }
+        issues
+    }
+
+    fn validate_release(&self, issues: &mut Vec<InputIssue>) {
+        let tips = &self.initial_tip_displacements;
+        if !tips.is_empty() && tips.len() != self.pins {
+            issues.push(InputIssue::new(
+                "initial_tip_displacements",
+                format!(
+                    "needs one value per pin ({}) or none, got {}",
+                    self.pins,
+                    tips.len()
+                ),
+            ));
+        }
+        for (p, tip) in tips.iter().enumerate() {
+            if !tip.is_finite() {
+                issues.push(InputIssue::new(
+                    format!("initial_tip_displacements/{p}"),
+                    "must be a finite number",
+                ));
+            }
+        }
+        if tips.iter().any(|t| *t != 0.0) && self.basis.unit_tip_release().is_none() {
+            issues.push(InputIssue::new(
+                "initial_tip_displacements",
+                "a tip release needs a free top (the basis has no tip-load shape)",
+            ));
+        }
+    }
+}
+
+/// Time step choice.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TimeStep {
+    /// This step (s); refused when above the critical step.
+    Fixed(f64),
+    /// Chosen for accuracy within stability ([`super::step_size`]).
+    Auto,
+}
+
+/// Integration settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    pub scheme: Scheme,
+    pub time_step: TimeStep,
+    /// Relative accuracy target of `auto` and of the quality verdict, in (0, 1)
+    /// ([`super::DEFAULT_TOLERANCE`]).
+    pub tolerance: f64,
+    /// The accuracy check [`super::Plan::run`] performs after the run.
+    pub check: Check,
+    /// Simulated duration (s).
+    pub duration: f64,
+    /// Time between two history samples (s), rounded to a whole number of steps (which
+    /// `auto` makes exact); `None` samples every step. Samples are at t = k·interval ≤
+    /// duration.
+    pub output_interval: Option<f64>,
+    /// Heights (m) where every pin's deflection is recorded.
+    pub output_heights: Vec<f64>,
+}
+
+impl Settings {
+    /// Every problem with these settings for pins of `length` (m): φ ≥ 1 for
+    /// Tchamwa–Wielgosz, a positive step, duration and output interval, a tolerance in
+    /// (0, 1), output heights within the pin.
+    pub fn validate(&self, length: f64) -> Vec<InputIssue> {
+        let mut issues = Vec::new();
+        if let Scheme::Tchamwa { phi } = self.scheme
+            && !(phi.is_finite() && phi >= 1.0)
+        {
+            issues.push(InputIssue::new(
+                "scheme/phi",
+                format!("must be at least 1 (got {phi})"),
+            ));
+        }
+        if let TimeStep::Fixed(dt) = self.time_step {
+            require_positive(&mut issues, "time_step", dt);
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance < 1.0) {
+            issues.push(InputIssue::new(
+                "tolerance",
+                format!("must be between 0 and 1, both excluded (got {})", self.tolerance),
+            ));
+        }
+        require_positive(&mut issues, "duration", self.duration);
+        if let Some(interval) = self.output_interval {
+            require_positive(&mut issues, "output_interval", interval);
+        }
+        for (k, h) in self.output_heights.iter().enumerate() {
+            if !(h.is_finite() && (0.0..=length).contains(h)) {
+                issues.push(InputIssue::new(
+                    format!("output_heights/{k}"),
+                    format!("must be within the pin, 0 to {length} m"),
+                ));
+            }
+        }
+        issues
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::ops::ControlFlow;
+
+    use super::*;
+    use crate::beam::tests::default_tube;
+    use crate::beam::{BeamSpec, Support};
+    use crate::contact::Body;
+    use crate::integrate::{DEFAULT_TOLERANCE, Plan, SimulationError, StepSize};
+    use crate::loads::Table;
+
+    fn basis() -> ModalBasis {
+        ModalBasis::compute(&default_tube(10), 4).expect("valid beam")
+    }
+
+    /// Two pins of 1 m between the walls, a contact at each level, every field valid.
+    fn row(basis: &ModalBasis) -> Model<'_> {
+        let contact = |left, right, height| Contact {
+            left,
+            right,
+            height,
+            gap: 1e-4,
+            stiffness: 1e4,
+            damping: 0.5,
+        };
+        Model {
+            basis,
+            pins: 2,
+            damping_ratios: vec![0.01; basis.modes()],
+            contacts: vec![
+                contact(Body::Wall, Body::Pin(0), 1.0),
+                contact(Body::Pin(0), Body::Pin(1), 1.0),
+                contact(Body::Pin(1), Body::Wall, 0.5),
+            ],
+            initial_tip_displacements: vec![1e-3, 0.0],
+            base_acceleration: Some(BaseAcceleration::HalfSine {
+                amplitude: 5.0,
+                duration: 0.01,
+            }),
+            point_forces: vec![PointForce {
+                pin: 1,
+                height: 0.7,
+                force: Table {
+                    time: vec![0.0, 0.01],
+                    values: vec![0.0, 1.0],
+                },
+            }],
+        }
+    }
+
+    fn settings() -> Settings {
+        Settings {
+            scheme: Scheme::CentralDifference,
+            time_step: TimeStep::Auto,
+            tolerance: DEFAULT_TOLERANCE,
+            check: Check::None,
+            duration: 0.02,
+            output_interval: Some(1e-3),
+            output_heights: vec![1.0, 0.5],
+        }
+    }
+
+    fn fields(issues: Vec<InputIssue>) -> Vec<String> {
+        issues.into_iter().map(|i| i.field).collect()
+    }
+
+    #[test]
+    fn a_valid_model_and_settings_have_no_issue() {
+        let basis = basis();
+        assert_eq!(row(&basis).validate(), vec![]);
+        assert_eq!(settings().validate(basis.length()), vec![]);
+    }
+
+    /// Every check names its field relative to the model, in the model's order.
+    #[test]
+    fn every_problem_of_a_model_is_named_by_its_path() {
+        let basis = basis();
+        let mut model = row(&basis);
+        model.damping_ratios = vec![0.01, f64::NAN, -0.1];
+        model.contacts[0].right = Body::Pin(2);
+        model.contacts[1].height = 1.5;
+        model.contacts[2].stiffness = -1.0;
+        model.initial_tip_displacements = vec![f64::INFINITY, 0.0, 1e-3];
+        model.base_acceleration = Some(BaseAcceleration::HalfSine {
+            amplitude: 5.0,
+            duration: 0.0,
+        });
+        model.point_forces[0].pin = 2;
+        model.point_forces[0].height = -0.1;
+        model.point_forces[0].force.time = vec![0.0, 0.0];
+        assert_eq!(
+            fields(model.validate()),
+            [
+                "damping_ratios",
+                "damping_ratios/1",
+                "damping_ratios/2",
+                "contacts/0/right",
+                "contacts/1/height",
+                "contacts/2/stiffness",
+                "initial_tip_displacements",
+                "initial_tip_displacements/0",
+                "base_acceleration/duration",
+                "point_forces/0/pin",
+                "point_forces/0/height",
+                "point_forces/0/time/1",
+            ]
+        );
+    }
+
+    #[test]
+    fn a_row_without_pins_is_refused_without_underflow() {
+        let basis = basis();
+        let mut model = row(&basis);
+        model.pins = 0;
+        model.initial_tip_displacements.clear();
+        let fields = fields(model.validate());
+        assert_eq!(fields[0], "pins", "{fields:?}");
+        assert!(fields.contains(&"contacts/0/right".to_owned()), "{fields:?}");
+    }
+
+    /// A clamped top has no tip-load shape: a release from it would be silently dropped.
+    #[test]
+    fn a_tip_release_needs_a_free_top() {
+        let clamped = BeamSpec {
+            top: Support::Clamped,
+            ..default_tube(10)
+        };
+        let basis = ModalBasis::compute(&clamped, 3).expect("valid beam");
+        let mut model = row(&basis);
+        assert_eq!(fields(model.validate()), ["initial_tip_displacements"]);
+        model.initial_tip_displacements = vec![0.0, 0.0];
+        assert_eq!(model.validate(), vec![]);
+    }
+
+    #[test]
+    fn every_problem_of_the_settings_is_named_by_its_path() {
+        let settings = Settings {
+            scheme: Scheme::Tchamwa { phi: 0.9 },
+            time_step: TimeStep::Fixed(0.0),
+            tolerance: 1.0,
+            check: Check::None,
+            duration: f64::NAN,
+            output_interval: Some(-1.0),
+            output_heights: vec![0.5, 1.2],
+        };
+        assert_eq!(
+            fields(settings.validate(1.0)),
+            [
+                "scheme/phi",
+                "time_step",
+                "tolerance",
+                "duration",
+                "output_interval",
+                "output_heights/1",
+            ]
+        );
+    }
+
+    /// The entry point refuses an invalid model before anything indexes a pin that does
+    /// not exist (the stability analysis would panic) or integrates a NaN.
+    #[test]
+    fn an_invalid_model_is_refused_by_the_plan_not_integrated() {
+        let basis = basis();
+        let settings = settings();
+        let mut model = row(&basis);
+        model.contacts[1].right = Body::Pin(7);
+        let Err(SimulationError::InvalidModel(issues)) = Plan::new(&model, &settings) else {
+            panic!("a contact with pin 7 of 2 must be refused");
+        };
+        assert_eq!(fields(issues), ["contacts/1/right"]);
+
+        let mut model = row(&basis);
+        model.initial_tip_displacements[1] = f64::NAN;
+        let step = *Plan::new(&row(&basis), &settings).expect("valid").step();
+        let refused = Plan::with_step(&model, &settings, step).map(|plan| *plan.step());
+        assert!(
+            matches!(&refused, Err(SimulationError::InvalidModel(issues)) if issues[0].field == "initial_tip_displacements/1"),
+            "{refused:?}"
+        );
+        assert!(
+            refused
+                .unwrap_err()
+                .to_string()
+                .contains("initial_tip_displacements/1: must be a finite number"),
+            "the message names the field"
+        );
+
+        let bad_settings = Settings {
+            duration: -1.0,
+            ..settings.clone()
+        };
+        let refused = Plan::new(&row(&basis), &bad_settings).map(|plan| *plan.step());
+        assert!(
+            matches!(&refused, Err(SimulationError::InvalidSettings(issues)) if issues[0].field == "duration"),
+            "{refused:?}"
+        );
+    }
+
+    /// A step resolved earlier is refused above its critical step, and runs below it.
+    #[test]
+    fn a_plan_with_a_given_step_checks_it_against_its_critical_step() {
+        let basis = basis();
+        let (model, settings) = (row(&basis), settings());
+        let step = *Plan::new(&model, &settings).expect("valid").step();
+        let above = StepSize {
+            time_step: 1.5 * step.critical_time_step,
+            ..step
+        };
+        assert!(matches!(
+            Plan::with_step(&model, &settings, above),
+            Err(SimulationError::TimeStepAboveCritical { .. })
+        ));
+        let zero = StepSize {
+            time_step: 0.0,
+            ..step
+        };
+        assert!(matches!(
+            Plan::with_step(&model, &settings, zero),
+            Err(SimulationError::InvalidSettings(_))
+        ));
+        let run = Plan::with_step(&model, &settings, step)
+            .and_then(|plan| plan.run(&mut |_| ControlFlow::Continue(())))
+            .expect("runs");
+        assert_eq!(run.simulation.step, step);
+    }
+}

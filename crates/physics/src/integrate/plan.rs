@@ -1,0 +1,151 @@
+//! The one way into the time loop. [`Plan::new`] checks the model and the settings
+//! ([`Model::validate`], [`Settings::validate`]) and resolves the step
+//! ([`super::step_size`]); [`Plan::run`] integrates and assesses the result
+//! ([`super::quality`]): the run, the check `settings.check` asks for, the verdict.
+
+use std::ops::ControlFlow;
+
+use super::quality::{self, Check};
+use super::{Assessed, Model, Settings, SimulationError, StepSize, step_size, stepper};
+use crate::InputIssue;
+
+/// A checked model, its settings and the step it runs with.
+#[derive(Debug, Clone, Copy)]
+pub struct Plan<'a> {
+    model: &'a Model<'a>,
+    settings: &'a Settings,
+    step: StepSize,
+}
+
+impl<'a> Plan<'a> {
+    /// Checks `model` and `settings` and resolves the step: a given step above the
+    /// critical one is refused, `auto` picks one for the tolerance.
+    pub fn new(model: &'a Model<'a>, settings: &'a Settings) -> Result<Self, SimulationError> {
+        check(model, settings)?;
+        let step = step_size::resolve(model, settings)?;
+        Ok(Self {
+            model,
+            settings,
+            step,
+        })
+    }
+
+    /// [`Plan::new`] with the step an earlier plan of the same model and settings
+    /// resolved (a caller that costs a plan and runs it later need not solve the
+    /// stability eigenproblem twice). The model and settings are checked again, and a
+    /// step above its critical step is refused.
+    pub fn with_step(
+        model: &'a Model<'a>,
+        settings: &'a Settings,
+        step: StepSize,
+    ) -> Result<Self, SimulationError> {
+        check(model, settings)?;
+        if !(step.time_step.is_finite() && step.time_step > 0.0) {
+            return Err(SimulationError::InvalidSettings(vec![InputIssue::new(
+                "time_step",
+                format!("must be a positive number of seconds (got {})", step.time_step),
+            )]));
+        }
+        if step.time_step > step.critical_time_step * (1.0 + 1e-12) {
+            return Err(SimulationError::TimeStepAboveCritical {
+                time_step: step.time_step,
+                critical_time_step: step.critical_time_step,
+            });
+        }
+        Ok(Self {
+            model,
+            settings,
+            step,
+        })
+    }
+
+    /// The step the run uses and its stability limit.
+    pub fn step(&self) -> &StepSize {
+        &self.step
+    }
+
+    /// Integrates the model and assesses the result: the check of `settings.check` (the
+    /// whole run again at Δt/2 for step halving), then the verdict. `progress` is called
+    /// every few thousand steps with the fraction done (the check included);
+    /// `ControlFlow::Break` stops the run with [`SimulationError::Cancelled`].
+    pub fn run(&self, progress: &mut dyn FnMut(f64) -> ControlFlow<()>) -> Result<Assessed, SimulationError> {
+        self.run_on(pulp::Arch::new(), progress)
+    }
+
+    /// [`Plan::run`] at the SIMD level `arch` (tests compare the vector and scalar
+    /// layouts).
+    pub(super) fn run_on(
+        &self,
+        arch: pulp::Arch,
+        progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+    ) -> Result<Assessed, SimulationError> {
+        let (model, settings, step) = (self.model, self.settings, &self.step);
+        // The check takes twice the steps of the run: a third of the progress for the run.
+        let share = match settings.check {
+            Check::StepHalving => 1.0 / 3.0,
+            Check::None => 1.0,
+        };
+        let simulation = stepper::integrate(arch, model, settings, step, &mut |f| progress(share * f))?;
+        let step_halving = match settings.check {
+            Check::None => None,
+            Check::StepHalving => {
+                let started = std::time::Instant::now();
+                let halved = step.halved();
+                // The same samples, so that the repeated run costs no more memory per step.
+                let settings = Settings {
+                    output_interval: Some(simulation.output_interval),
+                    ..settings.clone()
+                };
+                let check = stepper::integrate(arch, model, &settings, &halved, &mut |f| {
+                    progress(share + (1.0 - share) * f)
+                })?;
+                Some(quality::step_halving(
+                    settings.scheme,
+                    step,
+                    quality::KeyFigures::of(&simulation),
+                    quality::KeyFigures::of(&check),
+                    (check.steps, simulation.steps, started.elapsed().as_secs_f64()),
+                ))
+            }
+        };
+        let quality = quality::assess(&simulation, step, settings.tolerance, step_halving);
+        Ok(Assessed { simulation, quality })
+    }
+
+    /// A checked plan at step `dt` whatever the critical step (tests probe instability
+    /// with it).
+    #[cfg(test)]
+    pub(crate) fn unchecked(
+        model: &'a Model<'a>,
+        settings: &'a Settings,
+        dt: f64,
+    ) -> Result<Self, SimulationError> {
+        check(model, settings)?;
+        let auto = Settings {
+            time_step: super::TimeStep::Auto,
+            ..settings.clone()
+        };
+        let step = StepSize {
+            time_step: dt,
+            ..step_size::resolve(model, &auto)?
+        };
+        Ok(Self {
+            model,
+            settings,
+            step,
+        })
+    }
+}
+
+/// Refuses a model or settings that cannot be integrated.
+fn check(model: &Model<'_>, settings: &Settings) -> Result<(), SimulationError> {
+    let issues = model.validate();
+    if !issues.is_empty() {
+        return Err(SimulationError::InvalidModel(issues));
+    }
+    let issues = settings.validate(model.basis.length());
+    if !issues.is_empty() {
+        return Err(SimulationError::InvalidSettings(issues));
+    }
+    Ok(())
+}

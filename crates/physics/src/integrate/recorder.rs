@@ -1,0 +1,274 @@
+//! What a run records: the sampled histories and their peaks between samples, the
+//! per-contact statistics and per-pin extremes accumulated at every step, and the energy
+//! accounting (dissipated and external work by the trapezoidal rule on the powers of
+//! each step). It reads the [`State`] and never changes it.
+
+use pulp::Simd;
+
+use super::kernels::level_deflections;
+use super::layout::Layout;
+use super::state::State;
+use super::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme, Settings, Simulation};
+
+/// Powers of a step (W), integrated over time by the trapezoidal rule.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Powers {
+    /// Σ 2ξᵢωᵢ q̇ᵢ²: modal damping.
+    pub modal_damping: f64,
+    /// Σ (F − Kc δ) δ̇ over closed contacts: dashpots and the force clamp.
+    pub contact_damping: f64,
+    /// Base excitation and point forces.
+    pub external: f64,
+}
+
+/// Histories, peaks, statistics and energy of one run.
+pub(super) struct Recorder {
+    /// Per lane: statistics, largest penetration so far, largest force since the last
+    /// sample.
+    pub statistics: Vec<ContactStatistics>,
+    pub max_penetration: Vec<f64>,
+    pub force_peak: Vec<f64>,
+    /// Per output height and pin, the highest and lowest deflection since the last
+    /// sample, and the deflection of largest magnitude over the run.
+    deflection_high: Vec<f64>,
+    deflection_low: Vec<f64>,
+    peak_deflections: Vec<PeakDeflection>,
+    /// Scratch: the nodal deflections of every pin at the last sample (laid out as the
+    /// level deflections).
+    node_deflections: Vec<f64>,
+    pub energy: EnergyBalance,
+    previous_power: Powers,
+    /// Largest |net external work| so far (J).
+    pub external_work_peak: f64,
+    time: Vec<f64>,
+    deflections: Vec<Vec<Vec<f64>>>,
+    deflection_peaks: Vec<Vec<Vec<f64>>>,
+    /// Per contact (not by lane).
+    contact_forces: Vec<Vec<f64>>,
+    contact_force_peaks: Vec<Vec<f64>>,
+    mechanical_energy: Vec<f64>,
+    pin_extremes: Vec<PinExtreme>,
+}
+
+impl Recorder {
+    /// Nothing recorded yet.
+    pub fn new(layout: &Layout<'_>, settings: &Settings) -> Self {
+        let pins = layout.model.pins;
+        let lanes = layout.contact_lanes();
+        let outputs = layout.output_offsets.len() * pins;
+        let contacts = layout.model.contacts.len();
+        Self {
+            statistics: vec![ContactStatistics::default(); lanes],
+            max_penetration: vec![f64::NEG_INFINITY; lanes],
+            force_peak: vec![0.0; lanes],
+            deflection_high: vec![0.0; outputs],
+            deflection_low: vec![0.0; outputs],
+            peak_deflections: vec![PeakDeflection::default(); outputs],
+            node_deflections: vec![0.0; layout.node_deflections_len()],
+            energy: EnergyBalance::default(),
+            previous_power: Powers::default(),
+            external_work_peak: 0.0,
+            time: Vec::new(),
+            deflections: vec![vec![Vec::new(); pins]; settings.output_heights.len()],
+            deflection_peaks: vec![vec![Vec::new(); pins]; settings.output_heights.len()],
+            contact_forces: vec![Vec::new(); contacts],
+            contact_force_peaks: vec![Vec::new(); contacts],
+            mechanical_energy: Vec::new(),
+            pin_extremes: vec![PinExtreme::default(); pins],
+        }
+    }
+
+    /// Contacts already closed at t = 0 count as impacts at t = 0, with their force then.
+    pub fn record_initial_contacts(&mut self, layout: &Layout<'_>, state: &State) {
+        for (contact, lane) in layout.model.contacts.iter().zip(&layout.contacts.lane) {
+            let lane = *lane as usize;
+            if state.penetration[lane] > 0.0 && (contact.stiffness > 0.0 || contact.damping > 0.0) {
+                let stats = &mut self.statistics[lane];
+                stats.impacts = 1;
+                stats.first_impact_time = Some(0.0);
+                // The force at t = 0 counts for the peak, as it does in the samples.
+                stats.max_force = state.contact_force[lane];
+                stats.max_force_time = 0.0;
+            }
+        }
+    }
+
+    /// Accumulates the powers of the step just taken (step length 2 × `half`).
+    #[inline(always)]
+    pub fn add_powers(&mut self, half: f64, powers: Powers) {
+        let (energy, previous) = (&mut self.energy, self.previous_power);
+        energy.dissipated_modal += half * (previous.modal_damping + powers.modal_damping);
+        energy.dissipated_contact += half * (previous.contact_damping + powers.contact_damping);
+        energy.external_work += half * (previous.external + powers.external);
+        self.external_work_peak = self.external_work_peak.max(energy.external_work.abs());
+        self.previous_power = powers;
+    }
+
+    /// Keeps, per output height and pin, the highest and the lowest deflection since the
+    /// last sample (branch-free: this runs at every step).
+    #[inline(always)]
+    pub fn track_deflection_peaks(&mut self, layout: &Layout<'_>, level_deflections: &[f64]) {
+        let (pins, lanes) = (layout.model.pins, layout.lanes);
+        for (h, &offset) in layout.output_offsets.iter().enumerate() {
+            let column = &level_deflections[offset..][..(pins - 1) * lanes + 1];
+            let highs = &mut self.deflection_high[h * pins..][..pins];
+            let lows = &mut self.deflection_low[h * pins..][..pins];
+            for (p, (high, low)) in highs.iter_mut().zip(lows.iter_mut()).enumerate() {
+                let w = column[p * lanes];
+                *high = if w > *high { w } else { *high };
+                *low = if w < *low { w } else { *low };
+            }
+        }
+    }
+
+    /// Records the samples at time `t` (the state is the one of the last step) and the
+    /// peaks since the previous sample, then starts new peaks.
+    pub fn record_sample(&mut self, arch: pulp::Arch, layout: &Layout<'_>, state: &State, t: f64) {
+        self.time.push(t);
+        let (pins, lanes) = (layout.model.pins, layout.lanes);
+        for (h, &offset) in layout.output_offsets.iter().enumerate() {
+            for p in 0..pins {
+                // From the same values as the peaks, so that no sample exceeds its peak.
+                let w = state.level_deflections[offset + p * lanes];
+                let k = h * pins + p;
+                let (high, low) = (self.deflection_high[k].max(w), self.deflection_low[k].min(w));
+                // The extreme of largest magnitude, signed (the highest on a tie).
+                let peak = if high >= -low { high } else { low };
+                let run = &mut self.peak_deflections[k];
+                if peak.abs() > run.deflection.abs() {
+                    // Located to within the interval that ends at this sample.
+                    *run = PeakDeflection {
+                        deflection: peak,
+                        time: t,
+                    };
+                }
+                self.deflections[h][p].push(w);
+                self.deflection_peaks[h][p].push(peak);
+                (self.deflection_high[k], self.deflection_low[k]) = (0.0, 0.0);
+            }
+        }
+        for ((history, peaks), lane) in self
+            .contact_forces
+            .iter_mut()
+            .zip(&mut self.contact_force_peaks)
+            .zip(&layout.contacts.lane)
+        {
+            let lane = *lane as usize;
+            let force = state.contact_force_of(lane);
+            history.push(force);
+            peaks.push(self.force_peak[lane].max(force));
+            self.force_peak[lane] = 0.0;
+        }
+        self.mechanical_energy.push(state.mechanical_energy(arch, layout));
+        self.record_pin_extremes(arch, layout, state, t);
+    }
+
+    /// The largest |w| of each pin over the mesh nodes, if above the one so far.
+    fn record_pin_extremes(&mut self, arch: pulp::Arch, layout: &Layout<'_>, state: &State, t: f64) {
+        arch.dispatch(NodeDeflectionsOp {
+            layout,
+            q: &state.q,
+            out: &mut self.node_deflections,
+        });
+        let element_length = layout.model.basis.model().element_length;
+        let (lanes, stride) = (layout.lanes, layout.stride);
+        for node in 0..=layout.model.basis.model().elements {
+            let (block, lane) = (node / lanes, node % lanes);
+            for (p, extreme) in self.pin_extremes.iter_mut().enumerate() {
+                let w = self.node_deflections[(block * stride + 1 + p) * lanes + lane];
+                if w.abs() > extreme.max_abs_deflection {
+                    *extreme = PinExtreme {
+                        max_abs_deflection: w.abs(),
+                        height: crate::decimal(node as f64 * element_length),
+                        time: t,
+                    };
+                }
+            }
+        }
+    }
+
+    /// The results, with the energy balance of the final state.
+    pub fn finish(
+        mut self,
+        arch: pulp::Arch,
+        layout: &Layout<'_>,
+        state: &State,
+        steps: u64,
+        output_interval: f64,
+    ) -> Simulation {
+        self.energy.kinetic = 0.5 * state.v.iter().map(|v| v * v).sum::<f64>();
+        self.energy.contact = state.contact_energy(layout);
+        self.energy.strain =
+            state.mechanical_energy(arch, layout) - self.energy.kinetic - self.energy.contact;
+        for (stats, max) in self.statistics.iter_mut().zip(&self.max_penetration) {
+            stats.max_penetration = *max;
+        }
+        Simulation {
+            step: layout.step,
+            steps,
+            output_interval,
+            time: self.time,
+            deflections: self.deflections,
+            deflection_peaks: self.deflection_peaks,
+            peak_deflections: self
+                .peak_deflections
+                .chunks(layout.model.pins.max(1))
+                .map(<[_]>::to_vec)
+                .collect(),
+            contact_forces: self.contact_forces,
+            contact_force_peaks: self.contact_force_peaks,
+            contact_statistics: layout.contacts.by_contact(&self.statistics),
+            pin_extremes: self.pin_extremes,
+            energy: self.energy,
+            mechanical_energy: self.mechanical_energy,
+        }
+    }
+}
+
+/// A closed contact's step in its statistics: an impact when it was open a step ago
+/// (`previous` ≤ 0, the first one timed by linear interpolation of the penetration),
+/// contact time, impulse and the largest force.
+#[inline(always)]
+pub(super) fn record_closed_contact(
+    stats: &mut ContactStatistics,
+    (t, dt): (f64, f64),
+    (penetration, previous): (f64, f64),
+    force: f64,
+) {
+    if previous <= 0.0 {
+        stats.impacts += 1;
+        if stats.first_impact_time.is_none() {
+            stats.first_impact_time = Some(t - dt * penetration / (penetration - previous));
+        }
+    }
+    stats.contact_time += dt;
+    stats.impulse += force * dt;
+    if force > stats.max_force {
+        stats.max_force = force;
+        stats.max_force_time = t;
+    }
+}
+
+/// The deflection of every pin at every node, as a [`pulp::WithSimd`] operation.
+struct NodeDeflectionsOp<'a> {
+    layout: &'a Layout<'a>,
+    q: &'a [f64],
+    out: &'a mut [f64],
+}
+
+impl pulp::WithSimd for NodeDeflectionsOp<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let layout = self.layout;
+        level_deflections(
+            simd,
+            &layout.node_shapes,
+            layout.row,
+            self.q,
+            S::as_mut_simd_f64s(self.out).0,
+            layout.stride,
+        );
+    }
+}

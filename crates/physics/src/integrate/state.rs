@@ -1,0 +1,116 @@
+//! The dynamic state of a run: modal coordinates, velocities, accelerations and loads of
+//! every pin, and the contact states (penetrations and forces per lane of the
+//! [`super::layout::Layout`]), with the scratch the step needs.
+
+use pulp::Simd;
+
+use super::kernels;
+use super::layout::Layout;
+
+/// What a step advances.
+pub(super) struct State {
+    /// Pin-major (`pins × row`): coordinates, velocities, accelerations, and the contact
+    /// and point loads of the step (zeroed by the modal update). `v` and `a` have one
+    /// more row, of zeros, for the walls.
+    pub q: Vec<f64>,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+    pub force: Vec<f64>,
+    /// Per lane: penetration (m) now and a step ago (the two buffers swap every step).
+    pub penetration: Vec<f64>,
+    pub previous_penetration: Vec<f64>,
+    /// Per lane, the contact force (N); only meaningful where the penetration is positive
+    /// (see [`kernels::penetrations`]).
+    pub contact_force: Vec<f64>,
+    /// w of every pin at every level, block-major (see [`kernels::level_deflections`]);
+    /// the wall slots stay 0.
+    pub level_deflections: Vec<f64>,
+    /// Scratch: the lanes closed now (the only ones that need more than a penetration),
+    /// and the groups holding them.
+    pub closed: Vec<u32>,
+    pub closed_groups: Vec<u64>,
+}
+
+impl State {
+    /// At rest, or released from the static tip-load shape with the model's initial tip
+    /// deflections; contacts open and no load yet.
+    pub fn new(layout: &Layout<'_>) -> Self {
+        let (model, row) = (layout.model, layout.row);
+        let pins = model.pins;
+        let mut q = vec![0.0; pins * row];
+        if let Some(unit) = model.basis.unit_tip_release() {
+            for (coordinates, tip) in q.chunks_exact_mut(row).zip(&model.initial_tip_displacements) {
+                for (x, u) in coordinates.iter_mut().zip(unit.iter()) {
+                    *x = tip * u;
+                }
+            }
+        }
+        let lanes = layout.contact_lanes();
+        let groups = lanes / layout.lanes;
+        Self {
+            q,
+            v: vec![0.0; (pins + 1) * row],
+            a: vec![0.0; (pins + 1) * row],
+            force: vec![0.0; pins * row],
+            penetration: vec![0.0; lanes],
+            previous_penetration: vec![0.0; lanes],
+            contact_force: vec![0.0; lanes],
+            level_deflections: vec![0.0; layout.level_deflections_len()],
+            closed: vec![0; lanes],
+            closed_groups: vec![0; groups.div_ceil(64)],
+        }
+    }
+
+    /// Kinetic + strain + contact energy now (J).
+    pub fn mechanical_energy(&self, arch: pulp::Arch, layout: &Layout<'_>) -> f64 {
+        let modal = arch.dispatch(ModalEnergyOp {
+            stiffness: &layout.omega_squared,
+            q: &self.q,
+            v: &self.v,
+        });
+        modal + self.contact_energy(layout)
+    }
+
+    /// ½ Σ Kc δ² over the closed contacts (J).
+    pub fn contact_energy(&self, layout: &Layout<'_>) -> f64 {
+        layout
+            .model
+            .contacts
+            .iter()
+            .zip(&layout.contacts.lane)
+            .map(|(c, lane)| (c, self.penetration[*lane as usize]))
+            .filter(|(_, d)| *d > 0.0)
+            .map(|(c, d)| 0.5 * c.stiffness * d * d)
+            .sum()
+    }
+
+    /// The force of the contact in `lane` (N): forces are only updated while closed.
+    pub fn contact_force_of(&self, lane: usize) -> f64 {
+        if self.penetration[lane] > 0.0 {
+            self.contact_force[lane]
+        } else {
+            0.0
+        }
+    }
+}
+
+/// ½ Σ (v² + ω² q²) as a [`pulp::WithSimd`] operation.
+struct ModalEnergyOp<'a> {
+    stiffness: &'a [f64],
+    q: &'a [f64],
+    v: &'a [f64],
+}
+
+impl pulp::WithSimd for ModalEnergyOp<'_> {
+    type Output = f64;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> f64 {
+        kernels::modal_energy(
+            simd,
+            S::as_simd_f64s(self.stiffness).0,
+            S::as_simd_f64s(self.q).0,
+            S::as_simd_f64s(self.v).0,
+        )
+    }
+}
