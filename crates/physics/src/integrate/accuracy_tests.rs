@@ -11,10 +11,8 @@ use std::ops::ControlFlow;
 
 use super::*;
 use crate::beam::{BeamSpec, Section, Support};
-use crate::contact::Body;
-use crate::contact::Contact;
-use crate::loads::BaseAcceleration;
-use crate::loads::Table;
+use crate::contact::{Body, Contact};
+use crate::loads::{BaseAcceleration, Table};
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
 

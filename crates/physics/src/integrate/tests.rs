@@ -6,10 +6,8 @@ use std::ops::ControlFlow;
 
 use super::*;
 use crate::beam::tests::default_tube;
-use crate::contact::Body;
-use crate::contact::Contact;
-use crate::loads::Table;
-use crate::loads::{BaseAcceleration, PointForce};
+use crate::contact::{Body, Contact};
+use crate::loads::{BaseAcceleration, PointForce, Table};
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
 
