@@ -162,6 +162,11 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     fn description(&self) -> &'static str;
     /// OGC process description `inputs` object: `{name: {title, description, schema}}`.
     fn inputs_description(&self) -> serde_json::Value;
+    /// The self-contained JSON schema of the `inputs` object, if the process has one
+    /// (a sweep's axis pointers are checked against it).
+    fn inputs_schema(&self) -> Option<serde_json::Value> {
+        None
+    }
     /// OGC process description `outputs` object: `{name: {title, description, schema}}`.
     fn outputs_description(&self) -> serde_json::Value;
     /// Parses and checks the `inputs` object of an execution request, and estimates what

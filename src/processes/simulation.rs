@@ -95,6 +95,10 @@ impl<S: Simulation> Process for S {
         inputs::ogc_inputs(&inputs::schema_of::<S::Inputs>())
     }
 
+    fn inputs_schema(&self) -> Option<serde_json::Value> {
+        Some(inputs::schema_of::<S::Inputs>())
+    }
+
     fn outputs_description(&self) -> serde_json::Value {
         S::HISTORIES
             .iter()

@@ -9,6 +9,7 @@ use std::time::Duration;
 use super::auth::{AuthFileError, TokenTable};
 use super::clock::{SharedClock, SystemClock};
 use super::db::DatabaseUrl;
+use super::http::cors::CorsOrigin;
 use crate::processes::CostLimits;
 use crate::processes::cost::{DEFAULT_MAX_HISTORY_VALUES, DEFAULT_MAX_WORK};
 
@@ -103,6 +104,16 @@ pub struct ServeArgs {
     /// Longest time one request may take, its body included (s): slower ones get a 408.
     #[arg(long, env = "CHOCMODAL_REQUEST_TIMEOUT_SECONDS", default_value_t = 30)]
     pub request_timeout_seconds: u64,
+    /// Web origins allowed to call the API from a browser (CORS), e.g.
+    /// `https://dash.example.com`; repeat the flag or separate with commas; `*`: every
+    /// origin. Default: none (no CORS headers, preflights refused).
+    #[arg(
+        long = "cors-origin",
+        env = "CHOCMODAL_CORS_ORIGIN",
+        value_name = "ORIGIN",
+        value_delimiter = ','
+    )]
+    pub cors_origins: Vec<CorsOrigin>,
     /// Longest time a client may take to send a request's headers (s), and to start the
     /// next request on a kept-alive connection; the connection is closed after that.
     #[arg(long, env = "CHOCMODAL_HEADER_TIMEOUT_SECONDS", default_value_t = 10)]
@@ -162,6 +173,8 @@ pub struct ServiceConfig {
     pub auth: Option<TokenTable>,
     /// `/metrics` answers without a token.
     pub metrics_public: bool,
+    /// Web origins allowed to call the API from a browser; empty: no CORS.
+    pub cors_origins: Vec<CorsOrigin>,
     /// Bind a non-loopback address even without `auth`.
     pub insecure: bool,
     /// Ceilings on the estimated cost of one run.
@@ -218,6 +231,7 @@ impl ServiceConfig {
             max_sweep_runs: DEFAULT_MAX_SWEEP_RUNS,
             auth: None,
             metrics_public: false,
+            cors_origins: Vec::new(),
             insecure: false,
             limits: CostLimits::default(),
             max_history_points: DEFAULT_MAX_HISTORY_POINTS,
@@ -265,6 +279,7 @@ impl ServiceConfig {
             max_sweep_runs: args.max_sweep_runs,
             auth,
             metrics_public: args.metrics_public,
+            cors_origins: args.cors_origins.clone(),
             insecure: args.insecure,
             limits: CostLimits {
                 max_steps: crate::processes::cost::MAX_STEPS,

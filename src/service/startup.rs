@@ -185,6 +185,7 @@ impl Application {
                 request_timeout: config.request_timeout,
                 auth: config.auth.clone(),
                 metrics_public: config.metrics_public,
+                cors_origins: config.cors_origins.clone(),
             },
         );
         if tenants == 0 {

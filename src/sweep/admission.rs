@@ -1,7 +1,9 @@
 //! Sweep admission: from a request body to the runs to queue, or the reason why none is.
 //!
 //! A sweep is admitted whole or not at all. Its request is checked ([`spec::parse`]),
-//! its process looked up, its axes expanded into runs, and every run's inputs validated
+//! its process looked up, each axis pointer checked against the process's inputs schema
+//! ([`input_schema`]: a typo would otherwise fail every run), its axes expanded into
+//! runs, and every run's inputs validated
 //! by the process as an execution request's would be, its estimated cost compared with
 //! the service's ceilings. A run above a ceiling refuses the sweep; an invalid run
 //! refuses it too, unless the request says `invalid_runs: record` (the run is then
@@ -15,6 +17,7 @@ use std::collections::HashMap;
 
 use serde_json::Value;
 
+use super::input_schema;
 use super::spec::{self, SweepError, SweepSpec};
 use super::{InvalidRuns, Run};
 use crate::processes::cost::Excess;
@@ -85,8 +88,28 @@ pub fn admit(body: &Value, registry: &Registry, limits: &AdmissionLimits) -> Res
     let process = registry
         .get(&spec.process)
         .ok_or_else(|| Refusal::NoSuchProcess(spec.process.clone()))?;
+    check_pointers(&spec, process.as_ref())
+        .map_err(|errors| Refusal::Request(SweepError::Invalid(errors)))?;
     let runs = admit_runs(&spec, process.as_ref(), &limits.cost)?;
     Ok(Admitted { spec, runs })
+}
+
+/// Every axis whose pointer names no input of `process` (one error at
+/// `/axes/{k}/pointer` each), when the process has an inputs schema.
+fn check_pointers(spec: &SweepSpec, process: &dyn Process) -> Result<(), Vec<FieldError>> {
+    let Some(schema) = process.inputs_schema() else {
+        return Ok(());
+    };
+    let errors: Vec<FieldError> = spec
+        .axes
+        .iter()
+        .enumerate()
+        .filter_map(|(index, axis)| {
+            let why = input_schema::check(&schema, &axis.pointer).err()?;
+            Some(FieldError::new(format!("/axes/{index}/pointer"), why))
+        })
+        .collect();
+    if errors.is_empty() { Ok(()) } else { Err(errors) }
 }
 
 /// Why the process does not take a generated run as it is.
@@ -309,6 +332,50 @@ mod tests {
         assert!(runs.errors.len() <= MAX_RUN_ERRORS);
         assert!(runs.errors.iter().all(|e| e.pointer.starts_with("/runs/")));
         assert_eq!(exceeded[0].quantity, "work");
+    }
+
+    #[test]
+    fn an_axis_pointer_that_names_no_input_refuses_the_sweep_at_that_axis() {
+        let mut body = calibration();
+        body["axes"][1]["pointer"] = json!("/contact/rkk");
+        body["axes"][0]["pointer"] = json!("/reference/mode");
+        let Err(Refusal::Request(SweepError::Invalid(errors))) =
+            admit(&body, &Registry::builtin(), &limits())
+        else {
+            panic!("both pointers name no input");
+        };
+        assert_eq!(
+            errors,
+            vec![
+                FieldError::new(
+                    "/axes/0/pointer",
+                    "no input `mode` under /reference; valid: modes"
+                ),
+                FieldError::new(
+                    "/axes/1/pointer",
+                    "no input `rkk` under /contact; valid: damping, gap, rk, stiffness"
+                ),
+            ]
+        );
+    }
+
+    #[test]
+    fn the_pointers_of_the_shipped_sweeps_name_inputs() {
+        for example in [
+            include_str!("../../examples/sweep-calibration.json"),
+            include_str!("../../examples/sweep-gaps.json"),
+            include_str!("../../examples/sweep-static-correction.json"),
+        ] {
+            let body: Value = serde_json::from_str(example).unwrap();
+            let spec = spec::parse(&body, 10_000).unwrap();
+            let process = Registry::builtin().get(&spec.process).unwrap();
+            assert_eq!(
+                check_pointers(&spec, process.as_ref()),
+                Ok(()),
+                "{}",
+                spec.process
+            );
+        }
     }
 
     #[test]

@@ -14,6 +14,7 @@
 //!   its members as given, so that every problem is reported at once);
 //! - [`spec`]: checking the request, with JSON pointers into it for every problem;
 //! - [`admission`]: from a request to the runs to queue, or a typed refusal;
+//! - [`input_schema`]: whether an axis pointer names an input of the process;
 //! - [`definition`]: the request as stored with the sweep, read back for its results;
 //! - [`sampling`]: the seeded uniforms and the laws' quantiles;
 //! - [`pointer`]: writing a value at a JSON pointer;
@@ -23,6 +24,7 @@
 pub mod admission;
 pub mod aggregate;
 pub mod definition;
+pub mod input_schema;
 pub mod member;
 pub mod pointer;
 pub mod request;

@@ -8,6 +8,7 @@ mod postgres;
 mod skip;
 
 mod capabilities;
+mod cors;
 mod dashboard;
 mod database;
 mod dismissal;

@@ -246,6 +246,26 @@ async fn an_invalid_run_is_named_by_run_and_pointer_and_nothing_is_queued() {
     assert_eq!(app.get_json("/sweeps").await["sweeps"], json!([]));
 }
 
+/// A typo in an axis pointer (`/contact/rkk`) would make every run fail on an unknown
+/// input: the sweep is refused up front, at the axis, naming the valid members.
+#[tokio::test]
+async fn an_axis_pointer_that_names_no_input_is_refused_before_any_run_is_queued() {
+    let app = spawn_app_with_processes(vec![Arc::new(CantileverImpact)], |_| {}).await;
+    let mut body: Value =
+        serde_json::from_str(include_str!("../../examples/sweep-calibration.json")).unwrap();
+    body["axes"][0]["pointer"] = json!("/contact/rkk");
+    let response = app.post_sweep(&body).await;
+    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
+    assert_eq!(
+        problem["errors"],
+        json!([{"pointer": "/axes/0/pointer",
+                "detail": "no input `rkk` under /contact; valid: damping, gap, rk, stiffness"}]),
+        "{problem}"
+    );
+    assert_eq!(app.get_json("/jobs").await["jobs"], json!([]));
+    assert_eq!(app.get_json("/sweeps").await["sweeps"], json!([]));
+}
+
 async fn dismissing_a_sweep_dismisses_its_queued_and_running_runs(backend: Backend) {
     let app = spawn_app_on(backend, |_| {}).await;
     let id = app

@@ -1,9 +1,11 @@
 //! The HTTP API (OGC API – Processes): routes, shared state, and the layers every
-//! request goes through (tracing, metrics, authentication, body limit, timeout, panic
-//! catching, and the rewrite of any bare error response into a problem document).
+//! request goes through (tracing, metrics, CORS when configured, authentication, body
+//! limit, timeout, panic catching, and the rewrite of any bare error response into a
+//! problem document).
 
 pub mod auth;
 pub mod conditional;
+pub mod cors;
 pub mod dashboard;
 pub mod error;
 pub mod extract;
@@ -74,6 +76,8 @@ pub struct HttpSettings {
     pub auth: Option<TokenTable>,
     /// `/metrics` answers without a token.
     pub metrics_public: bool,
+    /// Web origins allowed to call the API from a browser; empty: no CORS.
+    pub cors_origins: Vec<cors::CorsOrigin>,
 }
 
 /// The application's router with all its layers.
@@ -82,7 +86,7 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         tokens: settings.auth.clone(),
         metrics_public: settings.metrics_public,
     });
-    Router::new()
+    let routes = Router::new()
         .route("/", get(landing::landing))
         .route("/conformance", get(landing::conformance))
         .route("/healthz", get(landing::healthz))
@@ -117,7 +121,14 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
             StatusCode::REQUEST_TIMEOUT,
             settings.request_timeout,
         ))
-        .layer(middleware::map_response(problem_for_bare_errors))
+        .layer(middleware::map_response(problem_for_bare_errors));
+    // CORS outside authentication (a preflight carries no token) and outside the error
+    // rewriting (a script must be able to read a 401 or 413 too).
+    let routes = match cors::layer(&settings.cors_origins) {
+        Some(cors) => routes.layer(cors),
+        None => routes,
+    };
+    routes
         .layer(middleware::from_fn_with_state(state.clone(), track_request))
         .layer(
             TraceLayer::new_for_http()
