@@ -9,6 +9,7 @@ use utoipa::ToSchema;
 use super::basis_report::BasisReport;
 use super::bundle_inputs::{BodyInput, BundleInputs, ContactInput};
 use super::inputs::{self, SolverDefaults, at};
+use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryOutput, Output, Simulation};
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
@@ -59,6 +60,33 @@ fn row_model<'a>(
             .map(|f| f.physics())
             .collect(),
     }
+}
+
+/// Where the user wrote what a path of the row's model or settings names: `contacts/k/…`
+/// in `contacts` (the generator's expansion is checked as `bundle`), the release in
+/// `initial`, the loads in `excitation`, the recorded heights in `output` (the pin tips
+/// by default: its length). `None` for a contact's body when the pin count itself is
+/// refused: that is the cause.
+fn pointer_of(inputs: &BundleInputs, path: &str, pins_refused: bool) -> Option<String> {
+    let generated = inputs.bundle.is_some();
+    let pointer = match model_check::split(path) {
+        ("pins", None, "") if generated => "/inputs/bundle/pins".to_owned(),
+        ("pins", None, "") => "/inputs/pins".to_owned(),
+        ("damping_ratios", mode, _) => model_check::damping_ratio_pointer(&inputs.pin, "/inputs/pin", mode),
+        ("contacts", Some(_), _) if generated => "/inputs/bundle".to_owned(),
+        ("contacts", Some(_), "left" | "right") if pins_refused => return None,
+        ("contacts", Some(k), rest) => model_check::join(&format!("/inputs/contacts/{k}"), rest),
+        ("initial_tip_displacements", None, "") => "/inputs/initial/tip_displacements".to_owned(),
+        ("initial_tip_displacements", Some(p), "") => format!("/inputs/initial/tip_displacements/{p}"),
+        ("base_acceleration", _, _) => model_check::join("/inputs/excitation", path),
+        ("point_forces", Some(k), rest) => {
+            model_check::join(&format!("/inputs/excitation/point_forces/{k}"), rest)
+        }
+        ("output_heights", Some(_), "") if inputs.output.heights.is_none() => "/inputs/pin/length".to_owned(),
+        ("output_heights", Some(k), "") => format!("/inputs/output/heights/{k}"),
+        _ => return Some(model_check::settings_pointer(path).unwrap_or_else(|| "/inputs".to_owned())),
+    };
+    Some(pointer)
 }
 
 /// The results document of `bundle-dynamics`.
@@ -231,15 +259,7 @@ impl Simulation for BundleDynamics {
                         format!("must be between 1 and {MAX_PINS}"),
                     ));
                 }
-                let contacts: Vec<Contact> = contacts.iter().flatten().map(ContactInput::contact).collect();
-                if pins >= 1 {
-                    for (k, contact) in contacts.iter().enumerate() {
-                        errors.extend(at(
-                            &format!("/inputs/contacts/{k}"),
-                            contact.validate(pins, length),
-                        ));
-                    }
-                }
+                let contacts = contacts.iter().flatten().map(ContactInput::contact).collect();
                 (pins, contacts)
             }
             (Some(_), _, _) => {
@@ -260,55 +280,11 @@ impl Simulation for BundleDynamics {
                 )]));
             }
         };
-        if pins > MAX_PINS {
+        if inputs.bundle.is_some() && pins > MAX_PINS {
             errors.push(FieldError::new(
                 "/inputs/bundle/pins",
                 format!("must be at most {MAX_PINS}"),
             ));
-        }
-
-        let tips = &inputs.initial.tip_displacements;
-        if !tips.is_empty() && tips.len() != pins {
-            errors.push(FieldError::new(
-                "/inputs/initial/tip_displacements",
-                format!("needs one value per pin ({pins}), got {}", tips.len()),
-            ));
-        }
-        for (p, tip) in tips.iter().enumerate() {
-            if !tip.is_finite() {
-                errors.push(FieldError::new(
-                    format!("/inputs/initial/tip_displacements/{p}"),
-                    "must be a finite number",
-                ));
-            }
-        }
-        if tips.iter().any(|t| *t != 0.0) && inputs.pin.supports.top != super::inputs::SupportInput::Free {
-            errors.push(FieldError::new(
-                "/inputs/initial/tip_displacements",
-                "a tip release needs a free top",
-            ));
-        }
-        if let Some(base) = &inputs.excitation.base_acceleration {
-            errors.extend(at(
-                "/inputs/excitation/base_acceleration",
-                base.physics().validate(),
-            ));
-        }
-        for (k, force) in inputs.excitation.point_forces.iter().enumerate() {
-            let prefix = format!("/inputs/excitation/point_forces/{k}");
-            if force.pin >= pins {
-                errors.push(FieldError::new(
-                    format!("{prefix}/pin"),
-                    format!("pin {} does not exist", force.pin),
-                ));
-            }
-            if !(force.height.is_finite() && (0.0..=length).contains(&force.height)) {
-                errors.push(FieldError::new(
-                    format!("{prefix}/height"),
-                    format!("must be within the pin, 0 to {length} m"),
-                ));
-            }
-            errors.extend(at(&prefix, force.physics().force.validate("force")));
         }
 
         let solver = inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
@@ -320,14 +296,17 @@ impl Simulation for BundleDynamics {
                 "must list at least one height",
             ));
         }
-        for (k, h) in heights.iter().enumerate() {
-            if !(h.is_finite() && (0.0..=length).contains(h)) {
-                errors.push(FieldError::new(
-                    format!("/inputs/output/heights/{k}"),
-                    format!("must be within the pin, 0 to {length} m"),
-                ));
-            }
-        }
+        let interval = inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL);
+        let settings = solver.integration(Some(interval), heights);
+        let stand_in = StandIn::of(&inputs.pin);
+        let pins_refused = errors.iter().any(|e| e.pointer.ends_with("/pins"));
+        model_check::check(
+            &stand_in,
+            &row_model(&inputs, pins, &contacts, &stand_in.basis),
+            &settings,
+            |path| pointer_of(&inputs, path, pins_refused),
+            &mut errors,
+        );
         if !errors.is_empty() {
             return Err(InvalidInputs(errors));
         }
@@ -335,15 +314,6 @@ impl Simulation for BundleDynamics {
         // One static correction per distinct contact height, shared by every pin.
         let contact_heights: Vec<f64> = contacts.iter().map(|c| c.height).collect();
         let basis = inputs.pin.basis(&contact_heights, "/inputs/pin")?;
-        let settings = Settings {
-            scheme: solver.scheme,
-            time_step: solver.time_step,
-            tolerance: solver.tolerance,
-            check: solver.check,
-            duration: solver.duration,
-            output_interval: Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
-            output_heights: heights,
-        };
         let step = inputs::resolve_step(&row_model(&inputs, pins, &contacts, &basis), &settings)?;
         Ok(Plan {
             inputs,

@@ -180,6 +180,74 @@ fn invalid_inputs_name_each_field() {
     assert_eq!(pointers(&bad_left), ["/inputs/contacts/0/left"]);
 }
 
+/// The model is checked by physics (`Model::validate`, `Settings::validate`) with the
+/// pin's own problems, in one refusal, each at the member the user wrote: an invalid pin
+/// does not hide the contacts', the loads' or the recorded heights' problems.
+#[test]
+fn an_invalid_pin_does_not_hide_the_models_problems() {
+    let mut bad_pin = pin();
+    bad_pin["modes"] = json!(0);
+    let inputs = json!({"pin": bad_pin, "pins": 2,
+        "contacts": [{"left": "wall", "right": 3, "height": 1.0, "stiffness": 1e4, "gap": -1e-4}],
+        "initial": {"tip_displacements": [1e-3, 0.0, 0.0]},
+        "excitation": {
+            "base_acceleration": {"type": "table", "time": [0.0, 0.01, 0.005], "acceleration": [0.0, 1.0]},
+            "point_forces": [{"pin": 5, "height": 2.0, "time": [0.0, 0.01], "force": [0.0, 1.0]}]},
+        "output": {"heights": [0.5, 1.5]}});
+    assert_eq!(
+        pointers(&inputs),
+        [
+            "/inputs/pin/modes",
+            "/inputs/contacts/0/right",
+            "/inputs/contacts/0/gap",
+            "/inputs/initial/tip_displacements",
+            "/inputs/excitation/base_acceleration/acceleration",
+            "/inputs/excitation/base_acceleration/time/2",
+            "/inputs/excitation/point_forces/0/pin",
+            "/inputs/excitation/point_forces/0/height",
+            "/inputs/output/heights/1",
+        ]
+    );
+}
+
+/// Heights within the pin cannot be checked against an invalid length: the length is
+/// refused, the heights are not, the rest still is.
+#[test]
+fn an_invalid_length_refuses_the_length_not_every_height() {
+    let mut bad_pin = pin();
+    bad_pin["length"] = json!(-1.0);
+    let inputs = json!({"pin": bad_pin, "pins": 1,
+        "contacts": [{"left": "wall", "right": 0, "height": 0.5, "stiffness": -1.0}]});
+    assert_eq!(
+        pointers(&inputs),
+        ["/inputs/pin/length", "/inputs/contacts/0/stiffness"]
+    );
+}
+
+/// A release from the static tip-load shape needs a free top; a row without pins is
+/// refused at its pin count, not at every contact that names a pin.
+#[test]
+fn a_tip_release_needs_a_free_top_and_a_row_needs_pins() {
+    let mut clamped_top = pin();
+    clamped_top["supports"] = json!({"foot": "clamped", "top": "clamped"});
+    let contacts = json!([{"left": "wall", "right": 0, "height": 0.5, "stiffness": 1e4},
+                          {"left": 0, "right": "wall", "height": 0.5, "stiffness": 1e4}]);
+    let released = json!({"pin": clamped_top, "pins": 1, "contacts": contacts,
+        "initial": {"tip_displacements": [1e-3]}});
+    assert_eq!(pointers(&released), ["/inputs/initial/tip_displacements"]);
+    let at_rest = json!({"pin": clamped_top, "pins": 1, "contacts": contacts,
+        "initial": {"tip_displacements": [0.0]}, "solver": {"duration": 0.001}});
+    assert!(BundleDynamics.validate(&at_rest).is_ok());
+    let no_pins = json!({"pin": pin(), "pins": 0, "contacts": contacts});
+    assert_eq!(pointers(&no_pins), ["/inputs/pins"]);
+    let too_many = json!({"pin": pin(), "pins": MAX_PINS + 1, "contacts": contacts});
+    assert_eq!(
+        pointers(&too_many),
+        ["/inputs/pins"],
+        "no pointer into an absent `bundle`"
+    );
+}
+
 /// The shipped benchmark example is valid and describes 17 pins and 180 contacts.
 #[test]
 fn row17_example_is_the_benchmark_case() {

@@ -8,6 +8,7 @@ use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
 use super::inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
+use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryOutput, Output, Simulation};
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
@@ -270,15 +271,40 @@ fn contact_stiffness(contact: &ContactInput, tip_stiffness: f64, errors: &mut Ve
             crate::physics::require_non_negative(&mut issues, "rk", rk);
             rk * tip_stiffness
         }
-        (None, Some(stiffness)) => {
-            crate::physics::require_non_negative(&mut issues, "stiffness", stiffness);
-            stiffness
-        }
+        (None, Some(stiffness)) => stiffness,
     };
-    crate::physics::require_non_negative(&mut issues, "gap", contact.gap);
-    crate::physics::require_non_negative(&mut issues, "damping", contact.damping);
     errors.extend(at("/inputs/contact", issues));
     stiffness
+}
+
+/// Where the user wrote what a path of the one-contact model or its settings names: the
+/// contact's values in `contact` (a stiffness derived from `rk` is refused at `rk`, or
+/// not at all when the beam it scales is refused), its height and the recorded height at
+/// the tip (`beam/length`), the release in `release`, the tip-load shape it needs in
+/// `beam/supports`.
+fn pointer_of(inputs: &CantileverInputs, path: &str, beam_refused: bool) -> Option<String> {
+    let pointer = match model_check::split(path) {
+        ("contacts", Some(_), "stiffness") if inputs.contact.stiffness.is_some() => {
+            "/inputs/contact/stiffness"
+        }
+        ("contacts", Some(_), "stiffness") if beam_refused => return None,
+        ("contacts", Some(_), "stiffness") => "/inputs/contact/rk",
+        ("contacts", Some(_), "gap") => "/inputs/contact/gap",
+        ("contacts", Some(_), "damping") => "/inputs/contact/damping",
+        ("contacts", Some(_), "height") | ("output_heights", _, _) => "/inputs/beam/length",
+        ("contacts", _, _) => "/inputs/contact",
+        ("initial_tip_displacements", Some(_), "") => "/inputs/release/tip_displacement",
+        ("initial_tip_displacements", None, "") => "/inputs/beam/supports",
+        ("damping_ratios", mode, _) => {
+            return Some(model_check::damping_ratio_pointer(
+                &inputs.beam,
+                "/inputs/beam",
+                mode,
+            ));
+        }
+        _ => return Some(model_check::settings_pointer(path).unwrap_or_else(|| "/inputs".to_owned())),
+    };
+    Some(pointer.to_owned())
 }
 
 /// The reference's own limit: it scans at 1/16 of its shortest period, and its highest
@@ -351,35 +377,30 @@ impl Simulation for CantileverImpact {
         let spec = inputs.beam.spec();
         let tip_stiffness = 3.0 * spec.bending_stiffness() / spec.length.powi(3);
         let contact_stiffness = contact_stiffness(&inputs.contact, tip_stiffness, &mut errors);
-        if !inputs.release.tip_displacement.is_finite() {
-            errors.push(FieldError::new(
-                "/inputs/release/tip_displacement",
-                "must be a finite number",
-            ));
-        }
         let solver = inputs::solver(&inputs.solver, SOLVER_DEFAULTS, &mut errors);
+        inputs::check_output_interval(inputs.output.interval, &mut errors);
+        let settings = solver.integration(inputs.output.interval, vec![spec.length]);
+        let stand_in = StandIn::of(&inputs.beam);
+        let beam_refused = errors.iter().any(|e| e.pointer.starts_with("/inputs/beam"));
+        model_check::check(
+            &stand_in,
+            &tip_model(&inputs, &stand_in.basis, contact_stiffness),
+            &settings,
+            |path| pointer_of(&inputs, path, beam_refused),
+            &mut errors,
+        );
         if !(1..=MAX_MODES).contains(&inputs.reference.modes) {
             errors.push(FieldError::new(
                 "/inputs/reference/modes",
                 format!("must be between 1 and {MAX_MODES}"),
             ));
         }
-        inputs::check_output_interval(inputs.output.interval, &mut errors);
         if !errors.is_empty() {
             return Err(InvalidInputs(errors));
         }
 
         // The contact is at the tip: the static correction, if any, is the tip-load shape.
         let basis = inputs.beam.basis(&[spec.length], "/inputs/beam")?;
-        let settings = Settings {
-            scheme: solver.scheme,
-            time_step: solver.time_step,
-            tolerance: solver.tolerance,
-            check: solver.check,
-            duration: solver.duration,
-            output_interval: inputs.output.interval,
-            output_heights: vec![spec.length],
-        };
         let reference = CantileverReference {
             length: spec.length,
             young_modulus: spec.young_modulus,

@@ -199,6 +199,43 @@ fn invalid_inputs_name_each_field() {
     );
 }
 
+/// The contact's values are checked by the model's own validation (issue 17), with the
+/// beam's problems and at the members the user wrote: a given stiffness at
+/// `contact/stiffness`, one derived from a negative `rk` once at `contact/rk`, and none
+/// when only the beam it scales is wrong.
+#[test]
+fn the_models_problems_come_with_the_beams_at_the_contact_members() {
+    let mut inputs = default_inputs();
+    inputs["beam"]["modes"] = json!(0);
+    inputs["contact"] = json!({"stiffness": -5.0, "gap": -1e-3, "damping": -1.0});
+    assert_eq!(
+        pointers(&inputs),
+        [
+            "/inputs/beam/modes",
+            "/inputs/contact/gap",
+            "/inputs/contact/stiffness",
+            "/inputs/contact/damping"
+        ]
+    );
+    let mut inputs = default_inputs();
+    inputs["contact"]["rk"] = json!(-2.0);
+    let errors = CantileverImpact.validate(&inputs).unwrap_err().0;
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert_eq!(errors[0].pointer, "/inputs/contact/rk");
+    assert!(
+        errors[0].detail.contains("-2"),
+        "the value given: {}",
+        errors[0].detail
+    );
+    let mut inputs = default_inputs();
+    inputs["beam"]["young_modulus"] = json!(-2.1e11);
+    assert_eq!(pointers(&inputs), ["/inputs/beam/young_modulus"]);
+    // The tip release needs a free top: the supports are the cause, named once.
+    let mut inputs = default_inputs();
+    inputs["beam"]["supports"] = json!({"foot": "clamped", "top": "pinned"});
+    assert_eq!(pointers(&inputs), ["/inputs/beam/supports"]);
+}
+
 #[test]
 fn unknown_and_mistyped_fields_are_refused_with_their_pointer() {
     let mut inputs = default_inputs();

@@ -12,7 +12,7 @@ use utoipa::ToSchema;
 use super::{FieldError, InvalidInputs};
 use crate::physics::InputIssue;
 use crate::physics::beam::{BeamSpec, Section, Support};
-use crate::physics::integrate::{Check, DEFAULT_TOLERANCE, TimeStep};
+use crate::physics::integrate::{Check, DEFAULT_TOLERANCE, Settings, TimeStep};
 use crate::physics::stability::Scheme;
 
 /// A uniform, slender Euler–Bernoulli beam (one fuel pin) and its modal truncation.
@@ -429,6 +429,22 @@ pub struct SolverSettings {
     pub duration: f64,
     pub tolerance: f64,
     pub check: Check,
+}
+
+impl SolverSettings {
+    /// The integration settings of this solver block, recording every pin's deflection
+    /// at `output_heights` (m) each `output_interval` (s; every step when `None`).
+    pub fn integration(&self, output_interval: Option<f64>, output_heights: Vec<f64>) -> Settings {
+        Settings {
+            scheme: self.scheme,
+            time_step: self.time_step,
+            tolerance: self.tolerance,
+            check: self.check,
+            duration: self.duration,
+            output_interval,
+            output_heights,
+        }
+    }
 }
 
 /// The settings of a `solver` block (`defaults` for the fields left out), its problems

@@ -13,6 +13,7 @@ pub mod cantilever_impact;
 pub mod cost;
 pub mod inputs;
 pub mod metrics;
+pub mod model_check;
 /// The shared parts of results documents (quality, energy) as serialized types.
 pub mod report;
 /// A process described by its types, and the one adapter to [`Process`].
