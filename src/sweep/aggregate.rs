@@ -1,6 +1,6 @@
 //! Aggregates of a sweep's results table.
 //!
-//! - Random sweeps: for every numeric column (random axes and metrics) over the
+//! - Random sweeps: for every numeric column (random axes and metrics; not seeds) over the
 //!   successful runs of each grid cell of the list axes (one cell without list axes):
 //!   count, mean, sample standard deviation (divisor n − 1; 0 for one run), min, max and
 //!   the 5 %, 50 %, 95 % quantiles (linear interpolation between order statistics: the
@@ -190,7 +190,8 @@ pub fn quantile(sorted: &[f64], p: f64) -> f64 {
     sorted[below] + (sorted[above] - sorted[below]) * weight
 }
 
-/// Statistics per grid cell of `list_axes`, for `numeric_axes` and every metric column.
+/// Statistics per grid cell of `list_axes`, for `numeric_axes` and every metric column
+/// but seeds ([`super::table::is_seed`]).
 pub fn cell_statistics(table: &Table, list_axes: &[String], numeric_axes: &[String]) -> Value {
     let successful: Vec<&Map<String, Value>> = table
         .rows
@@ -208,7 +209,12 @@ pub fn cell_statistics(table: &Table, list_axes: &[String], numeric_axes: &[Stri
             None => cells.push((cell, vec![row])),
         }
     }
-    let columns: Vec<&String> = numeric_axes.iter().chain(&table.metrics).collect();
+    // A seed names a draw: its mean or spread means nothing.
+    let columns: Vec<&String> = numeric_axes
+        .iter()
+        .chain(&table.metrics)
+        .filter(|column| !super::table::is_seed(column))
+        .collect();
     let groups: Vec<Value> = cells
         .into_iter()
         .map(|(cell, rows)| {
@@ -323,6 +329,31 @@ fn cheapest_along(cells: &[Value], axes: &[String], axis: &str, largest: bool) -
 mod tests {
     use super::*;
     use crate::sweep::table::{RunRecord, build};
+
+    /// A random seed axis and a seed echoed in the results are columns of the table but
+    /// not quantities: no mean of a seed; the other columns keep their statistics.
+    #[test]
+    fn seeds_are_left_out_of_the_statistics() {
+        let records: Vec<RunRecord> = [(11_u64, 2.0), (573_700_123, 4.0)]
+            .into_iter()
+            .enumerate()
+            .map(|(run, (seed, force))| RunRecord {
+                run,
+                job: format!("j{run}"),
+                status: "successful".into(),
+                inputs: json!({"gaps": {"seed": seed}, "rk": 1.0 + run as f64}),
+                metrics: vec![("force".into(), json!(force)), ("gaps.seed".into(), json!(seed))],
+            })
+            .collect();
+        let axes = ["/gaps/seed".to_owned(), "/rk".to_owned()];
+        let table = build(&axes, &records);
+        let cells = cell_statistics(&table, &[], &axes);
+        let metrics = cells[0]["metrics"].as_object().unwrap();
+        let mut names: Vec<&str> = metrics.keys().map(String::as_str).collect();
+        names.sort_unstable();
+        assert_eq!(names, ["/rk", "force"], "{metrics:?}");
+        assert_eq!(metrics["force"]["mean"], 3.0);
+    }
 
     #[test]
     fn statistics_match_values_computed_by_hand() {

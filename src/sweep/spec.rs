@@ -9,6 +9,7 @@ use super::member::Member;
 use super::pointer;
 use super::request::{AxisKind, Bounds, Design, InvalidRuns, Policy, Spacing, SweepAxis, SweepRequest};
 use super::sampling::Law;
+use super::table;
 use crate::processes::FieldError;
 
 /// The values an axis takes.
@@ -314,11 +315,13 @@ fn check_axis(
         }
         return None;
     }
-    // Integer targets (an integer in the base, or integer bounds for a new member) get integers.
-    let base_is_integer = base.as_ref().is_some_and(|v| v.is_i64() || v.is_u64());
+    // Integer targets (a seed, an integer in the base, or integer bounds for a new member)
+    // get integers.
+    let seed = table::is_seed(target);
+    let base_is_integer = seed || base.as_ref().is_some_and(|v| v.is_i64() || v.is_u64());
     let integer_target = |bounds: [&Number; 2]| match &base {
         Some(_) => base_is_integer,
-        None => bounds.iter().all(|n| is_integer(n)),
+        None => seed || bounds.iter().all(|n| is_integer(n)),
     };
     let checked = match kind {
         AxisKind::Values => match &given.values {

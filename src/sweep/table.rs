@@ -30,6 +30,13 @@ pub struct Table {
 /// Fixed leading columns.
 pub const LEADING: [&str; 3] = ["run", "job", "status"];
 
+/// Whether a column (an axis pointer, `/bundle/gaps/seed`, or a metric, `gaps.seed`) is
+/// a random generator's seed: an integer that names a draw, not a quantity. Seeds are
+/// generated as integers and left out of the statistics.
+pub fn is_seed(column: &str) -> bool {
+    column.rsplit(['/', '.']).next() == Some("seed")
+}
+
 /// Builds the table of `records` for axes at `pointers`; metric columns in order of
 /// first appearance.
 pub fn build(pointers: &[String], records: &[RunRecord]) -> Table {
@@ -144,5 +151,21 @@ mod tests {
             table.to_csv(),
             "run,job,status,/contact/rk,sum\n0,a,successful,1.0,3\n1,b,failed,10.0,\n"
         );
+    }
+
+    #[test]
+    fn seeds_are_the_columns_named_seed() {
+        for seed in ["/bundle/gaps/seed", "/seed", "gaps.seed", "seed"] {
+            assert!(is_seed(seed), "{seed}");
+        }
+        for other in [
+            "/bundle/gaps/seeds",
+            "/seed/mean",
+            "reseed",
+            "/contact/rk",
+            "seed_count",
+        ] {
+            assert!(!is_seed(other), "{other}");
+        }
     }
 }

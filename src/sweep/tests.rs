@@ -167,3 +167,19 @@ fn a_body_that_is_no_object_is_refused_whole() {
         )]))
     );
 }
+
+/// A seed names a draw: it is generated as an integer even where the base holds a float
+/// and the bounds are floats, and for a new member.
+#[test]
+fn seeds_are_generated_as_integers() {
+    let sweep = spec(json!({"process": "p", "inputs": {"gaps": {"seed": 1.0}},
+        "axes": [{"pointer": "/gaps/seed", "uniform": [0.5, 1e9]},
+                 {"pointer": "/signal/seed", "linspace": [0.0, 1e9, 3]}],
+        "samples": 50, "seed": 9}));
+    for run in sweep.expand() {
+        for pointer in ["/gaps/seed", "/signal/seed"] {
+            let seed = &run.inputs.pointer(pointer).unwrap();
+            assert!(seed.is_u64(), "{pointer} of run {}: {seed}", run.index);
+        }
+    }
+}
