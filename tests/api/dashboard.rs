@@ -228,9 +228,10 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
         app.wait_for(&poor, &["successful"], within).await["status"],
         "successful"
     );
-    for sweep in [&calibration, &gaps] {
-        app.wait_for_sweep(sweep, &["successful"], within).await;
-    }
+    // The coarse steps of the stiffest contact are beyond the critical step: those runs
+    // fail, so the calibration sweep is partial.
+    app.wait_for_sweep(&calibration, &["partial"], within).await;
+    app.wait_for_sweep(&gaps, &["successful"], within).await;
     let deadline = std::time::Instant::now() + within;
     let progress = loop {
         let progress = app.status(&slow).await["progress"].as_u64().unwrap();
@@ -431,6 +432,21 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
         contour[0]
     );
     assert!(dom.contains("data-results=\"9\""));
+    // The badge says the sweep is partial and how many runs failed.
+    let status = app.get_json(&format!("/sweeps/{calibration}")).await;
+    let failed = status["counts"]["failed"].as_u64().unwrap();
+    assert!(failed > 0, "{status}");
+    let badge = tags(&dom, "data-failed=");
+    assert_eq!(badge.len(), 1, "one sweep badge");
+    assert!(
+        badge[0].contains("data-status=\"partial\"") && number(badge[0], "data-failed") == failed as f64,
+        "{}",
+        badge[0]
+    );
+    assert!(
+        dom.contains(&format!("partial: {failed} of 9 failed")),
+        "the badge counts the failed runs"
+    );
     // The verdict counts of its runs, as aggregated.
     let poor = aggregate["aggregates"]["quality"]["poor"].as_u64().unwrap();
     assert!(
@@ -454,6 +470,15 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
         .map(|t| number(t, "data-count"))
         .sum();
     assert_eq!(counted, 8.0);
+    // Seeds are shown as the integers they are, in the results table.
+    let rows = app.sweep_results(&gaps).await["rows"].clone();
+    for row in rows.as_array().unwrap() {
+        let seed = row["/bundle/gaps/seed"].as_u64().expect("an integer seed");
+        assert!(
+            dom.contains(&format!("<td>{seed}</td>")),
+            "seed {seed} not shown as an integer"
+        );
+    }
 
     // A run refused for its time step: the submit form marks that very field.
     let refused = aggregate["rows"]

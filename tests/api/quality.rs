@@ -206,12 +206,7 @@ async fn sweep_rows_carry_the_verdict_and_the_aggregates_count_poor_runs_per_axi
         .unwrap();
     assert_eq!(coarse_entry["poor"], 2, "{coarse_entry}");
 
-    let csv = app
-        .get(&format!("/sweeps/{id}/results?format=csv"))
-        .await
-        .text()
-        .await
-        .unwrap();
+    let csv = app.sweep_csv(&id).await;
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let at = header.iter().position(|c| *c == "quality.verdict").unwrap();
     let poor_cells = csv

@@ -70,6 +70,13 @@ impl TestApp {
     pub async fn sweep_results(&self, id: &str) -> Value {
         self.get_json(&format!("/sweeps/{id}/results")).await
     }
+
+    /// The results table of a sweep as CSV (`format=csv`).
+    pub async fn sweep_csv(&self, id: &str) -> String {
+        let response = self.get(&format!("/sweeps/{id}/results?format=csv")).await;
+        assert_eq!(response.status(), StatusCode::OK);
+        response.text().await.unwrap()
+    }
 }
 
 fn sweep(inputs: Value, axes: Value) -> Value {
@@ -336,6 +343,115 @@ async fn a_failed_run_of_a_fail_fast_sweep_dismisses_the_rest_and_fails_the_swee
     assert_eq!(statuses, ["successful", "failed", "dismissed", "dismissed"]);
 }
 
+/// Under the `continue` policy every run ends: the sweep is `successful` only when none
+/// failed, `partial` when some did (the failed count in its status and in the list),
+/// `failed` when all did. `count-steps` fails at step `fail_at`, so the runs of 4 or more
+/// steps fail and the run of 3 does not.
+#[tokio::test]
+async fn a_sweep_whose_runs_failed_is_partial_or_failed_not_successful() {
+    let app = spawn_app().await;
+    let partial = app
+        .create_sweep(sweep(
+            json!({"steps": 1, "fail_at": 4}),
+            json!([{"pointer": "/steps", "values": [3, 4, 5, 6]}]),
+        ))
+        .await;
+    let failed = app
+        .create_sweep(sweep(
+            json!({"steps": 1, "fail_at": 4}),
+            json!([{"pointer": "/steps", "values": [4, 5]}]),
+        ))
+        .await;
+    let finished = ["successful", "partial", "failed", "dismissed"];
+    let status = app
+        .wait_for_sweep(&partial, &finished, Duration::from_secs(20))
+        .await;
+    assert_eq!(status["status"], "partial", "{status}");
+    assert_eq!(
+        status["counts"],
+        json!({"accepted": 0, "running": 0, "successful": 1, "failed": 3, "dismissed": 0})
+    );
+    assert_eq!(status["progress"], 100);
+    assert!(status["finished"].is_string(), "{status}");
+    assert_eq!(app.sweep_results(&partial).await["status"], "partial");
+
+    let status = app
+        .wait_for_sweep(&failed, &finished, Duration::from_secs(20))
+        .await;
+    assert_eq!(status["status"], "failed", "{status}");
+    assert_eq!(status["counts"]["failed"], 2, "{status}");
+    assert_eq!(status["counts"]["successful"], 0, "{status}");
+
+    let list = app.get_json("/sweeps").await;
+    let listed: Vec<(&str, &Value)> = list["sweeps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| (s["status"].as_str().unwrap(), &s["counts"]["failed"]))
+        .collect();
+    assert_eq!(listed, [("failed", &json!(2)), ("partial", &json!(3))]);
+}
+
+/// `Accept: text/csv` without `format` gives the table as CSV, the same bytes as
+/// `format=csv`; JSON stays the default, wins when listed first, and `format` overrides
+/// `Accept`. The response varies with `Accept`.
+#[tokio::test]
+async fn sweep_results_honour_accept_text_csv() {
+    let app = spawn_app().await;
+    let id = app
+        .create_sweep(sweep(
+            json!({"steps": 1}),
+            json!([{"pointer": "/steps", "values": [1, 2]}]),
+        ))
+        .await;
+    app.wait_for_sweep(&id, &["successful"], Duration::from_secs(20))
+        .await;
+    let path = format!("/sweeps/{id}/results");
+    let get = |query: &'static str, accept: Option<&'static str>| {
+        let mut request = app.client.get(app.url(&format!("{path}{query}")));
+        if let Some(accept) = accept {
+            request = request.header("accept", accept);
+        }
+        async move {
+            let response = request.send().await.unwrap();
+            assert_eq!(response.status(), StatusCode::OK);
+            let vary = response
+                .headers()
+                .get("vary")
+                .map(|v| v.to_str().unwrap().to_lowercase());
+            assert_eq!(vary.as_deref(), Some("accept"));
+            let content_type = response.headers()["content-type"].to_str().unwrap().to_owned();
+            (content_type, response.text().await.unwrap())
+        }
+    };
+    let (explicit_type, explicit) = get("?format=csv", None).await;
+    assert!(explicit_type.starts_with("text/csv"), "{explicit_type}");
+    for accept in [
+        "text/csv",
+        "text/csv, application/json;q=0.5",
+        "text/csv;q=0.9, */*;q=0.1",
+    ] {
+        let (content_type, body) = get("", Some(accept)).await;
+        assert!(
+            content_type.starts_with("text/csv"),
+            "Accept {accept}: {content_type}"
+        );
+        assert_eq!(body, explicit, "Accept {accept}");
+    }
+    assert!(explicit.starts_with("run,job,status,/steps,"), "{explicit}");
+    assert_eq!(explicit.lines().count(), 3, "a header and two runs: {explicit}");
+    for (query, accept) in [
+        ("", None),
+        ("", Some("application/json, text/csv")),
+        ("?format=json", Some("text/csv")),
+    ] {
+        let (content_type, body) = get(query, accept).await;
+        assert_eq!(content_type, "application/json", "{query} {accept:?}");
+        let document: Value = serde_json::from_str(&body).unwrap();
+        assert_eq!(document["rows"].as_array().unwrap().len(), 2);
+    }
+}
+
 #[tokio::test]
 async fn monte_carlo_aggregates_match_the_law_and_the_rows() {
     let app = spawn_app().await;
@@ -479,9 +595,15 @@ async fn a_calibration_grid_maps_validity_shrinking_as_rk_and_time_step_grow() {
         {"pointer": "/solver/time_step", "values": [1e-5, 3e-5, 1e-4]}
     ]);
     let id = app.create_sweep(body).await;
-    app.wait_for_sweep(&id, &["successful"], Duration::from_secs(120))
+    let status = app
+        .wait_for_sweep(&id, &["partial"], Duration::from_secs(120))
         .await;
+    assert!(
+        status["counts"]["failed"].as_i64().unwrap() >= 1,
+        "the runs beyond the critical step failed, so the sweep is partial: {status}"
+    );
     let results = app.sweep_results(&id).await;
+    assert_eq!(results["status"], "partial");
     let calibration = &results["aggregates"]["calibration"];
     let valid: Vec<bool> = calibration["cells"]
         .as_array()
@@ -626,7 +748,21 @@ async fn a_random_gap_campaign_tabulates_peak_forces_per_contact() {
             "the overall peak is the largest contact peak: {row}"
         );
     }
-    let force = &results["aggregates"]["statistics"][0]["metrics"]["max_contact_force.force"];
+    let statistics = &results["aggregates"]["statistics"][0]["metrics"];
+    assert!(
+        statistics.get("/bundle/gaps/seed").is_none(),
+        "no statistics of a seed: {statistics}"
+    );
+    let csv = app.sweep_csv(&id).await;
+    let seeds: Vec<String> = rows
+        .iter()
+        .map(|row| row["/bundle/gaps/seed"].to_string())
+        .collect();
+    for (line, seed) in csv.lines().skip(1).zip(&seeds) {
+        let cell = line.split(',').nth(3).unwrap();
+        assert_eq!(cell, seed, "the seed column of the CSV, as an integer: {line}");
+    }
+    let force = &statistics["max_contact_force.force"];
     assert_eq!(force["count"], 3, "{force}");
     assert!(force["min"].as_f64().unwrap() <= force["q50"].as_f64().unwrap());
     assert!(force["q50"].as_f64().unwrap() <= force["max"].as_f64().unwrap());

@@ -3,7 +3,7 @@
 //! both make, and [`respond`], which finds the history of a successful job, renders it
 //! off the runtime and sends it with an entity tag.
 
-use axum::http::HeaderMap;
+use axum::http::{HeaderMap, header};
 use axum::response::Response;
 
 use super::AppState;
@@ -34,7 +34,21 @@ impl Format {
         }
     }
 
-    fn content_type(self) -> &'static str {
+    /// CSV when `Accept` names `text/csv` before (or without) `application/json`.
+    pub(super) fn preferred(headers: &HeaderMap) -> Format {
+        let accept = headers
+            .get(header::ACCEPT)
+            .and_then(|v| v.to_str().ok())
+            .unwrap_or_default();
+        let csv = match (accept.find("text/csv"), accept.find("application/json")) {
+            (Some(c), Some(j)) => c < j,
+            (Some(_), None) => true,
+            _ => false,
+        };
+        if csv { Format::Csv } else { Format::Json }
+    }
+
+    pub(super) fn content_type(self) -> &'static str {
         match self {
             Format::Csv => "text/csv; charset=utf-8",
             Format::Json => "application/json",

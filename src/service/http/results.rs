@@ -136,7 +136,7 @@ pub async fn output(
     ApiQuery(mut query): ApiQuery<HistoryQuery>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
-    let format = Format::from_query(query.format.as_deref(), preferred_format(&headers))?;
+    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
     require_finite([("t_start", query.t_start), ("t_end", query.t_end)], "s")?;
     // However long the history, a response holds at most the service's cap.
     query.max_points = Some(capped_max_points(query.max_points, state.max_history_points)?);
@@ -170,18 +170,4 @@ fn render(stored: &store::StoredHistory, query: &HistoryQuery, format: Format) -
         series: Series::from_columns(selected.series),
     };
     serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
-}
-
-/// CSV when `Accept` names `text/csv` before (or without) `application/json`.
-fn preferred_format(headers: &HeaderMap) -> Format {
-    let accept = headers
-        .get(header::ACCEPT)
-        .and_then(|v| v.to_str().ok())
-        .unwrap_or_default();
-    let csv = match (accept.find("text/csv"), accept.find("application/json")) {
-        (Some(c), Some(j)) => c < j,
-        (Some(_), None) => true,
-        _ => false,
-    };
-    if csv { Format::Csv } else { Format::Json }
 }

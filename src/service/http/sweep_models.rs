@@ -11,7 +11,9 @@ use crate::service::queue::sweep_read::SweepCounts;
 /// Link relation of results (OGC API – Processes).
 const RESULTS_REL: &str = "http://www.opengis.net/def/rel/ogc/1.0/results";
 
-/// Status of a sweep.
+/// Status of a sweep: `accepted` (no run started), `running`, then once every run
+/// ended `successful` (none failed), `partial` (some succeeded, `counts.failed` failed)
+/// or `failed` (none succeeded; under `fail_fast`, the first failure); `dismissed`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum SweepState {
@@ -19,12 +21,28 @@ pub enum SweepState {
     Accepted,
     /// Some runs have started or ended, some have not.
     Running,
-    /// Every run ended (under the `continue` policy, some may have failed: see `counts`).
+    /// Every run ended and none failed (runs dismissed one by one aside).
     Successful,
-    /// A run failed under the `fail_fast` policy; the runs not finished were dismissed.
+    /// Every run ended, some successful and some failed (`counts.failed` of them).
+    Partial,
+    /// Every run ended and none succeeded because runs failed; or, under the `fail_fast`
+    /// policy, a run failed and the runs not finished were dismissed.
     Failed,
-    /// Dismissed by `DELETE /sweeps/{sweepId}`.
+    /// Dismissed by `DELETE /sweeps/{sweepId}`, or every run dismissed one by one.
     Dismissed,
+}
+
+impl SweepState {
+    /// The state of a sweep whose runs all ended: `failed` runs make it `partial`, or
+    /// `failed` when no run succeeded.
+    fn ended(counts: &SweepCounts) -> Self {
+        match (counts.successful, counts.failed) {
+            (0, 0) if counts.dismissed > 0 => SweepState::Dismissed,
+            (_, 0) => SweepState::Successful,
+            (0, _) => SweepState::Failed,
+            _ => SweepState::Partial,
+        }
+    }
 }
 
 /// Number of runs in each job status.
@@ -76,7 +94,7 @@ impl SweepStatus {
         } else if record.policy == "fail_fast" && counts.failed > 0 {
             SweepState::Failed
         } else if counts.pending() == 0 {
-            SweepState::Successful
+            SweepState::ended(counts)
         } else if counts.running > 0 || ended > 0 {
             SweepState::Running
         } else {
@@ -165,7 +183,7 @@ pub struct SweepResults {
     #[schema(value_type = Vec<Object>)]
     pub rows: Vec<serde_json::Map<String, serde_json::Value>>,
     /// `statistics` (random designs: per grid cell of the list axes, count, mean, std,
-    /// min, max, q05, q50, q95 of every numeric column over the successful runs) or
+    /// min, max, q05, q50, q95 of every numeric column but seeds over the successful runs) or
     /// `calibration` (grids with `comparison.f_err`: validity map, cheapest valid
     /// `/solver/time_step`, `/beam/modes`, `/beam/elements`); and `quality` when the
     /// runs carry a verdict: `{"runs", "good", "doubtful", "poor", "by_axis": [{"axis",

@@ -10,6 +10,7 @@ use super::AppState;
 use super::conditional::tagged;
 use super::error::ApiError;
 use super::extract::{ApiQuery, JsonBody};
+use super::history_view::Format;
 use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
 use super::models::Link;
 use super::sweep_models::{SweepList, SweepResults, SweepStatus};
@@ -279,7 +280,8 @@ pub async fn dismiss(
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct SweepResultsQuery {
-    /// `json` (default: the table with aggregates) or `csv` (the table only).
+    /// `json` (the table with aggregates) or `csv` (the table only); default: JSON, or
+    /// CSV when `Accept` prefers `text/csv`.
     #[param(pattern = "^(csv|json)$")]
     pub format: Option<String>,
 }
@@ -290,7 +292,7 @@ pub struct SweepResultsQuery {
 /// axis values (columns named by pointer), then the run's scalar results flattened with
 /// dots (`quality.verdict` and the numeric quality fields among them). JSON adds the
 /// aggregates, with the count of `poor` (and `doubtful`) runs in total and per axis
-/// value; `format=csv` gives the table alone.
+/// value; `format=csv`, or `Accept: text/csv` without a `format`, gives the table alone.
 #[utoipa::path(get, path = "/sweeps/{sweepId}/results", operation_id = "getSweepResults", tag = "Sweeps",
     params(("sweepId" = String, Path, description = "Sweep id"), SweepResultsQuery),
     responses(
@@ -308,15 +310,8 @@ pub async fn results(
     ApiQuery(query): ApiQuery<SweepResultsQuery>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
-    let csv = match query.format.as_deref() {
-        None | Some("json") => false,
-        Some("csv") => true,
-        Some(other) => {
-            return Err(
-                Problem::invalid_query(format!("`format` must be `csv` or `json`, not `{other}`")).into(),
-            );
-        }
-    };
+    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
+    let csv = format == Format::Csv;
     let record = find(&state, &tenant, &sweep_id).await?;
     let status = sweep_status(&state, &tenant, &record).await?;
     let runs = state.queue.ended_sweep_runs(tenant.as_str(), &sweep_id).await?;
@@ -326,12 +321,9 @@ pub async fn results(
         tokio::task::spawn_blocking(move || render_results(&record, status, runs, process.as_deref(), csv))
             .await
             .map_err(|e| ApiError::Internal(format!("rendering sweep results panicked: {e}")))??;
-    let content_type = if csv {
-        "text/csv; charset=utf-8"
-    } else {
-        "application/json"
-    };
-    Ok(tagged(&headers, content_type, body, HeaderMap::new()))
+    let mut extra = HeaderMap::new();
+    extra.insert(header::VARY, HeaderValue::from_static("accept"));
+    Ok(tagged(&headers, format.content_type(), body, extra))
 }
 
 fn render_results(

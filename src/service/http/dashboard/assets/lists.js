@@ -1,7 +1,8 @@
 // The home page, the job list and the sweep list. Lists refresh themselves: every second
 // while something in them is queued or running (progress bars move), every 5 s otherwise.
 
-import {FINISHED, api, badge, card, errorBox, fmtElapsed, fmtTime, h, progressBar, replace, shortId} from './util.js';
+import {FINISHED, api, badge, card, errorBox, fmtElapsed, fmtTime, h, progressBar, replace, shortId, sweepBadge}
+  from './util.js';
 
 const STATUSES = ['accepted', 'running', 'successful', 'failed', 'dismissed'];
 
@@ -58,7 +59,7 @@ function sweepTable(sweeps) {
       h('td', {}, h('a', {href: `/sweeps/${sweep.sweepID}`, title: sweep.sweepID, class: 'mono'}, shortId(sweep.sweepID))),
       h('td', {}, sweep.processID),
       h('td', {}, sweep.design),
-      h('td', {}, badge(sweep.status)),
+      h('td', {}, sweepBadge(sweep)),
       h('td', {}, FINISHED.has(sweep.status) ? '' : progressBar(sweep.progress, sweep.status)),
       h('td', {}, `${sweep.runs}`, h('div', {class: 'message'}, countsText(sweep.counts))),
       h('td', {}, fmtTime(sweep.created)),

@@ -2,8 +2,8 @@
 // two axes with its 0.2 contour, histograms of Monte Carlo metrics, the quality verdicts
 // of the runs (how many poor, per axis value), and the results table.
 
-import {FINISHED, api, badge, card, download, errorBox, fmt, fmtTime, h, keyValueTable, poll, progressBar, replace,
-  shortId} from './util.js';
+import {FINISHED, api, badge, card, download, errorBox, fmt, fmtColumn, fmtTime, h, keyValueTable, poll, progressBar,
+  replace, shortId, sweepBadge} from './util.js';
 import {heatMap, histogram, linePlot} from './plot.js';
 
 /** Rows of the results table shown on the page (the CSV has them all). */
@@ -50,7 +50,7 @@ function statusTable(id, status) {
   return [
     keyValueTable([
       ['Process', status.processID],
-      ['Status', badge(status.status)],
+      ['Status', sweepBadge(status)],
       ['Progress', running ? progressBar(status.progress, status.status) : `${status.progress} %`],
       ['Runs', h('span', {'data-runs': status.runs}, `${status.runs}: ${c.successful} successful, ${c.failed} failed, ` +
         `${c.running} running, ${c.accepted} queued, ${c.dismissed} dismissed`)],
@@ -116,7 +116,7 @@ function qualityCard(quality) {
   for (const axis of quality.by_axis || []) {
     for (const entry of axis.values) {
       rows.push(h('tr', {}, h('th', {}, h('code', {}, axis.axis)),
-        h('td', {}, typeof entry.value === 'number' ? fmt(entry.value, 6) : JSON.stringify(entry.value)), counts(entry)));
+        h('td', {}, typeof entry.value === 'number' ? fmtColumn(entry.value, axis.axis, 6) : JSON.stringify(entry.value)), counts(entry)));
     }
   }
   return card('Quality of the runs',
@@ -157,7 +157,7 @@ function calibrationCard(calibration, axes, jobOf) {
         draw();
       }}, values[p].map((v, k) => h('option', {value: k, selected: same(v, state.fixed[p])}, fmt(v)))))));
     const shown = cells.filter((c) => others.every((p) => same(c.parameters[p], state.fixed[p])));
-    const label = (c) => axes.map((p) => `${p} = ${fmt(c.parameters[p])}`).join(', ');
+    const label = (c) => axes.map((p) => `${p} = ${fmtColumn(c.parameters[p], p)}`).join(', ');
     const title = 'f_err over the grid';
     if (!state.y) {
       replace(mapBox, linePlot({id: 'calibration', title, xLabel: state.x, yLabel: 'f_err', logY: true,
@@ -207,7 +207,7 @@ function monteCarloCard(groups, doc, definition) {
   const listAxes = Object.keys(groups[0].cell || {});
   const plotBox = h('div');
   const tableBox = h('div');
-  const cellLabel = (g) => Object.entries(g.cell).map(([p, v]) => `${p} = ${fmt(v)}`).join(', ') || 'all runs';
+  const cellLabel = (g) => Object.entries(g.cell).map(([p, v]) => `${p} = ${fmtColumn(v, p)}`).join(', ') || 'all runs';
   const draw = () => {
     const group = groups[state.cell];
     const stats = group.metrics[state.metric] || {};
@@ -244,7 +244,7 @@ function tableCard(doc) {
     const value = row[column];
     if (column === 'job') return h('a', {href: `/jobs/${value}`, class: 'mono'}, shortId(value));
     if (column === 'status') return badge(value);
-    return value === undefined ? '' : fmt(value);
+    return value === undefined ? '' : fmtColumn(value, column);
   };
   return card(`Results (${doc.rows.length} of ${doc.runs} runs ended)`,
     h('div', {class: 'scroll'}, h('table', {class: 'list results', 'data-results': doc.rows.length},

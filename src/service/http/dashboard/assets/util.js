@@ -143,7 +143,7 @@ export function poll(step, interval = 1000) {
   return () => { stopped = true; };
 }
 
-export const FINISHED = new Set(['successful', 'failed', 'dismissed']);
+export const FINISHED = new Set(['successful', 'partial', 'failed', 'dismissed']);
 
 /** A number with `digits` significant digits, in exponent form when very small or large. */
 export function fmt(value, digits = 4) {
@@ -156,6 +156,18 @@ export function fmt(value, digits = 4) {
     return value.toExponential(digits - 1).replace(/\.?0+e/, 'e');
   }
   return String(Number(value.toPrecision(digits)));
+}
+
+/** Whether a column (an axis pointer or a dotted metric) is a random generator's seed. */
+export function isSeed(column) {
+  return /(^|[/.])seed$/.test(String(column));
+}
+
+/** A value of a results column: a seed exactly as the integer it is (it names a draw:
+ *  `573700123`, never `5.737e+8`), anything else as fmt does. */
+export function fmtColumn(value, column, digits = 4) {
+  if (isSeed(column) && Number.isInteger(value)) return String(value);
+  return fmt(value, digits);
 }
 
 /** A number with its unit: fmt(v) + ' ' + unit. */
@@ -192,6 +204,16 @@ export function shortId(id) {
 export function badge(status) {
   const label = status === 'accepted' ? 'queued' : status;
   return h('span', {class: `badge ${status}`, 'data-status': status}, label);
+}
+
+/** The badge of a sweep: its status, with how many runs failed when some did
+ *  (`partial: 2 of 32 failed`). */
+export function sweepBadge(sweep) {
+  const failed = (sweep.counts && sweep.counts.failed) || 0;
+  const element = badge(sweep.status);
+  if (failed > 0) element.textContent = `${element.textContent}: ${failed} of ${sweep.runs} failed`;
+  element.setAttribute('data-failed', failed);
+  return element;
 }
 
 /** A progress bar for a percentage 0–100; `data-value` holds the fraction 0–1. */
