@@ -404,3 +404,246 @@ fn a_contact_between_two_pins_exchanges_equal_and_opposite_impulses() {
         }
     }
 }
+
+/// The wear work is ∫ F |v_t| dt with v_t = t·(u̇_L − u̇_R), t = (−n_y, n_x), at the
+/// contact: recomputed from the force and deflection histories recorded at every step
+/// (sliding speed by central differences), it agrees to O((ωΔt)²).
+#[test]
+fn wear_work_is_the_integral_of_force_times_sliding_speed() {
+    let basis = basis(8);
+    let model = triangle(&basis);
+    let dt = 2e-6;
+    let settings = Settings {
+        output_interval: None,
+        output_heights: vec![1.0, 0.6],
+        ..settings(dt, 0.03)
+    };
+    let result = run(&model, &settings);
+    let normals = &model.plane.as_ref().expect("a plane model").normals;
+    let pins = model.pins;
+    let mut worn = 0;
+    for (c, contact) in model.contacts.iter().enumerate() {
+        let lines = &result.deflections[if contact.height == 1.0 { 0 } else { 1 }];
+        // Displacement of a body along x (axis 0) or y (axis 1) at sample k.
+        let u = |body: Body, axis: usize, k: usize| match body {
+            Body::Wall => 0.0,
+            Body::Pin(p) => lines[axis * pins + p][k],
+        };
+        let [nx, ny] = normals[c];
+        let slide = |k: usize| {
+            let relative = |axis| u(contact.left, axis, k) - u(contact.right, axis, k);
+            -ny * relative(0) + nx * relative(1)
+        };
+        let forces = &result.contact_forces[c];
+        let expected: f64 = (1..forces.len() - 1)
+            .map(|k| forces[k] * ((slide(k + 1) - slide(k - 1)) / (2.0 * dt)).abs() * dt)
+            .sum();
+        worn += usize::from(expected > 0.0);
+        assert_close(
+            &format!("wear of contact {c}"),
+            result.wear_work[c],
+            expected,
+            2e-3,
+            expected,
+        );
+    }
+    assert!(
+        worn > 10,
+        "most contacts slide: {worn} of {}",
+        model.contacts.len()
+    );
+}
+
+/// The plane's normals (one per contact, finite, unit length to 1e-9), its y
+/// excitation and the recorded contacts (existing, each once) are checked before the
+/// run, each problem named by its slash path.
+#[test]
+fn bad_normals_and_recorded_contacts_are_refused_with_their_paths() {
+    let basis = basis(4);
+    let fields = |issues: Vec<crate::InputIssue>| issues.into_iter().map(|i| i.field).collect::<Vec<_>>();
+    let mut model = triangle(&basis);
+    assert_eq!(model.validate(), vec![]);
+    let plane = model.plane.as_mut().expect("a plane model");
+    plane.normals[2] = [1.0 + 0.5 * NORMAL_LENGTH_TOLERANCE, 0.0];
+    plane.normals[3] = [0.6, 0.81];
+    plane.normals[5] = [f64::NAN, 0.0];
+    plane.normals[7] = [0.0, 0.0];
+    plane.base_acceleration_y = Some(BaseAcceleration::HalfSine {
+        amplitude: 1.0,
+        duration: -1.0,
+    });
+    assert_eq!(
+        fields(model.validate()),
+        [
+            "plane/normals/3",
+            "plane/normals/5",
+            "plane/normals/7",
+            "plane/base_acceleration_y/duration"
+        ]
+    );
+    let mut model = triangle(&basis);
+    model.plane.as_mut().expect("a plane model").normals.pop();
+    let settings = settings(1e-6, 0.01);
+    let Err(SimulationError::InvalidModel(issues)) = Plan::new(&model, &settings) else {
+        panic!("a normal short must be refused");
+    };
+    assert_eq!(fields(issues), ["plane/normals"]);
+
+    let model = triangle(&basis);
+    let settings = Settings {
+        recorded_contacts: Some(vec![0, 18, 3, 0]),
+        ..settings
+    };
+    let Err(SimulationError::InvalidSettings(issues)) = Plan::new(&model, &settings) else {
+        panic!("contact 18 of 18 must be refused");
+    };
+    assert_eq!(fields(issues), ["recorded_contacts/1", "recorded_contacts/3"]);
+}
+
+/// The same plane run twice gives the same results bit for bit, and the scalar
+/// fallback (one level per lane, every contact its own group) agrees with this CPU's
+/// SIMD level (four levels per lane with AVX2, the wall pairs in separate groups) to
+/// rounding.
+#[test]
+fn plane_runs_are_deterministic_and_agree_on_every_simd_level() {
+    let basis = basis(7);
+    let model = triangle(&basis);
+    let settings = Settings {
+        time_step: TimeStep::Auto,
+        ..settings(0.0, 0.03)
+    };
+    let plan = Plan::new(&model, &settings).expect("a valid model");
+    let on = |arch| {
+        plan.run_on(arch, &mut |_| ControlFlow::Continue(()))
+            .expect("runs")
+            .simulation
+    };
+    let (first, second) = (on(pulp::Arch::new()), on(pulp::Arch::new()));
+    assert_eq!(first, second);
+    let scalar = on(pulp::Arch::Scalar);
+    let peak_force = peak(&first.contact_forces);
+    for (c, (s, v)) in scalar
+        .contact_forces
+        .iter()
+        .zip(&first.contact_forces)
+        .enumerate()
+    {
+        for (k, (a, b)) in s.iter().zip(v).enumerate() {
+            assert_close(
+                &format!("force of contact {c} at sample {k}"),
+                *b,
+                *a,
+                1e-9,
+                peak_force,
+            );
+        }
+    }
+    for (c, (s, v)) in scalar
+        .contact_statistics
+        .iter()
+        .zip(&first.contact_statistics)
+        .enumerate()
+    {
+        assert_eq!(s.impacts, v.impacts, "impacts of contact {c}");
+        assert_close(
+            &format!("impulse of contact {c}"),
+            v.impulse,
+            s.impulse,
+            1e-9,
+            1e-3 + s.impulse,
+        );
+    }
+    for (c, (s, v)) in scalar.wear_work.iter().zip(&first.wear_work).enumerate() {
+        assert_close(&format!("wear of contact {c}"), *v, *s, 1e-9, 1e-6 + s);
+    }
+}
+
+/// Only the recorded contacts have histories, in the order asked, identical to the ones
+/// of a run that records every contact; statistics and wear cover every contact.
+#[test]
+fn only_the_recorded_contacts_have_histories_in_their_order() {
+    let basis = basis(6);
+    let model = triangle(&basis);
+    let every = settings(2e-6, 0.02);
+    let recorded = vec![7, 0, 12];
+    let some = Settings {
+        recorded_contacts: Some(recorded.clone()),
+        ..every.clone()
+    };
+    let (all, thinned) = (run(&model, &every), run(&model, &some));
+    assert_eq!(thinned.contact_forces.len(), recorded.len());
+    for (k, c) in recorded.iter().enumerate() {
+        assert_eq!(thinned.contact_forces[k], all.contact_forces[*c], "contact {c}");
+        assert_eq!(
+            thinned.contact_force_peaks[k], all.contact_force_peaks[*c],
+            "contact {c}"
+        );
+    }
+    assert!(peak(&thinned.contact_forces) > 0.0, "the recorded contacts close");
+    assert_eq!(thinned.contact_statistics, all.contact_statistics);
+    assert_eq!(thinned.wear_work, all.wear_work);
+    assert_eq!(thinned.deflections, all.deflections);
+}
+
+/// The plane's critical step is the true stability limit, as on the row: a pin held by
+/// a constant force along x against a stiff wall spring whose normal is oblique stays
+/// in contact; 1 % below the critical step the run is bounded, 1 % above it diverges.
+#[test]
+fn the_planes_critical_step_matches_brute_force_divergence() {
+    let basis = basis(4);
+    let model = Model {
+        basis: &basis,
+        pins: 1,
+        damping_ratios: vec![0.0; basis.modes()],
+        contacts: vec![Contact {
+            left: Body::Wall,
+            right: Body::Pin(0),
+            height: 1.0,
+            gap: 0.0,
+            stiffness: 1e6,
+            damping: 0.0,
+        }],
+        initial_tip_displacements: vec![0.0],
+        base_acceleration: None,
+        // Toward the wall: δ = n·(0 − u) = −0.6 u_x − 0.8 u_y > 0 for u_x < 0.
+        point_forces: vec![crate::loads::PointForce {
+            pin: 0,
+            height: 1.0,
+            force: crate::loads::Table {
+                time: vec![0.0, 10.0],
+                values: vec![-1.0, -1.0],
+            },
+        }],
+        plane: Some(Plane {
+            normals: vec![[0.6, 0.8]],
+            base_acceleration_y: None,
+        }),
+    };
+    let critical = critical_time_step(&model, Scheme::CentralDifference);
+    let row = Model {
+        plane: None,
+        ..model.clone()
+    };
+    assert_close(
+        "critical step, one contact: the plane's is the row's",
+        critical,
+        critical_time_step(&row, Scheme::CentralDifference),
+        1e-9,
+        critical,
+    );
+    let below = settings(0.99 * critical, 2000.0 * critical);
+    let stable = simulate(&model, &below, &mut |_| ControlFlow::Continue(()));
+    assert!(stable.is_ok(), "stable below critical: {:?}", stable.err());
+    let contact_time = stable.expect("checked").contact_statistics[0].contact_time;
+    assert!(
+        contact_time > 1000.0 * critical,
+        "the contact stays closed: {contact_time:e} s"
+    );
+    let above = Plan::unchecked(&model, &below, 1.01 * critical)
+        .and_then(|plan| plan.run(&mut |_| ControlFlow::Continue(())));
+    assert!(
+        matches!(above, Err(SimulationError::Diverged { .. })),
+        "diverges above critical: {:?}",
+        above.map(|a| a.simulation.energy)
+    );
+}
