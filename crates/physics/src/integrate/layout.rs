@@ -20,7 +20,7 @@
 
 use super::kernels::{ContactLanes, Lanes, LevelShapes, PlaneGroups};
 use super::{Model, Settings, StepSize};
-use crate::contact::Body;
+use crate::contact::{Body, Contact};
 use crate::stability::Scheme;
 
 /// The fixed data of one run at one step, for one SIMD level.
@@ -119,6 +119,41 @@ fn padded(values: &[f64], row: usize, fill: f64) -> Vec<f64> {
     out
 }
 
+/// The contact levels reordered so that levels where the same pairs of bodies touch
+/// are consecutive: `(heights, contact_level)` in the new order. A group of lanes holds
+/// one pair at `lanes` consecutive levels; in a wire-wrapped bundle the pattern of
+/// touching pairs turns by 60° from one level to the next and comes back every wire
+/// lead, so in the order of the heights a group would hold one contact in `lanes`,
+/// and in this order it is full. (The row's levels all hold the same pairs.)
+fn by_contact_pattern(
+    heights: &[f64],
+    contact_level: &[usize],
+    contacts: &[Contact],
+) -> (Vec<f64>, Vec<usize>) {
+    let side = |body: Body| match body {
+        Body::Wall => None,
+        Body::Pin(pin) => Some(pin),
+    };
+    let mut patterns = vec![Vec::new(); heights.len()];
+    for (contact, level) in contacts.iter().zip(contact_level) {
+        patterns[*level].push((side(contact.left), side(contact.right)));
+    }
+    for pattern in &mut patterns {
+        pattern.sort_unstable();
+    }
+    // Equal patterns side by side (then by height order), similar ones close.
+    let mut order: Vec<usize> = (0..heights.len()).collect();
+    order.sort_by(|a, b| patterns[*a].cmp(&patterns[*b]).then(a.cmp(b)));
+    let mut new_level = vec![0; heights.len()];
+    for (new, old) in order.iter().enumerate() {
+        new_level[*old] = new;
+    }
+    (
+        order.iter().map(|old| heights[*old]).collect(),
+        contact_level.iter().map(|old| new_level[*old]).collect(),
+    )
+}
+
 /// Index of `value` in `levels`, appended if new.
 fn level_of(levels: &mut Vec<f64>, value: f64) -> usize {
     match levels.iter().position(|h| *h == value) {
@@ -146,11 +181,14 @@ impl<'m> Layout<'m> {
             .collect();
 
         let mut heights: Vec<f64> = Vec::new();
-        let contact_level: Vec<usize> = model
+        let mut contact_level: Vec<usize> = model
             .contacts
             .iter()
             .map(|c| level_of(&mut heights, c.height))
             .collect();
+        if model.plane.is_some() {
+            (heights, contact_level) = by_contact_pattern(&heights, &contact_level, &model.contacts);
+        }
         // The output heights are levels too (with no contact unless one is there).
         let output_levels: Vec<usize> = settings
             .output_heights

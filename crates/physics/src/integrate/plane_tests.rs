@@ -647,3 +647,96 @@ fn the_planes_critical_step_matches_brute_force_divergence() {
         above.map(|a| a.simulation.energy)
     );
 }
+
+/// A synthetic bundle the size of the 217-pin hexagonal one: pins on a hexagonal
+/// lattice of 8 rings, 120 levels, at each level about half the neighbour pairs along
+/// one of the three lattice directions and the outer pins against the wrapper
+/// (about 14 000 contacts), 20 modes, shaken along x and y. Prints its lane packing
+/// and steps per second: `cargo test -p chocmodal-physics --lib
+/// large_plane_speed -- --ignored --nocapture`.
+#[test]
+#[ignore = "a timing, not a check"]
+fn large_plane_speed() {
+    let basis = ModalBasis::compute(&default_tube(40), 20).expect("valid beam");
+    let rings = 8i64;
+    let mut pins = Vec::new();
+    for q in -rings..=rings {
+        for r in (-rings).max(-q - rings)..=rings.min(-q + rings) {
+            pins.push((q, r));
+        }
+    }
+    let index = |at: (i64, i64)| pins.iter().position(|p| *p == at);
+    let s3 = 3f64.sqrt() / 2.0;
+    let directions = [((1, 0), [1.0, 0.0]), ((0, 1), [0.5, s3]), ((-1, 1), [-0.5, s3])];
+    let (mut contacts, mut normals) = (Vec::new(), Vec::new());
+    let levels = 120;
+    for level in 0..levels {
+        let height = 0.1 + 0.85 * level as f64 / levels as f64;
+        let ((dq, dr), normal) = directions[level % 3];
+        for (p, &(q, r)) in pins.iter().enumerate() {
+            let (left, right) = match index((q + dq, r + dr)) {
+                Some(neighbour) if (p + level / 3) % 2 == 0 => (Body::Pin(p), Body::Pin(neighbour)),
+                None => (Body::Pin(p), Body::Wall),
+                Some(_) => continue,
+            };
+            contacts.push(Contact {
+                left,
+                right,
+                height,
+                gap: 1e-5 * (1.0 + (p % 7) as f64 / 7.0),
+                stiffness: 1e6,
+                damping: 10.0,
+            });
+            normals.push(normal);
+        }
+    }
+    let count = contacts.len();
+    let model = Model {
+        basis: &basis,
+        pins: pins.len(),
+        damping_ratios: vec![0.01; basis.modes()],
+        contacts,
+        initial_tip_displacements: vec![],
+        base_acceleration: Some(BaseAcceleration::HalfSine {
+            amplitude: 30.0,
+            duration: 0.005,
+        }),
+        point_forces: vec![],
+        plane: Some(Plane {
+            normals,
+            base_acceleration_y: Some(BaseAcceleration::HalfSine {
+                amplitude: 20.0,
+                duration: 0.005,
+            }),
+        }),
+    };
+    let settings = Settings {
+        time_step: TimeStep::Auto,
+        output_interval: Some(1e-3),
+        recorded_contacts: Some(vec![0, 1, 2]),
+        ..settings(0.0, 0.015)
+    };
+    let plan = Plan::new(&model, &settings).expect("a valid model");
+    let layout = super::layout::Layout::new(pulp::Arch::new(), &model, &settings, plan.step());
+    let groups = layout.contacts.left.len();
+    println!(
+        "{} pins, {count} contacts in {groups} groups of {} lanes ({:.0} % of lanes used)",
+        model.pins,
+        layout.lanes,
+        100.0 * count as f64 / (groups * layout.lanes) as f64
+    );
+    let start = std::time::Instant::now();
+    let result = plan
+        .run(&mut |_| ControlFlow::Continue(()))
+        .expect("runs")
+        .simulation;
+    let seconds = start.elapsed().as_secs_f64();
+    let impacts: u64 = result.contact_statistics.iter().map(|s| s.impacts).sum();
+    println!(
+        "{} steps in {seconds:.2} s: {:.0} steps/s ({:.1} µs/step), {impacts} impacts, energy residual {:.1e}",
+        result.steps,
+        result.steps as f64 / seconds,
+        1e6 * seconds / result.steps as f64,
+        result.energy.relative_residual()
+    );
+}
