@@ -333,10 +333,47 @@ pub(super) fn penetrations<S: Simd>(
     state: ContactState<'_>,
 ) -> usize {
     let groups = layout.left.len();
+    let (gaps, _) = S::as_simd_f64s(gaps);
+    let (now, _) = S::as_mut_simd_f64s(state.now);
+    let (max, _) = S::as_mut_simd_f64s(state.max);
     let (left, right) = (&layout.left[..groups], &layout.right[..groups]);
-    closed_lanes(simd, layout.lanes, gaps, state, |g| {
-        simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize])
-    })
+    let (gaps, now, max) = (&gaps[..groups], &mut now[..groups], &mut max[..groups]);
+    // The groups holding a closed lane, as bits: most groups hold none, one test each
+    // and no branch, no store at a data-dependent address.
+    let words = &mut state.closed_groups[..groups.div_ceil(64)];
+    for (w, word) in words.iter_mut().enumerate() {
+        let mut bits = 0u64;
+        for g in w * 64..groups.min(w * 64 + 64) {
+            let n = simd.sub_f64s(
+                simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize]),
+                gaps[g],
+            );
+            now[g] = n;
+            max[g] = simd.max_f64s(max[g], n);
+            bits |= u64::from(simd.reduce_max_f64s(n) > 0.0) << (g % 64);
+        }
+        *word = bits;
+    }
+    list_closed(layout.lanes, words, state.now, state.closed)
+}
+
+/// The lanes of the groups marked in `words` whose penetration `now` is positive,
+/// listed first in `closed`; returns how many.
+#[inline(always)]
+fn list_closed(lanes: usize, words: &[u64], now: &[f64], closed: &mut [u32]) -> usize {
+    let mut count = 0;
+    for (w, word) in words.iter().enumerate() {
+        let mut bits = *word;
+        while bits != 0 {
+            let g = w * 64 + bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            for lane in g * lanes..(g + 1) * lanes {
+                closed[count] = lane as u32;
+                count += usize::from(now[lane] > 0.0);
+            }
+        }
+    }
+    count
 }
 
 /// The y side of the plane's contact groups ([`plane_penetrations`]): the x side is the
@@ -368,55 +405,25 @@ pub(super) fn plane_penetrations<S: Simd>(
     let (normal_x, _) = S::as_simd_f64s(&plane.normal_x);
     let (normal_y, _) = S::as_simd_f64s(&plane.normal_y);
     let (normal_x, normal_y) = (&normal_x[..groups], &normal_y[..groups]);
-    closed_lanes(simd, layout.lanes, gaps, state, |g| {
-        let along_x = simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize]);
-        let along_y = simd.sub_f64s(deflections[left_y[g] as usize], deflections[right_y[g] as usize]);
-        simd.mul_add_e_f64s(normal_x[g], along_x, simd.mul_f64s(normal_y[g], along_y))
-    })
-}
-
-/// The common part of [`penetrations`] and [`plane_penetrations`]: with
-/// `approach(g)` the relative approach of group g's lanes, δ = approach − gap, running
-/// maxima, and the closed lanes listed first in `state.closed` (their count returned).
-#[inline(always)]
-fn closed_lanes<S: Simd>(
-    simd: S,
-    lanes: usize,
-    gaps: &[f64],
-    state: ContactState<'_>,
-    approach: impl Fn(usize) -> S::f64s,
-) -> usize {
     let (gaps, _) = S::as_simd_f64s(gaps);
-    let groups = gaps.len();
     let (now, _) = S::as_mut_simd_f64s(state.now);
     let (max, _) = S::as_mut_simd_f64s(state.max);
-    let (now, max) = (&mut now[..groups], &mut max[..groups]);
-    // The groups holding a closed lane, as bits: most groups hold none, one test each
-    // and no branch, no store at a data-dependent address.
+    let (gaps, now, max) = (&gaps[..groups], &mut now[..groups], &mut max[..groups]);
     let words = &mut state.closed_groups[..groups.div_ceil(64)];
     for (w, word) in words.iter_mut().enumerate() {
         let mut bits = 0u64;
         for g in w * 64..groups.min(w * 64 + 64) {
-            let n = simd.sub_f64s(approach(g), gaps[g]);
+            let along_x = simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize]);
+            let along_y = simd.sub_f64s(deflections[left_y[g] as usize], deflections[right_y[g] as usize]);
+            let approach = simd.mul_add_e_f64s(normal_x[g], along_x, simd.mul_f64s(normal_y[g], along_y));
+            let n = simd.sub_f64s(approach, gaps[g]);
             now[g] = n;
             max[g] = simd.max_f64s(max[g], n);
             bits |= u64::from(simd.reduce_max_f64s(n) > 0.0) << (g % 64);
         }
         *word = bits;
     }
-    let mut count = 0;
-    for (w, word) in words.iter().enumerate() {
-        let mut bits = *word;
-        while bits != 0 {
-            let g = w * 64 + bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            for lane in g * lanes..(g + 1) * lanes {
-                state.closed[count] = lane as u32;
-                count += usize::from(state.now[lane] > 0.0);
-            }
-        }
-    }
-    count
+    list_closed(layout.lanes, words, state.now, state.closed)
 }
 
 /// ½ Σ (v² + ωᵢ² q²) over every pin (`stiffness` = ωᵢ² per mode: one row of vectors).

@@ -103,13 +103,15 @@ enum Operation {
 }
 
 /// An operation on the state as a [`pulp::WithSimd`] operation: everything it inlines
-/// is compiled with the target features [`pulp::Arch`] detected at run time.
-struct StepOp<'a, 'm> {
+/// is compiled with the target features [`pulp::Arch`] detected at run time. `PLANE`
+/// picks the plane's contacts and modal update at compile time, so that the row's step
+/// is compiled alone, as if the plane did not exist.
+struct StepOp<'a, 'm, const PLANE: bool> {
     integrator: &'a mut Integrator<'m>,
     operation: Operation,
 }
 
-impl pulp::WithSimd for StepOp<'_, '_> {
+impl<const PLANE: bool> pulp::WithSimd for StepOp<'_, '_, PLANE> {
     type Output = ();
 
     #[inline(always)]
@@ -119,20 +121,20 @@ impl pulp::WithSimd for StepOp<'_, '_> {
         debug_assert_eq!(integrator.layout.lanes, lanes::<S>());
         match self.operation {
             Operation::Initial => {
-                integrator.contact_forces_and_statistics(simd, 0.0, false, vectors);
+                integrator.contact_forces_and_statistics::<S, PLANE>(simd, 0.0, false, vectors);
             }
             // The usual row lengths get a copy of the step where the row length is a
             // constant: every per-row loop is then unrolled, without bounds checks.
             Operation::Steps(steps) => match vectors {
-                1 => integrator.steps_body(simd, steps, 1),
-                2 => integrator.steps_body(simd, steps, 2),
-                3 => integrator.steps_body(simd, steps, 3),
-                4 => integrator.steps_body(simd, steps, 4),
-                5 => integrator.steps_body(simd, steps, 5),
-                6 => integrator.steps_body(simd, steps, 6),
-                7 => integrator.steps_body(simd, steps, 7),
-                8 => integrator.steps_body(simd, steps, 8),
-                _ => integrator.steps_body(simd, steps, vectors),
+                1 => integrator.steps_body::<S, PLANE>(simd, steps, 1),
+                2 => integrator.steps_body::<S, PLANE>(simd, steps, 2),
+                3 => integrator.steps_body::<S, PLANE>(simd, steps, 3),
+                4 => integrator.steps_body::<S, PLANE>(simd, steps, 4),
+                5 => integrator.steps_body::<S, PLANE>(simd, steps, 5),
+                6 => integrator.steps_body::<S, PLANE>(simd, steps, 6),
+                7 => integrator.steps_body::<S, PLANE>(simd, steps, 7),
+                8 => integrator.steps_body::<S, PLANE>(simd, steps, 8),
+                _ => integrator.steps_body::<S, PLANE>(simd, steps, vectors),
             },
         }
     }
@@ -152,10 +154,7 @@ impl<'m> Integrator<'m> {
         };
         // The state at t = 0: contacts already closed count as impacts at t = 0; a₀ from
         // equilibrium (velocities are zero).
-        arch.dispatch(StepOp {
-            integrator: &mut integrator,
-            operation: Operation::Initial,
-        });
+        integrator.dispatch(Operation::Initial);
         let Self {
             layout,
             state,
@@ -188,7 +187,7 @@ impl<'m> Integrator<'m> {
     /// added too; updates the per-step statistics when `record` and returns the contact
     /// dissipation power Σ (F − Kc δ) δ̇. `vectors`: the row length in vectors.
     #[inline(always)]
-    fn contact_forces_and_statistics<S: Simd>(
+    fn contact_forces_and_statistics<S: Simd, const PLANE: bool>(
         &mut self,
         simd: S,
         t: f64,
@@ -225,7 +224,7 @@ impl<'m> Integrator<'m> {
             closed: &mut state.closed,
             closed_groups: &mut state.closed_groups,
         };
-        if let ContactModel::Plane(plane) = &layout.contact_model {
+        if let (true, ContactModel::Plane(plane)) = (PLANE, &layout.contact_model) {
             let count = plane_penetrations(
                 simd,
                 &layout.contacts,
@@ -305,23 +304,40 @@ impl<'m> Integrator<'m> {
     /// Takes the steps of `steps` (step n advances to t = n·Δt), compiled for the best
     /// SIMD level of this CPU.
     fn steps(&mut self, steps: std::ops::RangeInclusive<u64>) {
+        self.dispatch(Operation::Steps(steps));
+    }
+
+    /// `operation` compiled for the best SIMD level of this CPU, with the row's or the
+    /// plane's contacts.
+    fn dispatch(&mut self, operation: Operation) {
         let arch = self.arch;
-        arch.dispatch(StepOp {
-            integrator: self,
-            operation: Operation::Steps(steps),
-        });
+        match self.layout.contact_model {
+            ContactModel::Row => arch.dispatch(StepOp::<false> {
+                integrator: self,
+                operation,
+            }),
+            ContactModel::Plane(_) => arch.dispatch(StepOp::<true> {
+                integrator: self,
+                operation,
+            }),
+        }
     }
 
     #[inline(always)]
-    fn steps_body<S: Simd>(&mut self, simd: S, steps: std::ops::RangeInclusive<u64>, vectors: usize) {
+    fn steps_body<S: Simd, const PLANE: bool>(
+        &mut self,
+        simd: S,
+        steps: std::ops::RangeInclusive<u64>,
+        vectors: usize,
+    ) {
         for n in steps {
-            self.step_body(simd, n as f64 * self.layout.dt, vectors);
+            self.step_body::<S, PLANE>(simd, n as f64 * self.layout.dt, vectors);
         }
     }
 
     /// One step; `vectors` is the row length in vectors (a constant in the usual cases).
     #[inline(always)]
-    fn step_body<S: Simd>(&mut self, simd: S, t: f64, vectors: usize) {
+    fn step_body<S: Simd, const PLANE: bool>(&mut self, simd: S, t: f64, vectors: usize) {
         let dt = self.layout.dt;
         let half = 0.5 * dt;
         // q ← qₙ₊₁ and v ← v½ (central difference), or vₙ₊₁ (Tchamwa).
@@ -339,7 +355,7 @@ impl<'m> Integrator<'m> {
             S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
             S::as_simd_f64s(&state.a[..pins_state]).0,
         );
-        let contact_damping = self.contact_forces_and_statistics(simd, t, true, vectors);
+        let contact_damping = self.contact_forces_and_statistics::<S, PLANE>(simd, t, true, vectors);
         let Self {
             layout,
             state,
@@ -365,13 +381,13 @@ impl<'m> Integrator<'m> {
             S::as_mut_simd_f64s(&mut state.force).0,
         );
         // The base excitation's power −a(t) Σ Γ v, per direction in the plane.
-        let (modal_damping, mut external) = match layout.contact_model {
-            ContactModel::Row => {
+        let (modal_damping, mut external) = match (PLANE, &layout.contact_model) {
+            (false, _) | (true, ContactModel::Row) => {
                 let base = layout.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
                 let sums = modal_update(simd, &coefficients, base, second_half, (q, v, a, f));
                 (sums.damping_power, -base * sums.participation_velocity)
             }
-            ContactModel::Plane(_) => {
+            (true, ContactModel::Plane(_)) => {
                 let (base_x, base_y) = base_accelerations(layout.model, t);
                 let x_lines = q.len() / 2;
                 let (q_x, q_y) = q.split_at(x_lines);
