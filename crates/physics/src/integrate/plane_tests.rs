@@ -119,7 +119,7 @@ fn a_turned_row_moves_along_its_normal_with_the_rows_forces() {
     let impacts: u64 = row.contact_statistics.iter().map(|s| s.impacts).sum();
     assert!(impacts > 10, "the case must exercise contacts: {impacts} impacts");
     let peak_force = peak(&row.contact_forces);
-    let peak_deflection = row.deflections.iter().map(|h| peak(h)).fold(0.0, f64::max);
+    let peak_deflection = row.deflections.iter().map(peak).fold(0.0, f64::max);
     let peak_impulse = row
         .contact_statistics
         .iter()

@@ -25,6 +25,12 @@
 //! open contacts (microcoded on AMD), and reading lanes back as scalars right after a
 //! vector store (the store cannot be forwarded).
 //!
+//! The plane has its own copy of the step (`StepOp<true>`, chosen once per batch): twice
+//! the lines through the same kernels, penetrations from four slots and a normal per
+//! lane ([`plane_penetrations`]), two dashpot dot products and four force axpys per
+//! closed contact ([`plane_contact_forces`]), and the modal update on the x and the y
+//! lines with their own base acceleration. The row's copy does none of it.
+//!
 //! The step is dispatched through `pulp` so that it is compiled for the SIMD level of
 //! the running CPU (AVX2 + FMA on x86-64-v3) without unsafe code; see [`kernels`] for
 //! what that means for reproducibility.
