@@ -443,6 +443,7 @@ impl SolverSettings {
             duration: self.duration,
             output_interval,
             output_heights,
+            recorded_contacts: None,
         }
     }
 }

@@ -1,9 +1,16 @@
 //! Point contacts between a pin and a wall or between two pins (BRIEF §3, API.md).
 //!
-//! A contact at height z between `left` L and `right` R has penetration
-//! δ = w_L(z) − w_R(z) − gap (a wall's deflection is 0 in the wrapper frame). While
-//! δ > 0 it pushes L to the left and R to the right with F = max(0, Kc δ + cc δ̇): the
-//! clamp keeps the dashpot from pulling the bodies together while they separate.
+//! In a row (pins bending along x) a contact at height z between `left` L and `right` R
+//! has penetration δ = w_L(z) − w_R(z) − gap (a wall's deflection is 0 in the wrapper
+//! frame). While δ > 0 it pushes L to the left and R to the right with
+//! F = max(0, Kc δ + cc δ̇): the clamp keeps the dashpot from pulling the bodies
+//! together while they separate.
+//!
+//! For pins bending in the transverse plane (x, y) each contact also has a unit normal n
+//! from L toward R ([`crate::integrate::Plane`]): δ = n·(u_L(z) − u_R(z)) − gap, the
+//! same force law, −F n on L and +F n on R. The row is the plane with every n = +x.
+//! There is no friction: the sliding velocity t·(u̇_L − u̇_R), t = (−n_y, n_x), only
+//! enters the wear work ∫ F |v_t| dt.
 
 use super::{InputIssue, require_non_negative};
 

@@ -2,7 +2,8 @@
 //! a step for accuracy within stability.
 //!
 //! **Stability.** ω_max is the highest angular frequency of the modal system with every
-//! contact closed ([`crate::stability`]); a scheme is stable for
+//! contact closed ([`crate::stability`]; in the plane with each contact along its
+//! normal, never above the row with the same contacts); a scheme is stable for
 //! ω_max Δt ≤ its limit (2 for central difference).
 //!
 //! **Accuracy (`auto`).** A stable step is not an accurate one: at 0.8 × the critical
@@ -31,7 +32,7 @@
 
 use super::{Model, Settings, SimulationError, TimeStep};
 use crate::loads::BaseAcceleration;
-use crate::stability::{Scheme, max_angular_frequency};
+use crate::stability::{Scheme, max_angular_frequency, max_angular_frequency_in_plane};
 
 /// Steps per period of the fastest motion at the default tolerance (10⁻³).
 pub const STEPS_PER_PERIOD: f64 = 50.0;
@@ -149,12 +150,13 @@ pub fn max_frequency(model: &Model<'_>) -> f64 {
         .iter()
         .map(|c| model.basis.deflection_at(c.height))
         .collect();
-    max_angular_frequency(
-        model.basis.angular_frequencies(),
-        model.pins,
-        &model.contacts,
-        &shapes,
-    )
+    let frequencies = model.basis.angular_frequencies();
+    match &model.plane {
+        None => max_angular_frequency(frequencies, model.pins, &model.contacts, &shapes),
+        Some(plane) => {
+            max_angular_frequency_in_plane(frequencies, model.pins, &model.contacts, &shapes, &plane.normals)
+        }
+    }
 }
 
 /// Critical time step (s) of `scheme` for this model, all contacts closed.
@@ -166,7 +168,8 @@ pub fn critical_time_step(model: &Model<'_>, scheme: Scheme) -> f64 {
 /// (resolved with N steps) or a table's sampling interval (one step).
 fn excitation_bound(model: &Model<'_>, steps_per_period: f64) -> Option<f64> {
     let mut bound = f64::INFINITY;
-    if let Some(base) = &model.base_acceleration {
+    let base_y = model.plane.as_ref().and_then(|p| p.base_acceleration_y.as_ref());
+    for base in model.base_acceleration.iter().chain(base_y) {
         bound = bound.min(match base {
             BaseAcceleration::HalfSine { duration, .. } => 2.0 * duration / steps_per_period,
             BaseAcceleration::Sine { frequency, .. } => 1.0 / (frequency * steps_per_period),
