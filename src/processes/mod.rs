@@ -11,6 +11,8 @@ pub mod bundle_dynamics;
 pub mod bundle_inputs;
 pub mod cantilever_impact;
 pub mod cost;
+pub mod hex_bundle_dynamics;
+pub mod hex_inputs;
 pub mod inputs;
 pub mod metrics;
 /// The shared parts of results documents (quality, energy) as serialized types.
@@ -206,6 +208,7 @@ impl Registry {
         Self::new(vec![
             Arc::new(cantilever_impact::CantileverImpact),
             Arc::new(bundle_dynamics::BundleDynamics),
+            Arc::new(hex_bundle_dynamics::HexBundleDynamics),
         ])
     }
 
