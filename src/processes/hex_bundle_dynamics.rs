@@ -115,6 +115,16 @@ pub struct GeometryReport {
     pub rings: usize,
     /// Neighbour pairs, 9n² + 3n.
     pub neighbour_pairs: usize,
+    /// P (m).
+    pub pitch: f64,
+    /// D, the clad's outer diameter (m).
+    pub pin_diameter: f64,
+    /// d_w (m).
+    pub wire_diameter: f64,
+    /// H (m).
+    pub wire_lead: f64,
+    /// F, inner flat-to-flat distance of the wrapper (m).
+    pub wrapper_flat_to_flat: f64,
     /// Potential contacts over the pin length.
     pub contacts: usize,
     /// Nominal wire-to-clad clearance P − D − d_w (m).
@@ -675,11 +685,17 @@ fn recorded_contacts(
 }
 
 fn geometry_report(bundle: &HexBundle, contacts: usize) -> GeometryReport {
-    let rings = bundle.layout().rings;
+    let layout = bundle.layout();
+    let rings = layout.rings;
     GeometryReport {
         pins: bundle.pin_count(),
         rings,
         neighbour_pairs: pair_count(rings),
+        pitch: layout.pitch,
+        pin_diameter: layout.pin_diameter,
+        wire_diameter: layout.wire_diameter,
+        wire_lead: layout.wire_lead,
+        wrapper_flat_to_flat: layout.wrapper_flat_to_flat,
         contacts,
         pin_clearance: bundle.pin_clearance(),
         wall_clearance: bundle.wall_clearance(),
