@@ -52,6 +52,7 @@ fn row_model<'a>(
         contacts: contacts.to_vec(),
         initial_tip_displacements: inputs.initial.tip_displacements.clone(),
         base_acceleration: inputs.excitation.base_acceleration.as_ref().map(|b| b.physics()),
+        plane: None,
         point_forces: inputs
             .excitation
             .point_forces
@@ -342,6 +343,7 @@ impl Simulation for BundleDynamics {
             check: solver.check,
             duration: solver.duration,
             output_interval: Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
+            recorded_contacts: None,
             output_heights: heights,
         };
         let step = inputs::resolve_step(&row_model(&inputs, pins, &contacts, &basis), &settings)?;

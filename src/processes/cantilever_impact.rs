@@ -142,6 +142,7 @@ fn tip_model<'a>(inputs: &CantileverInputs, basis: &'a ModalBasis, contact_stiff
         }],
         initial_tip_displacements: vec![inputs.release.tip_displacement],
         base_acceleration: None,
+        plane: None,
         point_forces: vec![],
     }
 }
@@ -378,6 +379,7 @@ impl Simulation for CantileverImpact {
             check: solver.check,
             duration: solver.duration,
             output_interval: inputs.output.interval,
+            recorded_contacts: None,
             output_heights: vec![spec.length],
         };
         let reference = CantileverReference {

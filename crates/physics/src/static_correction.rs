@@ -400,6 +400,7 @@ mod tests {
             check: Check::None,
             duration,
             output_interval: None,
+            recorded_contacts: None,
             output_heights: vec![1.0],
         }
     }
@@ -420,6 +421,7 @@ mod tests {
             contacts: vec![tip_wall(1e5)],
             initial_tip_displacements: vec![0.0],
             base_acceleration: None,
+            plane: None,
             point_forces: vec![PointForce {
                 pin: 0,
                 height: 1.0,
@@ -491,6 +493,7 @@ mod tests {
                 amplitude: 20.0,
                 duration: 0.01,
             }),
+            plane: None,
             point_forces: vec![],
         }
     }

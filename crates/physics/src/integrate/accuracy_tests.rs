@@ -94,6 +94,7 @@ impl Row {
             contacts,
             initial_tip_displacements: vec![],
             base_acceleration: Some(self.excitation.clone()),
+            plane: None,
             point_forces: vec![],
         }
     }
@@ -106,6 +107,7 @@ impl Row {
             check: Check::None,
             duration: self.duration,
             output_interval: Some(1e-3),
+            recorded_contacts: None,
             output_heights: vec![self.length],
         }
     }

@@ -320,10 +320,10 @@ pub(super) struct ContactState<'a> {
     pub closed_groups: &'a mut [u64],
 }
 
-/// For every group: penetrations and running maxima; returns how many lanes are closed
-/// (listed first in `state.closed`). `gaps` are per lane. Forces are left alone: a
-/// masked store of zeros where open would cost more (microcoded on some CPUs) than
-/// reading a force only where the penetration is positive.
+/// For every group: penetrations δ = w_left − w_right − gap and running maxima; returns
+/// how many lanes are closed (listed first in `state.closed`). `gaps` are per lane.
+/// Forces are left alone: a masked store of zeros where open would cost more
+/// (microcoded on some CPUs) than reading a force only where the penetration is positive.
 #[inline(always)]
 pub(super) fn penetrations<S: Simd>(
     simd: S,
@@ -333,28 +333,77 @@ pub(super) fn penetrations<S: Simd>(
     state: ContactState<'_>,
 ) -> usize {
     let groups = layout.left.len();
+    let (left, right) = (&layout.left[..groups], &layout.right[..groups]);
+    closed_lanes(simd, layout.lanes, gaps, state, |g| {
+        simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize])
+    })
+}
+
+/// The y side of the plane's contact groups ([`plane_penetrations`]): the x side is the
+/// [`ContactLanes`] of the same contacts.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct PlaneGroups {
+    /// Per group: the deflection vector of its left and right body along y.
+    pub left_y: Vec<u32>,
+    pub right_y: Vec<u32>,
+    /// Per lane: the normal's components (0 in empty lanes).
+    pub normal_x: Vec<f64>,
+    pub normal_y: Vec<f64>,
+}
+
+/// [`penetrations`] in the plane: δ = n_x (L_x − R_x) + n_y (L_y − R_y) − gap per lane,
+/// the x deflections at the vectors of `layout`, the y ones at those of `plane`.
+#[inline(always)]
+pub(super) fn plane_penetrations<S: Simd>(
+    simd: S,
+    layout: &ContactLanes,
+    plane: &PlaneGroups,
+    deflections: &[S::f64s],
+    gaps: &[f64],
+    state: ContactState<'_>,
+) -> usize {
+    let groups = layout.left.len();
+    let (left, right) = (&layout.left[..groups], &layout.right[..groups]);
+    let (left_y, right_y) = (&plane.left_y[..groups], &plane.right_y[..groups]);
+    let (normal_x, _) = S::as_simd_f64s(&plane.normal_x);
+    let (normal_y, _) = S::as_simd_f64s(&plane.normal_y);
+    let (normal_x, normal_y) = (&normal_x[..groups], &normal_y[..groups]);
+    closed_lanes(simd, layout.lanes, gaps, state, |g| {
+        let along_x = simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize]);
+        let along_y = simd.sub_f64s(deflections[left_y[g] as usize], deflections[right_y[g] as usize]);
+        simd.mul_add_e_f64s(normal_x[g], along_x, simd.mul_f64s(normal_y[g], along_y))
+    })
+}
+
+/// The common part of [`penetrations`] and [`plane_penetrations`]: with
+/// `approach(g)` the relative approach of group g's lanes, δ = approach − gap, running
+/// maxima, and the closed lanes listed first in `state.closed` (their count returned).
+#[inline(always)]
+fn closed_lanes<S: Simd>(
+    simd: S,
+    lanes: usize,
+    gaps: &[f64],
+    state: ContactState<'_>,
+    approach: impl Fn(usize) -> S::f64s,
+) -> usize {
     let (gaps, _) = S::as_simd_f64s(gaps);
+    let groups = gaps.len();
     let (now, _) = S::as_mut_simd_f64s(state.now);
     let (max, _) = S::as_mut_simd_f64s(state.max);
-    let (left, right) = (&layout.left[..groups], &layout.right[..groups]);
-    let (gaps, now, max) = (&gaps[..groups], &mut now[..groups], &mut max[..groups]);
+    let (now, max) = (&mut now[..groups], &mut max[..groups]);
     // The groups holding a closed lane, as bits: most groups hold none, one test each
     // and no branch, no store at a data-dependent address.
     let words = &mut state.closed_groups[..groups.div_ceil(64)];
     for (w, word) in words.iter_mut().enumerate() {
         let mut bits = 0u64;
         for g in w * 64..groups.min(w * 64 + 64) {
-            let n = simd.sub_f64s(
-                simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize]),
-                gaps[g],
-            );
+            let n = simd.sub_f64s(approach(g), gaps[g]);
             now[g] = n;
             max[g] = simd.max_f64s(max[g], n);
             bits |= u64::from(simd.reduce_max_f64s(n) > 0.0) << (g % 64);
         }
         *word = bits;
     }
-    let lanes = layout.lanes;
     let mut count = 0;
     for (w, word) in words.iter().enumerate() {
         let mut bits = *word;

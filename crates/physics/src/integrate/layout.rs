@@ -10,8 +10,15 @@
 //! (a vector holds one pin's deflections at `lanes` consecutive levels, with a wall slot
 //! on each side: `[wall, pin 0, …, pin n−1, wall]`), and every per-contact array of the
 //! step is stored by lane and mapped back to contact order for samples and results.
+//!
+//! The rows are deflection *lines*: one per pin in the row; in the plane the x lines of
+//! every pin, then their y lines (line `pins + p` is pin p along y), each line a row of
+//! modal coordinates on the same basis. The level deflections then hold every line
+//! (`[wall, x lines, y lines, wall]`), and the contacts pick their kernel here
+//! ([`ContactModel`]): the row keeps its one-slot-per-side penetrations, the plane reads
+//! four slots and a normal per lane.
 
-use super::kernels::{ContactLanes, Lanes, LevelShapes};
+use super::kernels::{ContactLanes, Lanes, LevelShapes, PlaneGroups};
 use super::{Model, Settings, StepSize};
 use crate::contact::Body;
 use crate::stability::Scheme;
@@ -25,9 +32,11 @@ pub(super) struct Layout<'m> {
     pub step: StepSize,
     /// f64 values per SIMD vector of the run's `pulp::Arch`.
     pub lanes: usize,
-    /// Length of one pin's row: the modes rounded up to whole vectors.
+    /// Length of one line's row: the modes rounded up to whole vectors.
     pub row: usize,
-    /// Slots per block of the block-major deflections: `[wall, pin 0, …, pin n−1, wall]`.
+    /// Deflection lines: `pins` in the row, `2 × pins` in the plane (x lines, then y).
+    pub lines: usize,
+    /// Slots per block of the block-major deflections: `[wall, line 0, …, line n−1, wall]`.
     pub stride: usize,
     /// Per mode (padded to `row`): ωᵢ², 2ξᵢωᵢ, and for central difference 1/(1 + ξᵢωᵢΔt).
     pub omega_squared: Vec<f64>,
@@ -44,10 +53,13 @@ pub(super) struct Layout<'m> {
     pub grouped_level_shapes: LevelShapes,
     /// The contacts by lanes of the level deflections.
     pub contacts: ContactLanes,
-    /// Per lane: what a closed contact needs, and the gap (∞ in empty lanes).
+    /// Per lane: what a closed contact needs (its x rows in the plane), and the gap (∞
+    /// in empty lanes).
     pub lane_contacts: Vec<LaneContact>,
     pub gaps: Vec<f64>,
-    /// Offset (in vectors) of the row of zeros after the pins' rows in `v` and `a`,
+    /// The row's contacts (normal +x) or the plane's.
+    pub contact_model: ContactModel,
+    /// Offset (in vectors) of the row of zeros after the lines' rows in `v` and `a`,
     /// read for a wall.
     pub wall_row: usize,
     /// ψ at each point force's height (padded to `row`).
@@ -74,6 +86,30 @@ pub(super) struct LaneContact {
     pub right: usize,
     /// Whether it can push at all (stiffness or dashpot > 0): only those count impacts.
     pub active: bool,
+}
+
+/// What the contacts need besides [`LaneContact`]: nothing for the row, where every
+/// normal is +x (δ = w_L − w_R − gap), the y slots and rows and the normals in the plane.
+pub(super) enum ContactModel {
+    Row,
+    Plane(PlaneContacts),
+}
+
+/// The plane's contacts: per group the y deflection vectors and per lane the normal
+/// ([`super::kernels::plane_penetrations`]), per lane the y rows.
+pub(super) struct PlaneContacts {
+    pub groups: PlaneGroups,
+    pub lanes: Vec<PlaneLane>,
+}
+
+/// A plane contact's y rows and normal, as its lane needs them (offsets in vectors).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct PlaneLane {
+    /// Offsets of the left and right body's y rows in the state (`wall_row` for a wall).
+    pub left_y: usize,
+    pub right_y: usize,
+    /// Unit normal (x, y) from left to right; (0, 0) in empty lanes.
+    pub normal: [f64; 2],
 }
 
 /// `values` followed by `fill` up to `row`.
@@ -124,16 +160,21 @@ impl<'m> Layout<'m> {
         let shape_at = |height: f64| padded(&basis.deflection_at(height), row, 0.0);
         let nodes = basis.model().elements + 1;
         let contacts = &model.contacts;
+        let lines = model.lines();
         // Offsets in vectors of one row of `row` values; a wall reads the row of zeros
-        // after the pins' rows.
+        // after the lines' rows. A pin's x line is its number, its y line `pins` further.
         let vectors = row / lanes;
         let state_row = |body: Body| match body {
-            Body::Wall => vectors * pins,
+            Body::Wall => vectors * lines,
             Body::Pin(pin) => vectors * pin,
         };
-        // A wall on the left reads the zero slot before the first pin, on the right the one
-        // after the last.
-        let stride = pins + 2;
+        let state_row_y = |body: Body| match body {
+            Body::Wall => vectors * lines,
+            Body::Pin(pin) => vectors * (pins + pin),
+        };
+        // A wall on the left reads the zero slot before the first line, on the right the
+        // one after the last.
+        let stride = lines + 2;
         let slot = |body: Body, wall: usize| match body {
             Body::Wall => wall,
             Body::Pin(pin) => 1 + pin,
@@ -143,12 +184,47 @@ impl<'m> Layout<'m> {
                 (
                     contact_level[c],
                     slot(contact.left, 0),
-                    slot(contact.right, pins + 1),
+                    slot(contact.right, lines + 1),
                 )
             }),
             lanes,
             stride,
         );
+        let contact_model = match &model.plane {
+            None => ContactModel::Row,
+            Some(plane) => {
+                // The y slot of a pin's x slot (a wall's slot reads zeros either way).
+                let y_vector = |vector: &u32| {
+                    let slot = *vector as usize % stride;
+                    if (1..=pins).contains(&slot) {
+                        vector + pins as u32
+                    } else {
+                        *vector
+                    }
+                };
+                let lane_normals = contact_lanes.by_lane(&plane.normals, [0.0, 0.0]);
+                ContactModel::Plane(PlaneContacts {
+                    groups: PlaneGroups {
+                        left_y: contact_lanes.left.iter().map(y_vector).collect(),
+                        right_y: contact_lanes.right.iter().map(y_vector).collect(),
+                        normal_x: lane_normals.iter().map(|n| n[0]).collect(),
+                        normal_y: lane_normals.iter().map(|n| n[1]).collect(),
+                    },
+                    lanes: contact_lanes.by_lane(
+                        &contacts
+                            .iter()
+                            .zip(&plane.normals)
+                            .map(|(contact, normal)| PlaneLane {
+                                left_y: state_row_y(contact.left),
+                                right_y: state_row_y(contact.right),
+                                normal: *normal,
+                            })
+                            .collect::<Vec<_>>(),
+                        PlaneLane::default(),
+                    ),
+                })
+            }
+        };
         let level_shapes: Vec<f64> = heights.iter().flat_map(|h| shape_at(*h)).collect();
         let grouped_level_shapes = LevelShapes::new(&level_shapes, row, lanes);
         let node_shapes = LevelShapes::new(
@@ -166,6 +242,7 @@ impl<'m> Layout<'m> {
             step: *step,
             lanes,
             row,
+            lines,
             stride,
             omega_squared: padded(&omega.iter().map(|w| w * w).collect::<Vec<_>>(), row, 0.0),
             implicit_damping_factor: padded(
@@ -202,6 +279,7 @@ impl<'m> Layout<'m> {
                     .collect::<Vec<_>>(),
                 LaneContact::default(),
             ),
+            contact_model,
             wall_row: state_row(Body::Wall),
             gaps: contact_lanes.by_lane(&contacts.iter().map(|c| c.gap).collect::<Vec<_>>(), f64::INFINITY),
             contacts: contact_lanes,
@@ -215,8 +293,8 @@ impl<'m> Layout<'m> {
         }
     }
 
-    /// Index in the level deflections of pin 0 at `level` (block-major, the walls in
-    /// slots 0 and pins + 1); pin p is `lanes` × p further.
+    /// Index in the level deflections of line 0 at `level` (block-major, the walls in
+    /// slots 0 and lines + 1); line r is `lanes` × r further.
     fn level_offset(lanes: usize, stride: usize, level: usize) -> usize {
         ((level / lanes) * stride + 1) * lanes + level % lanes
     }
@@ -226,12 +304,12 @@ impl<'m> Layout<'m> {
         self.contacts.len()
     }
 
-    /// Length of a block-major array of the pins' deflections at every level.
+    /// Length of a block-major array of the lines' deflections at every level.
     pub fn level_deflections_len(&self) -> usize {
         self.grouped_level_shapes.blocks * self.stride * self.lanes
     }
 
-    /// Length of a block-major array of the pins' deflections at every node.
+    /// Length of a block-major array of the lines' deflections at every node.
     pub fn node_deflections_len(&self) -> usize {
         self.node_shapes.blocks * self.stride * self.lanes
     }

@@ -1,9 +1,24 @@
-//! Explicit time integration of a row of identical pins on their shared modal basis,
-//! with penalty point contacts, base excitation and point forces.
+//! Explicit time integration of identical pins on their shared modal basis, with
+//! penalty point contacts, base excitation and point forces.
 //!
-//! Modal equations per pin p: q̈ᵢ + 2ξᵢωᵢ q̇ᵢ + ωᵢ² qᵢ = ψᵢ(z)·(contact and point forces)
-//! − Γᵢ a(t). Coordinates are stored pin-major (`q[p * row + i]`, see `stepper`) so that
-//! a closed contact reads and writes whole contiguous rows.
+//! Modal equations per deflection line r: q̈ᵢ + 2ξᵢωᵢ q̇ᵢ + ωᵢ² qᵢ = ψᵢ(z)·(contact and
+//! point forces along the line) − Γᵢ a(t). Coordinates are stored line-major
+//! (`q[r * row + i]`, see `stepper`) so that a closed contact reads and writes whole
+//! contiguous rows.
+//!
+//! **Row and plane.** In the row ([`Model::plane`] `None`) every pin bends along x only:
+//! one line per pin (r = p), every contact normal is +x, δ = w_L − w_R − gap. In the
+//! plane every pin bends along x and y on the same basis (the two directions of a
+//! straight beam of circular section are uncoupled and identical): 2 × pins lines, r = p
+//! along x and r = pins + p along y. A contact with unit normal n (from left to right)
+//! has δ = n·(u_L − u_R) − gap, δ̇ = n·(u̇_L − u̇_R), and pushes the left pin by −F n and
+//! the right one by +F n on the modes of its x and y lines. The relative sliding
+//! velocity is v_t = t·(u̇_L − u̇_R), t = (−n_y, n_x), and the wear work ∫ F |v_t| dt is
+//! accumulated per contact at every step ([`Simulation::wear_work`]). The base
+//! acceleration has one component per direction (the y one in [`Plane`]); the initial
+//! tip displacements and the point forces act along x. Every per-pin output
+//! (deflections, peaks, extremes) is indexed by line. The row runs on its own kernels:
+//! the plane costs it nothing.
 //!
 //! **Velocity-dependent forces.** Central difference (velocity form):
 //! v½ = vₙ + ½Δt aₙ, qₙ₊₁ = qₙ + Δt v½, vₙ₊₁ = v½ + ½Δt aₙ₊₁. Modal damping is diagonal,
@@ -27,7 +42,7 @@
 
 pub use super::statistics::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme};
 use crate::InputIssue;
-pub use model::{Model, Settings, TimeStep};
+pub use model::{Model, NORMAL_LENGTH_TOLERANCE, Plane, Settings, TimeStep};
 pub use plan::Plan;
 pub use quality::{Check, Quality, StepHalving, Verdict};
 pub use step_size::{DEFAULT_TOLERANCE, StepLimit, StepSize, critical_time_step};
@@ -78,22 +93,27 @@ pub struct Simulation {
     pub output_interval: f64,
     /// Sample times (s).
     pub time: Vec<f64>,
-    /// `deflections[h][p]`: deflection (m) of pin p at output height h, per sample.
+    /// `deflections[h][r]`: deflection (m) of line r at output height h, per sample (the
+    /// row: r = pin; the plane: r = p along x, r = pins + p along y).
     pub deflections: Vec<Vec<Vec<f64>>>,
-    /// `deflection_peaks[h][p]`: per sample, the deflection of largest magnitude (signed)
+    /// `deflection_peaks[h][r]`: per sample, the deflection of largest magnitude (signed)
     /// reached at any step since the previous sample (the sample itself included).
     pub deflection_peaks: Vec<Vec<Vec<f64>>>,
-    /// `peak_deflections[h][p]`: the deflection of largest magnitude of pin p at output
-    /// height h over every step, and when: the extreme of `deflection_peaks[h][p]`.
+    /// `peak_deflections[h][r]`: the deflection of largest magnitude of line r at output
+    /// height h over every step, and when: the extreme of `deflection_peaks[h][r]`.
     pub peak_deflections: Vec<Vec<PeakDeflection>>,
-    /// Contact force (N) of each contact, per sample.
+    /// Contact force (N) of each recorded contact (`Settings::recorded_contacts`, in
+    /// that order; every contact by default), per sample.
     pub contact_forces: Vec<Vec<f64>>,
-    /// Per contact and sample, the largest force reached at any step since the previous
-    /// sample: its maximum over the run is the contact's `max_force` exactly.
+    /// Per recorded contact and sample, the largest force reached at any step since the
+    /// previous sample: its maximum over the run is the contact's `max_force` exactly.
     pub contact_force_peaks: Vec<Vec<f64>>,
-    /// Per contact, accumulated at every step.
+    /// Per contact (every one, recorded or not), accumulated at every step.
     pub contact_statistics: Vec<ContactStatistics>,
-    /// Per pin.
+    /// Per contact: wear work ∫ F·|v_t| dt (J), v_t the relative tangential velocity at
+    /// the contact (tangent t = (−n_y, n_x)); empty for the row (no tangential motion).
+    pub wear_work: Vec<f64>,
+    /// Per line (r as in `deflections`).
     pub pin_extremes: Vec<PinExtreme>,
     /// Energy balance at the end of the run.
     pub energy: EnergyBalance,
@@ -140,3 +160,6 @@ mod tests;
 
 #[cfg(test)]
 mod accuracy_tests;
+
+#[cfg(test)]
+mod plane_tests;

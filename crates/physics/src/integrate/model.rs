@@ -13,7 +13,8 @@ use crate::{InputIssue, require_non_negative, require_positive};
 
 use super::quality::Check;
 
-/// The row being integrated.
+/// The pins being integrated: a row (every pin bends along x, every contact normal is
+/// +x), or pins bending in the transverse plane ([`Plane`]).
 #[derive(Debug, Clone)]
 pub struct Model<'a> {
     /// Modal basis shared by every pin.
@@ -26,8 +27,68 @@ pub struct Model<'a> {
     /// Release of each pin from its static tip-load shape with this tip deflection (m);
     /// empty means all at rest.
     pub initial_tip_displacements: Vec<f64>,
+    /// Base acceleration (m/s²); along x in the plane.
     pub base_acceleration: Option<BaseAcceleration>,
+    /// Point forces; along x in the plane.
     pub point_forces: Vec<PointForce>,
+    /// `None`: the row (every pin bends along x only, every contact normal is +x).
+    /// `Some`: every pin bends along x and y with the same modal basis.
+    pub plane: Option<Plane>,
+}
+
+/// Pins bending in the transverse plane (x, y), each direction on the same basis.
+///
+/// Initial tip displacements and point forces act along x; the base acceleration has
+/// an x component (`Model::base_acceleration`) and a y component
+/// (`base_acceleration_y`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plane {
+    /// Per contact (same order as `Model::contacts`): unit normal (x, y) pointing from
+    /// `left` toward `right`: δ = n·(u_left − u_right) − gap; the force pushes left by −F n
+    /// and right by +F n. A wall's displacement is zero (wrapper frame).
+    pub normals: Vec<[f64; 2]>,
+    /// Base acceleration along y; `Model::base_acceleration` is the x component.
+    pub base_acceleration_y: Option<BaseAcceleration>,
+}
+
+/// How far from 1 the length of a contact normal may be.
+pub const NORMAL_LENGTH_TOLERANCE: f64 = 1e-9;
+
+impl Plane {
+    /// Every problem with the plane data of a model with `contacts` contacts: one
+    /// finite unit normal per contact (length within [`NORMAL_LENGTH_TOLERANCE`] of 1),
+    /// a valid y excitation.
+    pub fn validate(&self, contacts: usize) -> Vec<InputIssue> {
+        let mut issues = Vec::new();
+        if self.normals.len() != contacts {
+            issues.push(InputIssue::new(
+                "normals",
+                format!(
+                    "needs one normal per contact ({contacts}), got {}",
+                    self.normals.len()
+                ),
+            ));
+        }
+        for (c, [x, y]) in self.normals.iter().enumerate() {
+            let field = format!("normals/{c}");
+            if !(x.is_finite() && y.is_finite()) {
+                issues.push(InputIssue::new(field, "must be two finite numbers"));
+            } else if ((x * x + y * y).sqrt() - 1.0).abs() > NORMAL_LENGTH_TOLERANCE {
+                issues.push(InputIssue::new(
+                    field,
+                    format!("must be a unit vector (length {})", (x * x + y * y).sqrt()),
+                ));
+            }
+        }
+        if let Some(base) = &self.base_acceleration_y {
+            issues.extend(
+                base.validate()
+                    .into_iter()
+                    .map(|i| i.within("base_acceleration_y")),
+            );
+        }
+        issues
+    }
 }
 
 impl Model<'_> {
@@ -37,7 +98,7 @@ impl Model<'_> {
     /// stiffness and damping ([`Contact::validate`]); one finite initial tip deflection
     /// per pin or none, and none but zeros without a free top (no tip-load shape to
     /// release from); a valid excitation; point forces on existing pins, within the pin,
-    /// with valid tables.
+    /// with valid tables; in the plane, [`Plane::validate`].
     pub fn validate(&self) -> Vec<InputIssue> {
         let mut issues = Vec::new();
         let (pins, modes, length) = (self.pins, self.basis.modes(), self.basis.length());
@@ -91,7 +152,24 @@ impl Model<'_> {
                     .map(|i| i.within(&prefix)),
             );
         }
+        if let Some(plane) = &self.plane {
+            issues.extend(
+                plane
+                    .validate(self.contacts.len())
+                    .into_iter()
+                    .map(|i| i.within("plane")),
+            );
+        }
         issues
+    }
+
+    /// Deflection lines of the model: one per pin in the row, two (x then y) in the
+    /// plane. Every per-pin output is indexed by line.
+    pub fn lines(&self) -> usize {
+        match self.plane {
+            None => self.pins,
+            Some(_) => 2 * self.pins,
+        }
     }
 
     fn validate_release(&self, issues: &mut Vec<InputIssue>) {
@@ -150,13 +228,17 @@ pub struct Settings {
     pub output_interval: Option<f64>,
     /// Heights (m) where every pin's deflection is recorded.
     pub output_heights: Vec<f64>,
+    /// Contacts whose force histories are recorded, in this order; `None`: every contact.
+    /// Statistics are accumulated for every contact regardless.
+    pub recorded_contacts: Option<Vec<usize>>,
 }
 
 impl Settings {
-    /// Every problem with these settings for pins of `length` (m): φ ≥ 1 for
-    /// Tchamwa–Wielgosz, a positive step, duration and output interval, a tolerance in
-    /// (0, 1), output heights within the pin.
-    pub fn validate(&self, length: f64) -> Vec<InputIssue> {
+    /// Every problem with these settings for pins of `length` (m) and a model of
+    /// `contacts` contacts: φ ≥ 1 for Tchamwa–Wielgosz, a positive step, duration and
+    /// output interval, a tolerance in (0, 1), output heights within the pin, recorded
+    /// contacts that exist, each once.
+    pub fn validate(&self, length: f64, contacts: usize) -> Vec<InputIssue> {
         let mut issues = Vec::new();
         if let Scheme::Tchamwa { phi } = self.scheme
             && !(phi.is_finite() && phi >= 1.0)
@@ -185,6 +267,18 @@ impl Settings {
                     format!("output_heights/{k}"),
                     format!("must be within the pin, 0 to {length} m"),
                 ));
+            }
+        }
+        let mut listed = vec![false; contacts];
+        for (k, &c) in self.recorded_contacts.iter().flatten().enumerate() {
+            let field = format!("recorded_contacts/{k}");
+            match listed.get_mut(c) {
+                None => issues.push(InputIssue::new(
+                    field,
+                    format!("contact {c} does not exist (the model has {contacts})"),
+                )),
+                Some(true) => issues.push(InputIssue::new(field, format!("contact {c} is listed twice"))),
+                Some(seen) => *seen = true,
             }
         }
         issues
@@ -238,6 +332,7 @@ mod tests {
                     values: vec![0.0, 1.0],
                 },
             }],
+            plane: None,
         }
     }
 
@@ -250,6 +345,7 @@ mod tests {
             duration: 0.02,
             output_interval: Some(1e-3),
             output_heights: vec![1.0, 0.5],
+            recorded_contacts: None,
         }
     }
 
@@ -261,7 +357,7 @@ mod tests {
     fn a_valid_model_and_settings_have_no_issue() {
         let basis = basis();
         assert_eq!(row(&basis).validate(), vec![]);
-        assert_eq!(settings().validate(basis.length()), vec![]);
+        assert_eq!(settings().validate(basis.length(), 3), vec![]);
     }
 
     /// Every check names its field relative to the model, in the model's order.
@@ -335,9 +431,10 @@ mod tests {
             duration: f64::NAN,
             output_interval: Some(-1.0),
             output_heights: vec![0.5, 1.2],
+            recorded_contacts: Some(vec![1, 2, 1]),
         };
         assert_eq!(
-            fields(settings.validate(1.0)),
+            fields(settings.validate(1.0, 2)),
             [
                 "scheme/phi",
                 "time_step",
@@ -345,6 +442,8 @@ mod tests {
                 "duration",
                 "output_interval",
                 "output_heights/1",
+                "recorded_contacts/1",
+                "recorded_contacts/2",
             ]
         );
     }

@@ -143,7 +143,7 @@ fn check(model: &Model<'_>, settings: &Settings) -> Result<(), SimulationError> 
     if !issues.is_empty() {
         return Err(SimulationError::InvalidModel(issues));
     }
-    let issues = settings.validate(model.basis.length());
+    let issues = settings.validate(model.basis.length(), model.contacts.len());
     if !issues.is_empty() {
         return Err(SimulationError::InvalidSettings(issues));
     }

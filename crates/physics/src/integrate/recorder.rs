@@ -1,12 +1,14 @@
-//! What a run records: the sampled histories and their peaks between samples, the
-//! per-contact statistics and per-pin extremes accumulated at every step, and the energy
+//! What a run records: the sampled histories and their peaks between samples (the
+//! deflections of every line, the forces of the recorded contacts), the per-contact
+//! statistics (and wear work in the plane) and per-line extremes accumulated at every
+//! step, and the energy
 //! accounting (dissipated and external work by the trapezoidal rule on the powers of
 //! each step). It reads the [`State`] and never changes it.
 
 use pulp::Simd;
 
 use super::kernels::level_deflections;
-use super::layout::Layout;
+use super::layout::{ContactModel, Layout};
 use super::state::State;
 use super::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme, Settings, Simulation};
 
@@ -28,7 +30,11 @@ pub(super) struct Recorder {
     pub statistics: Vec<ContactStatistics>,
     pub max_penetration: Vec<f64>,
     pub force_peak: Vec<f64>,
-    /// Per output height and pin, the highest and lowest deflection since the last
+    /// Per lane in the plane (empty for the row): ∫ F |v_t| dt (J).
+    pub wear: Vec<f64>,
+    /// The lanes of the recorded contacts, in the order of their histories.
+    recorded: Vec<usize>,
+    /// Per output height and line, the highest and lowest deflection since the last
     /// sample, and the deflection of largest magnitude over the run.
     deflection_high: Vec<f64>,
     deflection_low: Vec<f64>,
@@ -43,7 +49,7 @@ pub(super) struct Recorder {
     time: Vec<f64>,
     deflections: Vec<Vec<Vec<f64>>>,
     deflection_peaks: Vec<Vec<Vec<f64>>>,
-    /// Per contact (not by lane).
+    /// Per recorded contact (not by lane).
     contact_forces: Vec<Vec<f64>>,
     contact_force_peaks: Vec<Vec<f64>>,
     mechanical_energy: Vec<f64>,
@@ -53,14 +59,24 @@ pub(super) struct Recorder {
 impl Recorder {
     /// Nothing recorded yet.
     pub fn new(layout: &Layout<'_>, settings: &Settings) -> Self {
-        let pins = layout.model.pins;
+        let lines = layout.lines;
         let lanes = layout.contact_lanes();
-        let outputs = layout.output_offsets.len() * pins;
-        let contacts = layout.model.contacts.len();
+        let outputs = layout.output_offsets.len() * lines;
+        let lane_of = |c: &usize| layout.contacts.lane[*c] as usize;
+        let recorded: Vec<usize> = match &settings.recorded_contacts {
+            Some(contacts) => contacts.iter().map(lane_of).collect(),
+            None => (0..layout.model.contacts.len()).map(|c| lane_of(&c)).collect(),
+        };
+        let contacts = recorded.len();
         Self {
             statistics: vec![ContactStatistics::default(); lanes],
             max_penetration: vec![f64::NEG_INFINITY; lanes],
             force_peak: vec![0.0; lanes],
+            wear: match layout.contact_model {
+                ContactModel::Row => Vec::new(),
+                ContactModel::Plane(_) => vec![0.0; lanes],
+            },
+            recorded,
             deflection_high: vec![0.0; outputs],
             deflection_low: vec![0.0; outputs],
             peak_deflections: vec![PeakDeflection::default(); outputs],
@@ -69,12 +85,12 @@ impl Recorder {
             previous_power: Powers::default(),
             external_work_peak: 0.0,
             time: Vec::new(),
-            deflections: vec![vec![Vec::new(); pins]; settings.output_heights.len()],
-            deflection_peaks: vec![vec![Vec::new(); pins]; settings.output_heights.len()],
+            deflections: vec![vec![Vec::new(); lines]; settings.output_heights.len()],
+            deflection_peaks: vec![vec![Vec::new(); lines]; settings.output_heights.len()],
             contact_forces: vec![Vec::new(); contacts],
             contact_force_peaks: vec![Vec::new(); contacts],
             mechanical_energy: Vec::new(),
-            pin_extremes: vec![PinExtreme::default(); pins],
+            pin_extremes: vec![PinExtreme::default(); lines],
         }
     }
 
@@ -104,15 +120,15 @@ impl Recorder {
         self.previous_power = powers;
     }
 
-    /// Keeps, per output height and pin, the highest and the lowest deflection since the
+    /// Keeps, per output height and line, the highest and the lowest deflection since the
     /// last sample (branch-free: this runs at every step).
     #[inline(always)]
     pub fn track_deflection_peaks(&mut self, layout: &Layout<'_>, level_deflections: &[f64]) {
-        let (pins, lanes) = (layout.model.pins, layout.lanes);
+        let (lines, lanes) = (layout.lines, layout.lanes);
         for (h, &offset) in layout.output_offsets.iter().enumerate() {
-            let column = &level_deflections[offset..][..(pins - 1) * lanes + 1];
-            let highs = &mut self.deflection_high[h * pins..][..pins];
-            let lows = &mut self.deflection_low[h * pins..][..pins];
+            let column = &level_deflections[offset..][..(lines - 1) * lanes + 1];
+            let highs = &mut self.deflection_high[h * lines..][..lines];
+            let lows = &mut self.deflection_low[h * lines..][..lines];
             for (p, (high, low)) in highs.iter_mut().zip(lows.iter_mut()).enumerate() {
                 let w = column[p * lanes];
                 *high = if w > *high { w } else { *high };
@@ -125,12 +141,12 @@ impl Recorder {
     /// peaks since the previous sample, then starts new peaks.
     pub fn record_sample(&mut self, arch: pulp::Arch, layout: &Layout<'_>, state: &State, t: f64) {
         self.time.push(t);
-        let (pins, lanes) = (layout.model.pins, layout.lanes);
+        let (lines, lanes) = (layout.lines, layout.lanes);
         for (h, &offset) in layout.output_offsets.iter().enumerate() {
-            for p in 0..pins {
+            for p in 0..lines {
                 // From the same values as the peaks, so that no sample exceeds its peak.
                 let w = state.level_deflections[offset + p * lanes];
-                let k = h * pins + p;
+                let k = h * lines + p;
                 let (high, low) = (self.deflection_high[k].max(w), self.deflection_low[k].min(w));
                 // The extreme of largest magnitude, signed (the highest on a tie).
                 let peak = if high >= -low { high } else { low };
@@ -147,23 +163,23 @@ impl Recorder {
                 (self.deflection_high[k], self.deflection_low[k]) = (0.0, 0.0);
             }
         }
-        for ((history, peaks), lane) in self
+        for ((history, peaks), &lane) in self
             .contact_forces
             .iter_mut()
             .zip(&mut self.contact_force_peaks)
-            .zip(&layout.contacts.lane)
+            .zip(&self.recorded)
         {
-            let lane = *lane as usize;
             let force = state.contact_force_of(lane);
             history.push(force);
             peaks.push(self.force_peak[lane].max(force));
-            self.force_peak[lane] = 0.0;
         }
+        // Every lane's peak restarts, recorded or not (the step tracks them all).
+        self.force_peak.fill(0.0);
         self.mechanical_energy.push(state.mechanical_energy(arch, layout));
         self.record_pin_extremes(arch, layout, state, t);
     }
 
-    /// The largest |w| of each pin over the mesh nodes, if above the one so far.
+    /// The largest |w| of each line over the mesh nodes, if above the one so far.
     fn record_pin_extremes(&mut self, arch: pulp::Arch, layout: &Layout<'_>, state: &State, t: f64) {
         arch.dispatch(NodeDeflectionsOp {
             layout,
@@ -212,12 +228,16 @@ impl Recorder {
             deflection_peaks: self.deflection_peaks,
             peak_deflections: self
                 .peak_deflections
-                .chunks(layout.model.pins.max(1))
+                .chunks(layout.lines.max(1))
                 .map(<[_]>::to_vec)
                 .collect(),
             contact_forces: self.contact_forces,
             contact_force_peaks: self.contact_force_peaks,
             contact_statistics: layout.contacts.by_contact(&self.statistics),
+            wear_work: match layout.contact_model {
+                ContactModel::Row => Vec::new(),
+                ContactModel::Plane(_) => layout.contacts.by_contact(&self.wear),
+            },
             pin_extremes: self.pin_extremes,
             energy: self.energy,
             mechanical_energy: self.mechanical_energy,

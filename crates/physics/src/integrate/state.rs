@@ -9,9 +9,9 @@ use super::layout::Layout;
 
 /// What a step advances.
 pub(super) struct State {
-    /// Pin-major (`pins × row`): coordinates, velocities, accelerations, and the contact
-    /// and point loads of the step (zeroed by the modal update). `v` and `a` have one
-    /// more row, of zeros, for the walls.
+    /// Line-major (`lines × row`, see [`Layout`]): coordinates, velocities,
+    /// accelerations, and the contact and point loads of the step (zeroed by the modal
+    /// update). `v` and `a` have one more row, of zeros, for the walls.
     pub q: Vec<f64>,
     pub v: Vec<f64>,
     pub a: Vec<f64>,
@@ -33,11 +33,11 @@ pub(super) struct State {
 
 impl State {
     /// At rest, or released from the static tip-load shape with the model's initial tip
-    /// deflections; contacts open and no load yet.
+    /// deflections (along x in the plane: the x lines come first); contacts open and no
+    /// load yet.
     pub fn new(layout: &Layout<'_>) -> Self {
-        let (model, row) = (layout.model, layout.row);
-        let pins = model.pins;
-        let mut q = vec![0.0; pins * row];
+        let (model, row, lines) = (layout.model, layout.row, layout.lines);
+        let mut q = vec![0.0; lines * row];
         if let Some(unit) = model.basis.unit_tip_release() {
             for (coordinates, tip) in q.chunks_exact_mut(row).zip(&model.initial_tip_displacements) {
                 for (x, u) in coordinates.iter_mut().zip(unit.iter()) {
@@ -49,9 +49,9 @@ impl State {
         let groups = lanes / layout.lanes;
         Self {
             q,
-            v: vec![0.0; (pins + 1) * row],
-            a: vec![0.0; (pins + 1) * row],
-            force: vec![0.0; pins * row],
+            v: vec![0.0; (lines + 1) * row],
+            a: vec![0.0; (lines + 1) * row],
+            force: vec![0.0; lines * row],
             penetration: vec![0.0; lanes],
             previous_penetration: vec![0.0; lanes],
             contact_force: vec![0.0; lanes],

@@ -166,7 +166,8 @@ pub fn critical_time_step(model: &Model<'_>, scheme: Scheme) -> f64 {
 /// (resolved with N steps) or a table's sampling interval (one step).
 fn excitation_bound(model: &Model<'_>, steps_per_period: f64) -> Option<f64> {
     let mut bound = f64::INFINITY;
-    if let Some(base) = &model.base_acceleration {
+    let base_y = model.plane.as_ref().and_then(|p| p.base_acceleration_y.as_ref());
+    for base in model.base_acceleration.iter().chain(base_y) {
         bound = bound.min(match base {
             BaseAcceleration::HalfSine { duration, .. } => 2.0 * duration / steps_per_period,
             BaseAcceleration::Sine { frequency, .. } => 1.0 / (frequency * steps_per_period),

@@ -35,9 +35,9 @@ use pulp::Simd;
 
 use super::kernels::{
     self, ContactState, ModalCoefficients, advance_positions, axpy, lanes, level_deflections, modal_update,
-    penetration_rate, penetrations, row_axpy,
+    penetration_rate, penetrations, plane_penetrations, row_axpy,
 };
-use super::layout::Layout;
+use super::layout::{ContactModel, Layout, PlaneContacts};
 use super::recorder::{Powers, Recorder, record_closed_contact};
 use super::state::State;
 use super::{Model, Settings, Simulation, SimulationError, StepSize, step_counts};
@@ -163,14 +163,17 @@ impl<'m> Integrator<'m> {
             ..
         } = &mut integrator;
         recorder.record_initial_contacts(layout, state);
-        let base = model.base_acceleration.as_ref().map_or(0.0, |b| b.at(0.0));
-        let row = layout.row;
-        for ((a, f), q) in state
+        let (base_x, base_y) = base_accelerations(model, 0.0);
+        let (row, pins) = (layout.row, model.pins);
+        for (line, ((a, f), q)) in state
             .a
             .chunks_exact_mut(row)
             .zip(state.force.chunks_exact_mut(row))
             .zip(state.q.chunks_exact(row))
+            .enumerate()
         {
+            // The x lines come first; y lines only exist in the plane.
+            let base = if line < pins { base_x } else { base_y };
             for k in 0..row {
                 a[k] = f[k] - base * layout.participation[k] - layout.omega_squared[k] * q[k];
                 f[k] = 0.0;
@@ -216,18 +219,32 @@ impl<'m> Integrator<'m> {
         // Every contact, in vectors: penetration, its running maximum, a zero force
         // where open, and the list of closed contacts (about one in seven).
         std::mem::swap(&mut state.penetration, &mut state.previous_penetration);
-        let count = penetrations(
-            simd,
-            &layout.contacts,
-            deflections,
-            &layout.gaps,
-            ContactState {
-                now: &mut state.penetration,
-                max: &mut recorder.max_penetration,
-                closed: &mut state.closed,
-                closed_groups: &mut state.closed_groups,
-            },
-        );
+        let contact_state = ContactState {
+            now: &mut state.penetration,
+            max: &mut recorder.max_penetration,
+            closed: &mut state.closed,
+            closed_groups: &mut state.closed_groups,
+        };
+        if let ContactModel::Plane(plane) = &layout.contact_model {
+            let count = plane_penetrations(
+                simd,
+                &layout.contacts,
+                &plane.groups,
+                deflections,
+                &layout.gaps,
+                contact_state,
+            );
+            return plane_contact_forces(
+                simd,
+                (layout, plane),
+                state,
+                recorder,
+                count,
+                (t, record),
+                vectors,
+            );
+        }
+        let count = penetrations(simd, &layout.contacts, deflections, &layout.gaps, contact_state);
 
         let mut dissipation_power = 0.0;
         let (lookahead, wall, n) = (layout.dashpot_lookahead, layout.wall_row, vectors);
@@ -330,31 +347,45 @@ impl<'m> Integrator<'m> {
             ..
         } = self;
         recorder.track_deflection_peaks(layout, &state.level_deflections);
-        let base = layout.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
         let second_half = match layout.scheme {
             Scheme::CentralDifference => half,
             Scheme::Tchamwa { .. } => 0.0,
         };
         let n = vectors;
-        let sums = modal_update(
-            simd,
-            &ModalCoefficients::<S> {
-                stiffness: &S::as_simd_f64s(&layout.omega_squared).0[..n],
-                damping: &S::as_simd_f64s(&layout.damping).0[..n],
-                factor: &S::as_simd_f64s(&layout.implicit_damping_factor).0[..n],
-                participation: &S::as_simd_f64s(&layout.participation).0[..n],
-            },
-            base,
-            second_half,
-            (
-                S::as_simd_f64s(&state.q).0,
-                S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
-                S::as_mut_simd_f64s(&mut state.a[..pins_state]).0,
-                S::as_mut_simd_f64s(&mut state.force).0,
-            ),
+        let coefficients = ModalCoefficients::<S> {
+            stiffness: &S::as_simd_f64s(&layout.omega_squared).0[..n],
+            damping: &S::as_simd_f64s(&layout.damping).0[..n],
+            factor: &S::as_simd_f64s(&layout.implicit_damping_factor).0[..n],
+            participation: &S::as_simd_f64s(&layout.participation).0[..n],
+        };
+        let (q, v, a, f) = (
+            S::as_simd_f64s(&state.q).0,
+            S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
+            S::as_mut_simd_f64s(&mut state.a[..pins_state]).0,
+            S::as_mut_simd_f64s(&mut state.force).0,
         );
-        let modal_damping = sums.damping_power;
-        let mut external = -base * sums.participation_velocity;
+        // The base excitation's power −a(t) Σ Γ v, per direction in the plane.
+        let (modal_damping, mut external) = match layout.contact_model {
+            ContactModel::Row => {
+                let base = layout.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
+                let sums = modal_update(simd, &coefficients, base, second_half, (q, v, a, f));
+                (sums.damping_power, -base * sums.participation_velocity)
+            }
+            ContactModel::Plane(_) => {
+                let (base_x, base_y) = base_accelerations(layout.model, t);
+                let x_lines = q.len() / 2;
+                let (q_x, q_y) = q.split_at(x_lines);
+                let (v_x, v_y) = v.split_at_mut(x_lines);
+                let (a_x, a_y) = a.split_at_mut(x_lines);
+                let (f_x, f_y) = f.split_at_mut(x_lines);
+                let x = modal_update(simd, &coefficients, base_x, second_half, (q_x, v_x, a_x, f_x));
+                let y = modal_update(simd, &coefficients, base_y, second_half, (q_y, v_y, a_y, f_y));
+                (
+                    x.damping_power + y.damping_power,
+                    -base_x * x.participation_velocity - base_y * y.participation_velocity,
+                )
+            }
+        };
         for (point, shape) in layout.model.point_forces.iter().zip(&layout.point_force_shapes) {
             let velocity = kernels::dot(simd, shape, &state.v[point.pin * layout.row..][..layout.row]);
             external += point.force.at(t) * velocity;
@@ -408,4 +439,85 @@ impl<'m> Integrator<'m> {
         self.recorder
             .finish(self.arch, &self.layout, &self.state, steps, output_interval)
     }
+}
+
+/// The base acceleration (m/s²) at `t` along x and along y (0 for the row).
+fn base_accelerations(model: &Model<'_>, t: f64) -> (f64, f64) {
+    let at = |base: Option<&crate::loads::BaseAcceleration>| base.map_or(0.0, |b| b.at(t));
+    let y = model.plane.as_ref().and_then(|p| p.base_acceleration_y.as_ref());
+    (at(model.base_acceleration.as_ref()), at(y))
+}
+
+/// The closed contacts of the plane, after [`plane_penetrations`]: with the dashpot
+/// velocity of each body along x and y, rate_x = ψ·Δṽ_x and rate_y = ψ·Δṽ_y, the
+/// penetration rate is δ̇ = n_x rate_x + n_y rate_y and the sliding velocity
+/// v_t = −n_y rate_x + n_x rate_y (tangent t = (−n_y, n_x)); F = max(0, Kc δ + cc δ̇)
+/// pushes the left body by −F n and the right one by +F n, and the wear work gains
+/// F |v_t| Δt. Returns the contact dissipation power Σ (F − Kc δ) δ̇.
+#[inline(always)]
+fn plane_contact_forces<S: Simd>(
+    simd: S,
+    (layout, plane): (&Layout<'_>, &PlaneContacts),
+    state: &mut State,
+    recorder: &mut Recorder,
+    count: usize,
+    (t, record): (f64, bool),
+    vectors: usize,
+) -> f64 {
+    let mut dissipation_power = 0.0;
+    let (lookahead, wall, n, dt) = (layout.dashpot_lookahead, layout.wall_row, vectors, layout.dt);
+    let shapes = S::as_simd_f64s(&layout.level_shapes).0;
+    let (v, a) = (S::as_simd_f64s(&state.v).0, S::as_simd_f64s(&state.a).0);
+    let loads = S::as_mut_simd_f64s(&mut state.force).0;
+    let lane_contacts = layout.lane_contacts.as_slice();
+    let lanes = lane_contacts.len();
+    let plane_lanes = &plane.lanes[..lanes];
+    let (now, before) = (&state.penetration[..lanes], &state.previous_penetration[..lanes]);
+    let (forces, statistics) = (
+        &mut state.contact_force[..lanes],
+        &mut recorder.statistics[..lanes],
+    );
+    let (peaks, wear) = (&mut recorder.force_peak[..lanes], &mut recorder.wear[..lanes]);
+    let closed = &state.closed[..count];
+    for &j in closed {
+        let j = j as usize;
+        let (contact, lane) = (lane_contacts[j], plane_lanes[j]);
+        let (penetration, previous) = (now[j], before[j]);
+        let rows = |offset: usize| (&v[offset..], &a[offset..]);
+        let shape = &shapes[contact.shape..][..n];
+        let rate_x = penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead);
+        let rate_y = penetration_rate(simd, shape, rows(lane.left_y), rows(lane.right_y), lookahead);
+        let [normal_x, normal_y] = lane.normal;
+        let rate = normal_x * rate_x + normal_y * rate_y;
+        let sliding = normal_x * rate_y - normal_y * rate_x;
+        let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
+        forces[j] = force;
+        dissipation_power += (force - contact.stiffness * penetration) * rate;
+        if record {
+            if force > peaks[j] {
+                peaks[j] = force;
+            }
+            if contact.active {
+                record_closed_contact(&mut statistics[j], (t, dt), (penetration, previous), force);
+            }
+            wear[j] += force * sliding.abs() * dt;
+        }
+    }
+    for &j in closed {
+        let j = j as usize;
+        let (contact, lane, force) = (lane_contacts[j], plane_lanes[j], forces[j]);
+        if force != 0.0 {
+            let shape = &shapes[contact.shape..][..n];
+            let [normal_x, normal_y] = lane.normal;
+            if contact.left != wall {
+                row_axpy(simd, -force * normal_x, shape, &mut loads[contact.left..]);
+                row_axpy(simd, -force * normal_y, shape, &mut loads[lane.left_y..]);
+            }
+            if contact.right != wall {
+                row_axpy(simd, force * normal_x, shape, &mut loads[contact.right..]);
+                row_axpy(simd, force * normal_y, shape, &mut loads[lane.right_y..]);
+            }
+        }
+    }
+    dissipation_power
 }

@@ -23,6 +23,7 @@ fn free_model(basis: &ModalBasis, xi: f64, tip: f64) -> Model<'_> {
         contacts: vec![],
         initial_tip_displacements: vec![tip],
         base_acceleration: None,
+        plane: None,
         point_forces: vec![],
     }
 }
@@ -35,6 +36,7 @@ fn settings(scheme: Scheme, dt: f64, duration: f64) -> Settings {
         check: Check::None,
         duration,
         output_interval: None,
+        recorded_contacts: None,
         output_heights: vec![1.0],
     }
 }
@@ -260,6 +262,7 @@ fn shaken_two_pin_row(basis: &ModalBasis) -> Model<'_> {
             amplitude: 20.0,
             duration: 0.01,
         }),
+        plane: None,
         point_forces: vec![],
     }
 }
