@@ -541,9 +541,21 @@ fn excitation(
         })
     };
     let pointer = "/inputs/excitation";
-    let single = component(&input.base_acceleration, &format!("{pointer}/base_acceleration"), errors);
-    let x = component(&input.base_acceleration_x, &format!("{pointer}/base_acceleration_x"), errors);
-    let y = component(&input.base_acceleration_y, &format!("{pointer}/base_acceleration_y"), errors);
+    let single = component(
+        &input.base_acceleration,
+        &format!("{pointer}/base_acceleration"),
+        errors,
+    );
+    let x = component(
+        &input.base_acceleration_x,
+        &format!("{pointer}/base_acceleration_x"),
+        errors,
+    );
+    let y = component(
+        &input.base_acceleration_y,
+        &format!("{pointer}/base_acceleration_y"),
+        errors,
+    );
     if let Some(direction) = input.direction
         && !direction.is_finite()
     {
@@ -724,7 +736,11 @@ fn histories(plan: &Plan, simulation: integrate::Simulation) -> Vec<History> {
     let mut displacement_names = Vec::new();
     for height in &plan.settings.output_heights {
         for line in 0..2 * pins {
-            let (pin, axis) = if line < pins { (line, 'x') } else { (line - pins, 'y') };
+            let (pin, axis) = if line < pins {
+                (line, 'x')
+            } else {
+                (line - pins, 'y')
+            };
             displacement_names.push(if tips_only {
                 format!("p{pin}{axis}")
             } else {
@@ -748,10 +764,7 @@ fn histories(plan: &Plan, simulation: integrate::Simulation) -> Vec<History> {
         series,
     };
     vec![
-        history(
-            "contact_forces",
-            named(&contact_names, simulation.contact_forces),
-        ),
+        history("contact_forces", named(&contact_names, simulation.contact_forces)),
         history(
             "displacements",
             named(

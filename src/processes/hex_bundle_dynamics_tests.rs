@@ -42,12 +42,17 @@ fn errors(inputs: &Value) -> Vec<(String, String)> {
         .expect_err("invalid")
         .0
         .into_iter()
-        .map(|e| (e.pointer, e.message))
+        .map(|e| (e.pointer, e.detail))
         .collect()
 }
 
+/// `base` with the member at `pointer` set (created in its object if absent).
 fn with(mut base: Value, pointer: &str, value: Value) -> Value {
-    *base.pointer_mut(pointer).unwrap_or_else(|| panic!("no {pointer}")) = value;
+    let (parent, key) = pointer.rsplit_once('/').expect("a pointer");
+    base.pointer_mut(parent)
+        .and_then(Value::as_object_mut)
+        .unwrap_or_else(|| panic!("no object at {parent}"))
+        .insert(key.to_owned(), value);
     base
 }
 
@@ -107,7 +112,10 @@ fn the_bundle_turned_by_sixty_degrees_gives_the_turned_response() {
     };
     let (a, b) = (contacts(&first.document), contacts(&turned.document));
     let peak = first.document["max_contact_force"]["force"].as_f64().unwrap();
-    assert!(peak > 1.0, "contacts must carry force for the check to mean anything");
+    assert!(
+        peak > 1.0,
+        "contacts must carry force for the check to mean anything"
+    );
     let mut matched = 0;
     for ca in a {
         let target = key(ca, 1);
@@ -117,7 +125,11 @@ fn the_bundle_turned_by_sixty_degrees_gives_the_turned_response() {
             .expect("the turned contact exists");
         for field in ["max_force", "impulse", "contact_time"] {
             let (x, y) = (ca[field].as_f64().unwrap(), cb[field].as_f64().unwrap());
-            let scale = if field == "max_force" { peak } else { x.abs().max(1e-12) };
+            let scale = if field == "max_force" {
+                peak
+            } else {
+                x.abs().max(1e-12)
+            };
             assert!((x - y).abs() <= 1e-6 * scale, "{field}: {x} vs {y} at {ca}");
         }
         matched += 1;
@@ -131,17 +143,17 @@ fn the_bundle_turned_by_sixty_degrees_gives_the_turned_response() {
         let q = lattice.rotated(p, 1);
         let history = &first.histories[1];
         let last = |h: &History, name: &str| *series(h, name).last().unwrap();
-        let u = Vec2::new(
-            last(history, &format!("p{p}x")),
-            last(history, &format!("p{p}y")),
-        )
-        .rotated(rotation);
+        let u =
+            Vec2::new(last(history, &format!("p{p}x")), last(history, &format!("p{p}y"))).rotated(rotation);
         let turned_history = &turned.histories[1];
         let v = Vec2::new(
             last(turned_history, &format!("p{q}x")),
             last(turned_history, &format!("p{q}y")),
         );
-        assert!((u - v).norm() <= 1e-6 * u.norm().max(1e-9), "pin {p}: {u:?} vs {v:?}");
+        assert!(
+            (u - v).norm() <= 1e-6 * u.norm().max(1e-9),
+            "pin {p}: {u:?} vs {v:?}"
+        );
     }
 }
 
@@ -197,7 +209,11 @@ fn output_selection_records_only_the_selected_contacts() {
     for k in &recorded {
         assert!(doc["contacts"][*k as usize]["touched_flat"].is_number());
     }
-    let names: Vec<&str> = walls.histories[0].series.iter().map(|(n, _)| n.as_str()).collect();
+    let names: Vec<&str> = walls.histories[0]
+        .series
+        .iter()
+        .map(|(n, _)| n.as_str())
+        .collect();
     assert_eq!(names[0], format!("c{}", recorded[0]));
     // The force history of a recorded contact peaks at its max_force (the peaks history
     // keeps every step's maximum).
@@ -206,10 +222,18 @@ fn output_selection_records_only_the_selected_contacts() {
     let max = peaks.iter().copied().fold(0.0, f64::max);
     assert_eq!(max, doc["contacts"][k]["max_force"].as_f64().unwrap());
 
-    let list = run(&with(inputs(), "/output/contacts", json!({"type": "list", "contacts": [5, 2]})));
+    let list = run(&with(
+        inputs(),
+        "/output/contacts",
+        json!({"type": "list", "contacts": [5, 2]}),
+    ));
     let names: Vec<&str> = list.histories[0].series.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(names, ["c5", "c2"]);
-    let ring = run(&with(inputs(), "/output/contacts", json!({"type": "rings", "first": 0, "last": 0})));
+    let ring = run(&with(
+        inputs(),
+        "/output/contacts",
+        json!({"type": "rings", "first": 0, "last": 0}),
+    ));
     // The centre pin: its wire on a neighbour at each pin–pin level, and touched once
     // per pin–pin level by the neighbour whose wire points at it (12 levels each way).
     assert_eq!(ring.document["recorded_contacts"].as_array().unwrap().len(), 24);

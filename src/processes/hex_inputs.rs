@@ -274,14 +274,23 @@ impl HexInputs {
         self.closures
             .iter()
             .enumerate()
-            .filter_map(|(k, c)| c.zone().err().map(|reason| (format!("/inputs/closures/{k}"), reason)))
+            .filter_map(|(k, c)| {
+                c.zone()
+                    .err()
+                    .map(|reason| (format!("/inputs/closures/{k}"), reason))
+            })
             .collect()
     }
 }
 
 impl HexClosureInput {
     fn zone(&self) -> Result<PinZone, String> {
-        match (self.first_ring, self.last_ring, self.first_sector, self.last_sector) {
+        match (
+            self.first_ring,
+            self.last_ring,
+            self.first_sector,
+            self.last_sector,
+        ) {
             (Some(first_ring), Some(last_ring), None, None) => Ok(PinZone::Rings {
                 first_ring,
                 last_ring,
