@@ -11,6 +11,8 @@ pub mod bundle_dynamics;
 pub mod bundle_inputs;
 pub mod cantilever_impact;
 pub mod cost;
+pub mod hex_bundle_dynamics;
+pub mod hex_inputs;
 pub mod inputs;
 pub mod metrics;
 pub mod model_check;
@@ -207,6 +209,7 @@ impl Registry {
         Self::new(vec![
             Arc::new(cantilever_impact::CantileverImpact),
             Arc::new(bundle_dynamics::BundleDynamics),
+            Arc::new(hex_bundle_dynamics::HexBundleDynamics),
         ])
     }
 

@@ -45,6 +45,30 @@ impl BaseAcceleration {
         }
     }
 
+    /// The same signal multiplied by `factor` (a component of a signal along a
+    /// direction: `factor` = cos θ or sin θ).
+    pub fn scaled(&self, factor: f64) -> BaseAcceleration {
+        match self {
+            BaseAcceleration::HalfSine { amplitude, duration } => BaseAcceleration::HalfSine {
+                amplitude: factor * amplitude,
+                duration: *duration,
+            },
+            BaseAcceleration::Sine {
+                amplitude,
+                frequency,
+                cycles,
+            } => BaseAcceleration::Sine {
+                amplitude: factor * amplitude,
+                frequency: *frequency,
+                cycles: *cycles,
+            },
+            BaseAcceleration::Table(table) => BaseAcceleration::Table(Table {
+                time: table.time.clone(),
+                values: table.values.iter().map(|v| factor * v).collect(),
+            }),
+        }
+    }
+
     /// Every problem (fields relative to the excitation object).
     pub fn validate(&self) -> Vec<InputIssue> {
         let mut issues = Vec::new();

@@ -1,7 +1,8 @@
 // One job: status (live while it runs), inputs, results and plots. `cantilever-impact`
 // gets its tip deflection and contact force, numerical against reference, and the power
 // spectra of both with f_err; `bundle-dynamics` its peak contact forces by level and
-// position and any contact's or pin's history; any other process its histories.
+// position and any contact's or pin's history; `hex-bundle-dynamics` a cross-section
+// per level (hex.js); any other process its histories.
 // Every job with a quality section shows its verdict as a badge (with the reasons) next
 // to its numbers, and each force or displacement plot draws the history's peak-keeping
 // companion (`<name>_peaks`) with the samples, so the plotted peak is the reported one.
@@ -9,6 +10,7 @@
 import {FINISHED, ApiProblem, api, badge, card, download, errorBox, fmt, fmtElapsed, fmtTime, h, keyValueTable,
   leaves, poll, progressBar, replace, withUnit} from './util.js';
 import {barChart, heatMap, linePlot} from './plot.js';
+import {hexBundle} from './hex.js';
 
 /** Points asked of a history for a plot (min/max thinning keeps every peak). */
 const PLOT_POINTS = 2400;
@@ -96,6 +98,8 @@ async function showResults(box, id, status) {
     await cantilever(sections, id, results);
   } else if (status.processID === 'bundle-dynamics') {
     await bundle(sections, id, results);
+  } else if (status.processID === 'hex-bundle-dynamics') {
+    await hexBundle(sections, id, results);
   } else {
     await generic(sections, id, results);
   }
@@ -122,7 +126,7 @@ const VERDICT_MEANING = {
 };
 
 /** The quality verdict as a badge, its reasons as a tooltip; null without a quality section. */
-function qualityBadge(results) {
+export function qualityBadge(results) {
   const quality = results.quality;
   if (!quality || !quality.verdict) return null;
   return h('span', {class: `badge ${quality.verdict}`, 'data-quality': quality.verdict,
@@ -155,31 +159,31 @@ function qualityCard(results) {
  * The peak-keeping companion of `output` (`<output>_peaks`: the extreme of every output
  * interval over all steps), or null when the results have none.
  */
-async function envelope(id, results, output, series) {
+export async function envelope(id, results, output, series) {
   const name = `${output}_peaks`;
   if (!(results.outputs || {})[name]) return null;
   return history(id, name, series);
 }
 
 /** The series of an envelope document, drawn light under the samples of the same colour. */
-function envelopeSeries(doc, styles = {}) {
+export function envelopeSeries(doc, styles = {}) {
   if (!doc) return [];
   return doc.series.map((item, k) => ({...(styles[item.name] || {color: k}), name: `${item.name}_peaks`,
     label: `${item.name}: peak per output interval`, x: doc.time, y: item.values, envelope: true, dashed: false}));
 }
 
 /** A horizontal line at a reported peak. */
-const reportedPeak = (value, unit) => (Number.isFinite(value) && value !== 0
+export const reportedPeak = (value, unit) => (Number.isFinite(value) && value !== 0
   ? [{y: value, label: `reported ${fmt(value, 4)} ${unit}`}] : []);
 
 /** A history (or some of its series) thinned for plotting: {time, series: [{name, values}]}. */
-function history(id, output, series) {
+export function history(id, output, series) {
   const params = new URLSearchParams({max_points: PLOT_POINTS});
   if (series) params.set('series', series);
   return api(`/jobs/${id}/results/${output}?${params}`);
 }
 
-function seriesOf(doc, styles = {}) {
+export function seriesOf(doc, styles = {}) {
   return doc.series.map((item, k) => ({name: item.name, x: doc.time, y: item.values, ...(styles[item.name] || {color: k})}));
 }
 
@@ -246,7 +250,7 @@ async function cantilever(box, id, results) {
   await draw();
 }
 
-function thinned(doc, peaks = null) {
+export function thinned(doc, peaks = null) {
   return h('span', {class: 'muted', 'data-envelope': peaks ? 'true' : null},
     doc.thinned ? ` ${doc.points} of ${doc.total_points} samples (peaks kept)` : ` ${doc.points} samples`,
     peaks ? '; light: the extreme of every output interval over all steps' : '');

@@ -387,3 +387,6 @@ export function barChart({id, title, caption, labels, values, yLabel, xLabel, se
     axisLabels(width, height, margin, xLabel, yLabel));
   return figure(id, title, caption || null, svg);
 }
+
+/** For figures drawn elsewhere (hex.js): the SVG element builder and the figure frame. */
+export {s as svgElement, figure};

@@ -1,0 +1,791 @@
+//! Process `hex-bundle-dynamics`: a wire-wrapped hexagonal bundle (7 to 271 identical
+//! pins on one shared modal basis, bending along x and y) in its wrapper tube, built from
+//! a dozen numbers (`physics::hex`): each wire touches a neighbour's clad or the wrapper
+//! once every H/12, each contact with its normal in the transverse plane. Shaken by the
+//! wrapper in any horizontal direction. Statistics for every contact, full force
+//! histories for a selection.
+
+use serde::Serialize;
+use utoipa::ToSchema;
+
+use super::basis_report::BasisReport;
+use super::bundle_dynamics::{PeakDeflectionResult, PeakForce};
+use super::hex_inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
+use super::inputs::{self, SolverDefaults, at};
+use super::report::{EnergyReport, QualityReport};
+use super::simulation::{HistoryOutput, Output, Simulation};
+use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
+use crate::physics::contact::{Body as RowBody, Contact};
+use crate::physics::hex::{Aim, Body, HexBundle, HexContact, pair_count};
+use crate::physics::integrate::{self, Model, Plane, Settings, StepSize};
+use crate::physics::loads::BaseAcceleration;
+use crate::physics::modal::ModalBasis;
+use crate::physics::{InputIssue, require_non_negative};
+
+/// Default history interval (s).
+pub const DEFAULT_OUTPUT_INTERVAL: f64 = 1e-4;
+
+/// Validated inputs, ready to run.
+#[derive(Debug)]
+pub struct Plan {
+    inputs: HexInputs,
+    bundle: HexBundle,
+    geometry: Vec<HexContact>,
+    contacts: Vec<Contact>,
+    normals: Vec<[f64; 2]>,
+    excitation: (Option<BaseAcceleration>, Option<BaseAcceleration>),
+    basis: ModalBasis,
+    settings: Settings,
+    step: StepSize,
+}
+
+impl Plan {
+    fn model(&self) -> Model<'_> {
+        plane_model(
+            &self.inputs,
+            self.bundle.pin_count(),
+            (&self.contacts, &self.normals),
+            &self.excitation,
+            &self.basis,
+        )
+    }
+}
+
+/// The bundle as the integrator sees it: the wire pin is the contact's left body, the
+/// touched clad (or the wall) its right body, the normal from left to right.
+fn plane_model<'a>(
+    inputs: &HexInputs,
+    pins: usize,
+    (contacts, normals): (&[Contact], &[[f64; 2]]),
+    (x, y): &(Option<BaseAcceleration>, Option<BaseAcceleration>),
+    basis: &'a ModalBasis,
+) -> Model<'a> {
+    Model {
+        basis,
+        pins,
+        damping_ratios: inputs.pin.damping_ratios_for(basis.modes()),
+        contacts: contacts.to_vec(),
+        initial_tip_displacements: Vec::new(),
+        base_acceleration: x.clone(),
+        point_forces: Vec::new(),
+        plane: Some(Plane {
+            normals: normals.to_vec(),
+            base_acceleration_y: y.clone(),
+        }),
+    }
+}
+
+/// The results document of `hex-bundle-dynamics`.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct HexResults {
+    /// The bundle the inputs describe: counts, clearances, levels.
+    pub geometry: GeometryReport,
+    /// Every contact (bodies, level, normal, gap) and its statistics, accumulated at
+    /// every step.
+    pub contacts: Vec<HexContactResult>,
+    /// The largest force over all contacts; null without contacts.
+    pub max_contact_force: Option<PeakForce>,
+    /// Total closures over all contacts.
+    pub impacts: u64,
+    /// Contacts whose force histories were recorded (`c<k>` columns), in column order.
+    pub recorded_contacts: Vec<usize>,
+    /// Per pin: position and largest deflections along x and y.
+    pub pins: Vec<HexPinResult>,
+    pub energy: EnergyReport,
+    /// Step used (s).
+    pub time_step: f64,
+    /// Critical step with every contact closed (s).
+    pub critical_time_step: f64,
+    /// Steps taken.
+    pub steps: u64,
+    /// Time between two history samples (s).
+    pub output_interval: f64,
+    pub quality: QualityReport,
+    /// Frequencies of the pin's basis (Hz), eigenmodes then pseudo-modes (the same in x
+    /// and y).
+    pub frequencies_hz: Vec<f64>,
+    pub basis: BasisReport,
+}
+
+/// The generated bundle.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct GeometryReport {
+    /// Pins, 3n(n + 1) + 1.
+    pub pins: usize,
+    pub rings: usize,
+    /// Neighbour pairs, 9n² + 3n.
+    pub neighbour_pairs: usize,
+    /// P (m).
+    pub pitch: f64,
+    /// D, the clad's outer diameter (m).
+    pub pin_diameter: f64,
+    /// d_w (m).
+    pub wire_diameter: f64,
+    /// H (m).
+    pub wire_lead: f64,
+    /// F, inner flat-to-flat distance of the wrapper (m).
+    pub wrapper_flat_to_flat: f64,
+    /// Potential contacts over the pin length.
+    pub contacts: usize,
+    /// Nominal wire-to-clad clearance P − D − d_w (m).
+    pub pin_clearance: f64,
+    /// Nominal wire-to-wrapper clearance F/2 − n·P·√3/2 − D/2 − d_w (m).
+    pub wall_clearance: f64,
+    /// Contact levels from the lowest (one every H/12).
+    pub levels: Vec<LevelReport>,
+}
+
+/// One contact level: where every wire points.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct LevelReport {
+    /// Height from the pin feet (m).
+    pub height: f64,
+    /// Direction of every wire there (degrees, counter-clockwise from +x).
+    pub wire_angle: f64,
+    /// The lattice direction (0..6) of the neighbours touched, or null on a wall level.
+    pub neighbour_direction: Option<usize>,
+    /// The flat (0..6) touched by the pins facing it, or null on a pin–pin level.
+    pub flat: Option<usize>,
+}
+
+/// One contact and its statistics.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct HexContactResult {
+    /// Level index (`geometry.levels`).
+    pub level: usize,
+    /// Height from the pin feet (m).
+    pub height: f64,
+    /// The pin whose wire touches.
+    pub wire_pin: usize,
+    /// The pin whose clad is touched; null for a wall contact.
+    pub touched_pin: Option<usize>,
+    /// The wrapper flat touched; null for a pin–pin contact.
+    pub touched_flat: Option<usize>,
+    /// Unit normal (x, y) from the wire pin toward what it touches.
+    pub normal: [f64; 2],
+    /// Gap at rest (m).
+    pub gap: f64,
+    /// Largest force (N).
+    pub max_force: f64,
+    /// Its time (s); 0 when the contact never closed.
+    pub max_force_time: f64,
+    /// Closures after a separation (the first counts).
+    pub impacts: u64,
+    /// Total time closed (s).
+    pub contact_time: f64,
+    /// ∫ F dt (N·s), along the normal.
+    pub impulse: f64,
+    /// Time of the first closure (s), interpolated between steps; null if none.
+    pub first_impact_time: Option<f64>,
+    /// Largest penetration (m); ≤ 0 when the contact never closed (smallest clearance).
+    pub max_penetration: f64,
+    /// Wear work rate (1/T) ∫ F·|v_t| dt (W), v_t the sliding velocity across the normal.
+    pub wear_work_rate: f64,
+}
+
+/// One pin's position and largest deflections.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct HexPinResult {
+    pub pin: usize,
+    /// Ring (0 = the centre pin).
+    pub ring: usize,
+    /// Centre (x, y) in the wrapper (m).
+    pub position: [f64; 2],
+    /// Bending along x.
+    pub x: DirectionResult,
+    /// Bending along y.
+    pub y: DirectionResult,
+}
+
+/// A pin's largest deflections along one direction.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct DirectionResult {
+    /// max |w| (m) over the mesh nodes at every output time.
+    pub max_abs_deflection: f64,
+    /// Height where it occurred (m).
+    pub height: f64,
+    /// When (s).
+    pub time: f64,
+    /// Per output height, the deflection of largest magnitude over every step.
+    pub peak_deflections: Vec<PeakDeflectionResult>,
+}
+
+/// The `hex-bundle-dynamics` process.
+#[derive(Debug, Default)]
+pub struct HexBundleDynamics;
+
+impl Simulation for HexBundleDynamics {
+    const ID: &'static str = "hex-bundle-dynamics";
+    const TITLE: &'static str = "Wire-wrapped hexagonal bundle shaken in the transverse plane";
+    const DESCRIPTION: &'static str = "Builds a wire-wrapped hexagonal bundle (7 to 271 identical pins, one shared modal basis \
+         bending along x and y) in its wrapper from a dozen numbers: each spacer wire touches a \
+         neighbour's clad or the wrapper once every H/12, with its normal in the transverse plane. \
+         Integrates it under a base acceleration in any horizontal direction with penalty contacts. \
+         Returns every contact with its statistics (peak force, impacts, contact time, impulse, wear \
+         work rate), per-pin extremes, the energy balance, force histories of a selection of \
+         contacts and the pins' deflection histories.";
+    const HISTORIES: &'static [HistoryOutput] = &[
+        HistoryOutput {
+            name: "contact_forces",
+            title: "Contact forces (N)",
+            description: "CSV columns time (s), c<k> for each recorded contact k (results recorded_contacts)",
+        },
+        HistoryOutput {
+            name: "displacements",
+            title: "Pin deflections (m)",
+            description: "CSV columns time (s), p<pin>x, p<pin>y, ... (pin tips; `p<pin>x@<height>` for other heights)",
+        },
+        HistoryOutput {
+            name: "contact_forces_peaks",
+            title: "Contact force peaks (N)",
+            description: "As contact_forces, each value the largest force reached at any step of its output interval",
+        },
+        HistoryOutput {
+            name: "displacements_peaks",
+            title: "Pin deflection peaks (m)",
+            description: "As displacements, each value the deflection of largest magnitude (signed) reached at \
+                          any step of its output interval",
+        },
+    ];
+
+    type Inputs = HexInputs;
+    type Results = HexResults;
+    type Plan = Plan;
+
+    fn prepare(inputs: HexInputs) -> Result<Plan, InvalidInputs> {
+        let (length, elements) = (inputs.pin.length, inputs.pin.elements);
+        let pin_issues = inputs.pin.validate();
+        let pin_ok = pin_issues.is_empty();
+        let mut errors: Vec<FieldError> = at("/inputs/pin", pin_issues);
+
+        let diameter = inputs.pin_diameter();
+        if diameter.is_none() {
+            errors.push(FieldError::new(
+                "/inputs/bundle/pin_diameter",
+                "is required with an explicit pin section (the clad diameter D)",
+            ));
+        }
+        let bundle = diameter.and_then(|d| match HexBundle::new(inputs.layout(d), length, elements) {
+            Ok(bundle) => Some(bundle),
+            Err(issues) => {
+                errors.extend(geometry_errors(&inputs, issues, pin_ok));
+                None
+            }
+        });
+        errors.extend(contact_law_errors(&inputs));
+        errors.extend(
+            inputs
+                .closure_issues()
+                .into_iter()
+                .map(|(pointer, reason)| FieldError::new(pointer, reason)),
+        );
+        let excitation = excitation(&inputs.excitation, &mut errors);
+        let solver = inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
+        inputs::check_output_interval(inputs.output.interval, &mut errors);
+        let heights = output_heights(&inputs, &mut errors);
+
+        let Some(bundle) = bundle else {
+            return Err(InvalidInputs(errors));
+        };
+        let geometry = bundle.contacts();
+        let gaps = match inputs.gaps().gaps(&bundle, &geometry) {
+            Ok(gaps) => gaps,
+            Err(issues) => {
+                errors.extend(at("/inputs", issues));
+                Vec::new()
+            }
+        };
+        let recorded = recorded_contacts(&inputs, &bundle, &geometry, &mut errors);
+        if !errors.is_empty() {
+            return Err(InvalidInputs(errors));
+        }
+
+        let law = &inputs.contact;
+        let contacts: Vec<Contact> = geometry
+            .iter()
+            .zip(&gaps)
+            .map(|(c, gap)| {
+                let (right, stiffness, damping) = match c.touched {
+                    Body::Pin(pin) => (RowBody::Pin(pin), law.stiffness, law.damping),
+                    Body::Flat(_) => (
+                        RowBody::Wall,
+                        law.wall_stiffness.unwrap_or(law.stiffness),
+                        law.wall_damping.unwrap_or(law.damping),
+                    ),
+                };
+                Contact {
+                    left: RowBody::Pin(c.wire_pin),
+                    right,
+                    height: c.height,
+                    gap: *gap,
+                    stiffness,
+                    damping,
+                }
+            })
+            .collect();
+        let normals: Vec<[f64; 2]> = geometry.iter().map(|c| [c.normal.x, c.normal.y]).collect();
+        // One static correction per distinct contact height (one per level), shared by
+        // every pin and both directions.
+        let levels: Vec<f64> = bundle.levels().iter().map(|l| l.height).collect();
+        let basis = inputs.pin.basis(&levels, "/inputs/pin")?;
+        let settings = Settings {
+            scheme: solver.scheme,
+            time_step: solver.time_step,
+            tolerance: solver.tolerance,
+            check: solver.check,
+            duration: solver.duration,
+            output_interval: Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
+            output_heights: heights,
+            recorded_contacts: Some(recorded),
+        };
+        let model = plane_model(
+            &inputs,
+            bundle.pin_count(),
+            (&contacts, &normals),
+            &excitation,
+            &basis,
+        );
+        let step = inputs::resolve_step(&model, &settings)?;
+        Ok(Plan {
+            inputs,
+            bundle,
+            geometry,
+            contacts,
+            normals,
+            excitation,
+            basis,
+            settings,
+            step,
+        })
+    }
+
+    /// 2 × pins lines of modes and every contact at each step; histories
+    /// `contact_forces` (time + one column per recorded contact) and `displacements`
+    /// (time + two columns per pin and output height), and their peaks.
+    fn estimate(plan: &Plan) -> WorkEstimate {
+        let (stepping, samples) = inputs::stepping(&plan.settings, &plan.step);
+        let lines = 2 * plan.bundle.pin_count();
+        let recorded = plan.settings.recorded_contacts.as_ref().map_or(0, Vec::len);
+        let columns = 2 * ((1 + recorded) + (1 + lines * plan.settings.output_heights.len()));
+        let mut history_drivers = vec![
+            "/inputs/solver/duration".to_owned(),
+            "/inputs/output/interval".to_owned(),
+            "/inputs/output/contacts".to_owned(),
+            "/inputs/bundle/rings".to_owned(),
+        ];
+        if plan.inputs.output.heights.is_some() {
+            history_drivers.push("/inputs/output/heights".to_owned());
+        }
+        WorkEstimate {
+            modal_dofs: (lines * plan.basis.modes()) as f64,
+            contacts: plan.contacts.len() as f64,
+            history_values: samples * columns as f64,
+            work_drivers: [
+                "/inputs/solver/duration",
+                "/inputs/solver/time_step",
+                "/inputs/pin/modes",
+                "/inputs/bundle/rings",
+                "/inputs/bundle/wire_lead",
+            ]
+            .map(str::to_owned)
+            .to_vec(),
+            history_drivers,
+            ..stepping
+        }
+    }
+
+    fn run(plan: Plan, progress: &mut ProgressFn<'_>) -> Result<Output<HexResults>, RunError> {
+        let model = plan.model();
+        let assessed = integrate::Plan::with_step(&model, &plan.settings, plan.step)?.run(progress)?;
+        let (simulation, quality) = (assessed.simulation, assessed.quality);
+        let duration = plan.settings.duration;
+
+        let contacts: Vec<HexContactResult> = plan
+            .geometry
+            .iter()
+            .zip(&plan.contacts)
+            .zip(&simulation.contact_statistics)
+            .enumerate()
+            .map(|(k, ((g, c), s))| HexContactResult {
+                level: g.level,
+                height: g.height,
+                wire_pin: g.wire_pin,
+                touched_pin: g.touched_pin(),
+                touched_flat: match g.touched {
+                    Body::Flat(flat) => Some(flat.index()),
+                    Body::Pin(_) => None,
+                },
+                normal: [g.normal.x, g.normal.y],
+                gap: c.gap,
+                max_force: s.max_force,
+                max_force_time: s.max_force_time,
+                impacts: s.impacts,
+                contact_time: s.contact_time,
+                impulse: s.impulse,
+                first_impact_time: s.first_impact_time,
+                max_penetration: s.max_penetration,
+                wear_work_rate: simulation.wear_work.get(k).copied().unwrap_or(0.0) / duration,
+            })
+            .collect();
+        let max_contact_force = simulation
+            .contact_statistics
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.max_force.total_cmp(&b.1.max_force))
+            .map(|(k, s)| PeakForce {
+                contact: k,
+                force: s.max_force,
+                time: s.max_force_time,
+            });
+        let pin_count = plan.bundle.pin_count();
+        let heights = &plan.settings.output_heights;
+        let direction = |line: usize| {
+            let extreme = &simulation.pin_extremes[line];
+            DirectionResult {
+                max_abs_deflection: extreme.max_abs_deflection,
+                height: extreme.height,
+                time: extreme.time,
+                peak_deflections: heights
+                    .iter()
+                    .zip(&simulation.peak_deflections)
+                    .map(|(height, per_line)| PeakDeflectionResult {
+                        height: *height,
+                        deflection: per_line[line].deflection,
+                        time: per_line[line].time,
+                    })
+                    .collect(),
+            }
+        };
+        let pins: Vec<HexPinResult> = (0..pin_count)
+            .map(|p| {
+                let position = plan.bundle.position(p);
+                HexPinResult {
+                    pin: p,
+                    ring: plan.bundle.lattice().ring(p),
+                    position: [position.x, position.y],
+                    x: direction(p),
+                    y: direction(pin_count + p),
+                }
+            })
+            .collect();
+        let recorded_contacts = plan.settings.recorded_contacts.clone().unwrap_or_default();
+        let results = HexResults {
+            geometry: geometry_report(&plan.bundle, plan.geometry.len()),
+            contacts,
+            max_contact_force,
+            impacts: simulation.contact_statistics.iter().map(|s| s.impacts).sum(),
+            recorded_contacts,
+            pins,
+            energy: simulation.energy.into(),
+            time_step: simulation.step.time_step,
+            critical_time_step: simulation.step.critical_time_step,
+            steps: simulation.steps,
+            output_interval: simulation.output_interval,
+            quality,
+            frequencies_hz: plan.basis.frequencies_hz(),
+            basis: BasisReport::of(&model, plan.settings.scheme, simulation.step.critical_time_step),
+        };
+        let histories = histories(&plan, simulation);
+        Ok(Output { results, histories })
+    }
+}
+
+/// The layout's issues at the user's pointers: the geometry under `/inputs/bundle`, D at
+/// the field that gave it, the pin's length and elements under `/inputs/pin` (unless the
+/// pin's own checks already refused them).
+fn geometry_errors(inputs: &HexInputs, issues: Vec<InputIssue>, pin_ok: bool) -> Vec<FieldError> {
+    issues
+        .into_iter()
+        .filter_map(|issue| {
+            let pointer = match issue.field.as_str() {
+                "pin_length" | "elements" if !pin_ok => return None,
+                "pin_length" => "/inputs/pin/length".to_owned(),
+                "elements" => "/inputs/pin/elements".to_owned(),
+                "pin_diameter" if inputs.bundle.pin_diameter.is_none() => {
+                    "/inputs/pin/section/outer_diameter".to_owned()
+                }
+                field => format!("/inputs/bundle/{field}"),
+            };
+            Some(FieldError::new(pointer, issue.reason))
+        })
+        .collect()
+}
+
+fn contact_law_errors(inputs: &HexInputs) -> Vec<FieldError> {
+    let law = &inputs.contact;
+    let mut issues = Vec::new();
+    require_non_negative(&mut issues, "stiffness", law.stiffness);
+    require_non_negative(&mut issues, "damping", law.damping);
+    if let Some(k) = law.wall_stiffness {
+        require_non_negative(&mut issues, "wall_stiffness", k);
+    }
+    if let Some(c) = law.wall_damping {
+        require_non_negative(&mut issues, "wall_damping", c);
+    }
+    at("/inputs/contact", issues)
+}
+
+/// The (x, y) components of the base acceleration, or the errors: one signal with an
+/// optional direction, or two components, not both.
+fn excitation(
+    input: &HexExcitationInput,
+    errors: &mut Vec<FieldError>,
+) -> (Option<BaseAcceleration>, Option<BaseAcceleration>) {
+    let component = |signal: &Option<super::bundle_inputs::BaseAccelerationInput>,
+                     pointer: &str,
+                     errors: &mut Vec<FieldError>| {
+        signal.as_ref().map(|s| {
+            let physics = s.physics();
+            errors.extend(at(pointer, physics.validate()));
+            physics
+        })
+    };
+    let pointer = "/inputs/excitation";
+    let single = component(
+        &input.base_acceleration,
+        &format!("{pointer}/base_acceleration"),
+        errors,
+    );
+    let x = component(
+        &input.base_acceleration_x,
+        &format!("{pointer}/base_acceleration_x"),
+        errors,
+    );
+    let y = component(
+        &input.base_acceleration_y,
+        &format!("{pointer}/base_acceleration_y"),
+        errors,
+    );
+    if let Some(direction) = input.direction
+        && !direction.is_finite()
+    {
+        errors.push(FieldError::new(
+            format!("{pointer}/direction"),
+            "must be a finite angle in degrees",
+        ));
+    }
+    match single {
+        Some(signal) => {
+            if x.is_some() || y.is_some() {
+                let field = if x.is_some() {
+                    "base_acceleration_x"
+                } else {
+                    "base_acceleration_y"
+                };
+                errors.push(FieldError::new(
+                    format!("{pointer}/{field}"),
+                    "give either base_acceleration (with direction) or the components base_acceleration_x \
+                     and base_acceleration_y, not both",
+                ));
+            }
+            let angle = input.direction.unwrap_or(0.0).to_radians();
+            (Some(signal.scaled(angle.cos())), Some(signal.scaled(angle.sin())))
+        }
+        None => {
+            if input.direction.is_some() {
+                errors.push(FieldError::new(
+                    format!("{pointer}/direction"),
+                    "is the direction of base_acceleration, which is not given (the components \
+                     base_acceleration_x and base_acceleration_y need none)",
+                ));
+            }
+            (x, y)
+        }
+    }
+}
+
+fn output_heights(inputs: &HexInputs, errors: &mut Vec<FieldError>) -> Vec<f64> {
+    let length = inputs.pin.length;
+    let heights = inputs.output.heights.clone().unwrap_or_else(|| vec![length]);
+    if heights.is_empty() {
+        errors.push(FieldError::new(
+            "/inputs/output/heights",
+            "must list at least one height",
+        ));
+    }
+    for (k, h) in heights.iter().enumerate() {
+        if !(h.is_finite() && (0.0..=length).contains(h)) {
+            errors.push(FieldError::new(
+                format!("/inputs/output/heights/{k}"),
+                format!("must be within the pin, 0 to {length} m"),
+            ));
+        }
+    }
+    heights
+}
+
+/// The contacts `output.contacts` selects, in contact order (a list keeps its order).
+fn recorded_contacts(
+    inputs: &HexInputs,
+    bundle: &HexBundle,
+    contacts: &[HexContact],
+    errors: &mut Vec<FieldError>,
+) -> Vec<usize> {
+    let pointer = "/inputs/output/contacts";
+    let selection = inputs
+        .output
+        .contacts
+        .clone()
+        .unwrap_or(ContactSelectionInput::Walls {});
+    let indices = |keep: &dyn Fn(&HexContact) -> bool| -> Vec<usize> {
+        contacts
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| keep(c))
+            .map(|(k, _)| k)
+            .collect()
+    };
+    let mut range = |first: usize, last: usize, count: usize, what: &str| -> bool {
+        let mut ok = true;
+        for (end, index) in [("first", first), ("last", last)] {
+            if index >= count {
+                errors.push(FieldError::new(
+                    format!("{pointer}/{end}"),
+                    format!(
+                        "{what} {index} is outside the bundle: must be ≤ {} ({count} {what}s, from 0)",
+                        count.saturating_sub(1)
+                    ),
+                ));
+                ok = false;
+            }
+        }
+        if first > last {
+            errors.push(FieldError::new(
+                format!("{pointer}/last"),
+                format!("must be ≥ first ({first}), got {last}"),
+            ));
+            ok = false;
+        }
+        ok
+    };
+    match selection {
+        ContactSelectionInput::All {} => (0..contacts.len()).collect(),
+        ContactSelectionInput::None {} => Vec::new(),
+        ContactSelectionInput::Walls {} => indices(&|c| matches!(c.touched, Body::Flat(_))),
+        ContactSelectionInput::List { contacts: list } => {
+            for (i, k) in list.iter().enumerate() {
+                if *k >= contacts.len() {
+                    errors.push(FieldError::new(
+                        format!("{pointer}/contacts/{i}"),
+                        format!(
+                            "contact {k} does not exist: the bundle has {} contacts (0..{})",
+                            contacts.len(),
+                            contacts.len().saturating_sub(1)
+                        ),
+                    ));
+                }
+            }
+            list
+        }
+        ContactSelectionInput::Levels { first, last } => {
+            if range(first, last, bundle.levels().len(), "level") {
+                indices(&|c| (first..=last).contains(&c.level))
+            } else {
+                Vec::new()
+            }
+        }
+        ContactSelectionInput::Rings { first, last } => {
+            if range(first, last, bundle.layout().rings + 1, "ring") {
+                let lattice = bundle.lattice();
+                let in_rings = |pin: usize| (first..=last).contains(&lattice.ring(pin));
+                indices(&|c| in_rings(c.wire_pin) || c.touched_pin().is_some_and(in_rings))
+            } else {
+                Vec::new()
+            }
+        }
+    }
+}
+
+fn geometry_report(bundle: &HexBundle, contacts: usize) -> GeometryReport {
+    let layout = bundle.layout();
+    let rings = layout.rings;
+    GeometryReport {
+        pins: bundle.pin_count(),
+        rings,
+        neighbour_pairs: pair_count(rings),
+        pitch: layout.pitch,
+        pin_diameter: layout.pin_diameter,
+        wire_diameter: layout.wire_diameter,
+        wire_lead: layout.wire_lead,
+        wrapper_flat_to_flat: layout.wrapper_flat_to_flat,
+        contacts,
+        pin_clearance: bundle.pin_clearance(),
+        wall_clearance: bundle.wall_clearance(),
+        levels: bundle
+            .levels()
+            .iter()
+            .map(|level| LevelReport {
+                height: level.height,
+                wire_angle: level.aim.twelfth() as f64 * 30.0,
+                neighbour_direction: match level.aim {
+                    Aim::Neighbour(direction) => Some(direction.index()),
+                    Aim::Flat(_) => None,
+                },
+                flat: match level.aim {
+                    Aim::Flat(flat) => Some(flat.index()),
+                    Aim::Neighbour(_) => None,
+                },
+            })
+            .collect(),
+    }
+}
+
+fn histories(plan: &Plan, simulation: integrate::Simulation) -> Vec<History> {
+    let tips_only = plan.inputs.output.heights.is_none();
+    let pins = plan.bundle.pin_count();
+    let mut displacement_names = Vec::new();
+    for height in &plan.settings.output_heights {
+        for line in 0..2 * pins {
+            let (pin, axis) = if line < pins {
+                (line, 'x')
+            } else {
+                (line - pins, 'y')
+            };
+            displacement_names.push(if tips_only {
+                format!("p{pin}{axis}")
+            } else {
+                format!("p{pin}{axis}@{height}")
+            });
+        }
+    }
+    let contact_names: Vec<String> = plan
+        .settings
+        .recorded_contacts
+        .iter()
+        .flatten()
+        .map(|k| format!("c{k}"))
+        .collect();
+    let named = |names: &[String], columns: Vec<Vec<f64>>| -> Vec<(String, Vec<f64>)> {
+        names.iter().cloned().zip(columns).collect()
+    };
+    let history = |name: &str, series| History {
+        name: name.into(),
+        time: simulation.time.clone(),
+        series,
+    };
+    vec![
+        history("contact_forces", named(&contact_names, simulation.contact_forces)),
+        history(
+            "displacements",
+            named(
+                &displacement_names,
+                simulation.deflections.into_iter().flatten().collect(),
+            ),
+        ),
+        history(
+            "contact_forces_peaks",
+            named(&contact_names, simulation.contact_force_peaks),
+        ),
+        history(
+            "displacements_peaks",
+            named(
+                &displacement_names,
+                simulation.deflection_peaks.into_iter().flatten().collect(),
+            ),
+        ),
+    ]
+}
+
+#[cfg(test)]
+#[path = "hex_bundle_dynamics_tests.rs"]
+mod tests;

@@ -1,0 +1,308 @@
+//! Inputs of `hex-bundle-dynamics`: the pin, the bundle's geometry (a dozen numbers),
+//! contact laws, gap state, excitation in the transverse plane, solver and output
+//! selection, with their mapping to the physics types (`physics::hex`).
+//!
+//! Angles are in degrees, counter-clockwise from +x seen from above (the physics works in
+//! radians). Flats are numbered 0..6 counter-clockwise, flat k's outward normal at
+//! k·60° + 30°; pins from the centre outward, ring by ring (docs/hex-bundle.md).
+
+use serde::Deserialize;
+use utoipa::ToSchema;
+
+use super::bundle_inputs::{BaseAccelerationInput, DistributionInput};
+use super::inputs::{BeamInput, SectionInput, SolverInput};
+use crate::physics::bundle::GapDistribution;
+use crate::physics::hex::{FlatOffset, Handedness, HexGapState, HexGaps, HexLayout, PinZone, ZoneClosure};
+
+/// Inputs of `hex-bundle-dynamics`.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HexInputs {
+    /// The pin shared by every pin of the bundle: one modal basis, used for the bending
+    /// along x and along y. A tube section's outer diameter is the clad diameter D.
+    pub pin: BeamInput,
+    pub bundle: HexGeometryInput,
+    pub contact: HexContactInput,
+    /// Gap state (default: the nominal clearances from the geometry).
+    #[serde(default)]
+    pub gaps: HexGapsInput,
+    /// Local gap changes (swelling), applied after `gaps`, in order.
+    #[serde(default)]
+    pub closures: Vec<HexClosureInput>,
+    /// Every pin moved toward one flat (a bundle pressed against the wrapper), applied last.
+    pub offset: Option<OffsetInput>,
+    #[serde(default)]
+    pub excitation: HexExcitationInput,
+    #[serde(default)]
+    pub solver: SolverInput,
+    #[serde(default)]
+    pub output: HexOutputInput,
+}
+
+/// The wire-wrapped hexagonal bundle in its wrapper tube (lengths in m).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HexGeometryInput {
+    /// Rings of pins around the centre pin, 1 to 9: 3n(n + 1) + 1 pins (7 to 271).
+    #[schema(minimum = 1, maximum = 9)]
+    pub rings: usize,
+    /// P, distance between neighbouring pin centres (m), ≥ D + d_w.
+    pub pitch: f64,
+    /// d_w, spacer wire diameter (m).
+    pub wire_diameter: f64,
+    /// H, axial length of one wire turn (m), ≥ 6 beam element lengths.
+    pub wire_lead: f64,
+    /// F, inner flat-to-flat distance of the wrapper (m), ≥ √3·n·P + D + 2·d_w.
+    pub wrapper_flat_to_flat: f64,
+    /// D, clad outer diameter (m); default: the pin section's outer diameter (required
+    /// with an explicit section).
+    pub pin_diameter: Option<f64>,
+    /// Direction of every wire at the pin foot (degrees, counter-clockwise from +x).
+    #[serde(default)]
+    #[schema(default = 0.0)]
+    pub wire_start_angle: f64,
+    /// Sense in which the wires turn going up.
+    #[serde(default)]
+    pub handedness: HandednessInput,
+}
+
+/// `right`: counter-clockwise seen from above as z rises; `left`: clockwise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum HandednessInput {
+    #[default]
+    Right,
+    Left,
+}
+
+/// Penalty laws of the contacts (wire on clad, wire on wrapper).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HexContactInput {
+    /// Kc of the pin–pin contacts (N/m).
+    pub stiffness: f64,
+    /// cc of the pin–pin contacts (N·s/m).
+    #[serde(default)]
+    #[schema(default = 0.0)]
+    pub damping: f64,
+    /// Kc of the pin–wrapper contacts (N/m); default: `stiffness`.
+    pub wall_stiffness: Option<f64>,
+    /// cc of the pin–wrapper contacts (N·s/m); default: `damping`.
+    pub wall_damping: Option<f64>,
+}
+
+/// Gap state of the bundle.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum HexGapsInput {
+    /// One gap for every pin–pin contact and one for every wall contact (m); an absent
+    /// value keeps the nominal clearance (P − D − d_w between pins, from the
+    /// flat-to-flat for the wall).
+    Uniform {
+        pin_pin: Option<f64>,
+        pin_wall: Option<f64>,
+    },
+    /// One gap per contact (m), in contact order (results `contacts`).
+    PerContact { values: Vec<f64> },
+    /// Independent draws in contact order, reproducible from the seed on every machine.
+    Random {
+        distribution: DistributionInput,
+        seed: u64,
+        /// Draws multiply the nominal clearances instead of being gaps (m).
+        #[serde(default)]
+        relative: bool,
+    },
+}
+
+impl Default for HexGapsInput {
+    fn default() -> Self {
+        Self::Uniform {
+            pin_pin: None,
+            pin_wall: None,
+        }
+    }
+}
+
+/// Gaps of the contacts on levels first_level..=last_level that involve a pin of the
+/// zone (rings first_ring..=last_ring, or sectors first_sector..=last_sector: give one
+/// pair) are multiplied by `factor` (0 closes them).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HexClosureInput {
+    /// First ring of the zone (0 = the centre pin).
+    pub first_ring: Option<usize>,
+    pub last_ring: Option<usize>,
+    /// First sector of the zone (sextants 0..6 of the centre angles [s·60°, (s+1)·60°)).
+    pub first_sector: Option<usize>,
+    pub last_sector: Option<usize>,
+    /// Level indices (0 = the lowest; results `geometry.levels`).
+    pub first_level: usize,
+    pub last_level: usize,
+    /// Multiplier of the gaps (≥ 0).
+    pub factor: f64,
+}
+
+/// Every pin moved by `distance` (m) toward flat `flat` (0..6): the wall gaps change,
+/// pin–pin gaps do not.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OffsetInput {
+    pub flat: usize,
+    pub distance: f64,
+}
+
+/// Acceleration of the wrapper and of every pin foot in the transverse plane: one
+/// signal along `direction`, or two components.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HexExcitationInput {
+    /// The signal (m/s²) along `direction`.
+    pub base_acceleration: Option<BaseAccelerationInput>,
+    /// Direction of `base_acceleration` (degrees, counter-clockwise from +x; 30 is flat
+    /// 0's normal). Default 0.
+    pub direction: Option<f64>,
+    /// Component along x (m/s²), instead of `base_acceleration`.
+    pub base_acceleration_x: Option<BaseAccelerationInput>,
+    /// Component along y (m/s²), instead of `base_acceleration`.
+    pub base_acceleration_y: Option<BaseAccelerationInput>,
+}
+
+/// History sampling and selection.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HexOutputInput {
+    /// Time between two history samples (s), a whole number of steps; default 1e-4 s.
+    pub interval: Option<f64>,
+    /// Heights (m) of the deflections (x and y) recorded for every pin; default: the tips.
+    pub heights: Option<Vec<f64>>,
+    /// Contacts whose force histories are recorded (statistics are kept for every
+    /// contact); default: the wall contacts.
+    pub contacts: Option<ContactSelectionInput>,
+}
+
+/// A selection of contacts.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ContactSelectionInput {
+    /// Every contact (thousands of columns for a large bundle).
+    All {},
+    /// None.
+    None {},
+    /// The pin–wrapper contacts.
+    Walls {},
+    /// These contact indices (results `contacts` order).
+    List { contacts: Vec<usize> },
+    /// The contacts on levels first..=last (indices).
+    Levels { first: usize, last: usize },
+    /// The contacts involving a pin of rings first..=last (0 = the centre pin).
+    Rings { first: usize, last: usize },
+}
+
+impl HexInputs {
+    /// D: `bundle.pin_diameter`, else the tube's outer diameter; `None` when neither.
+    pub fn pin_diameter(&self) -> Option<f64> {
+        self.bundle.pin_diameter.or(match self.pin.section {
+            SectionInput::Tube { outer_diameter, .. } => Some(outer_diameter),
+            SectionInput::Explicit { .. } => None,
+        })
+    }
+
+    /// The physics layout (angles in radians).
+    pub fn layout(&self, pin_diameter: f64) -> HexLayout {
+        let geometry = &self.bundle;
+        HexLayout {
+            rings: geometry.rings,
+            pitch: geometry.pitch,
+            pin_diameter,
+            wire_diameter: geometry.wire_diameter,
+            wire_lead: geometry.wire_lead,
+            wrapper_flat_to_flat: geometry.wrapper_flat_to_flat,
+            wire_start_angle: geometry.wire_start_angle.to_radians(),
+            handedness: match geometry.handedness {
+                HandednessInput::Right => Handedness::Right,
+                HandednessInput::Left => Handedness::Left,
+            },
+        }
+    }
+
+    /// The physics gap description; closures with no zone or two are reported by
+    /// [`Self::closure_issues`] and left out here.
+    pub fn gaps(&self) -> HexGaps {
+        HexGaps {
+            state: match &self.gaps {
+                HexGapsInput::Uniform { pin_pin, pin_wall } => HexGapState::Uniform {
+                    pin_pin: *pin_pin,
+                    pin_wall: *pin_wall,
+                },
+                HexGapsInput::PerContact { values } => HexGapState::PerContact(values.clone()),
+                HexGapsInput::Random {
+                    distribution,
+                    seed,
+                    relative,
+                } => HexGapState::Random {
+                    distribution: match *distribution {
+                        DistributionInput::Uniform { low, high } => GapDistribution::Uniform { low, high },
+                        DistributionInput::Normal { mean, std } => GapDistribution::Normal { mean, std },
+                    },
+                    seed: *seed,
+                    relative: *relative,
+                },
+            },
+            closures: self
+                .closures
+                .iter()
+                .filter_map(|c| {
+                    let zone = c.zone().ok()?;
+                    Some(ZoneClosure {
+                        zone,
+                        first_level: c.first_level,
+                        last_level: c.last_level,
+                        factor: c.factor,
+                    })
+                })
+                .collect(),
+            offset: self.offset.map(|o| FlatOffset {
+                flat: o.flat,
+                distance: o.distance,
+            }),
+        }
+    }
+
+    /// `(pointer, reason)` for every closure whose zone is not exactly one of rings or
+    /// sectors (both ends).
+    pub fn closure_issues(&self) -> Vec<(String, String)> {
+        self.closures
+            .iter()
+            .enumerate()
+            .filter_map(|(k, c)| {
+                c.zone()
+                    .err()
+                    .map(|reason| (format!("/inputs/closures/{k}"), reason))
+            })
+            .collect()
+    }
+}
+
+impl HexClosureInput {
+    fn zone(&self) -> Result<PinZone, String> {
+        match (
+            self.first_ring,
+            self.last_ring,
+            self.first_sector,
+            self.last_sector,
+        ) {
+            (Some(first_ring), Some(last_ring), None, None) => Ok(PinZone::Rings {
+                first_ring,
+                last_ring,
+            }),
+            (None, None, Some(first_sector), Some(last_sector)) => Ok(PinZone::Sectors {
+                first_sector,
+                last_sector,
+            }),
+            _ => Err(
+                "give the zone as first_ring and last_ring, or as first_sector and last_sector (one pair)"
+                    .to_owned(),
+            ),
+        }
+    }
+}
