@@ -329,14 +329,11 @@ impl Simulation for HexBundleDynamics {
         let levels: Vec<f64> = bundle.levels().iter().map(|l| l.height).collect();
         let basis = inputs.pin.basis(&levels, "/inputs/pin")?;
         let settings = Settings {
-            scheme: solver.scheme,
-            time_step: solver.time_step,
-            tolerance: solver.tolerance,
-            check: solver.check,
-            duration: solver.duration,
-            output_interval: Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
-            output_heights: heights,
             recorded_contacts: Some(recorded),
+            ..solver.integration(
+                Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
+                heights,
+            )
         };
         let model = plane_model(
             &inputs,

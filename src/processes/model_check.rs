@@ -80,7 +80,7 @@ pub fn check(
     let issues = model
         .validate()
         .into_iter()
-        .chain(settings.validate(stand_in.basis.length()));
+        .chain(settings.validate(stand_in.basis.length(), model.contacts.len()));
     for InputIssue { field, reason } in issues {
         let about_a_height = field.ends_with("/height") || field.starts_with("output_heights");
         if about_a_height && !stand_in.length_known {
