@@ -20,6 +20,8 @@ pub mod simulation;
 pub mod strict_json;
 
 #[cfg(test)]
+mod excitation_tests;
+#[cfg(test)]
 mod robustness_tests;
 #[cfg(test)]
 mod simulation_tests;
