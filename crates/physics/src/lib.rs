@@ -27,6 +27,8 @@ pub mod spectrum;
 pub mod stability;
 pub mod static_correction;
 pub mod statistics;
+/// Spectrum-compatible synthetic accelerograms (seeded, bit-reproducible).
+pub mod synthetic;
 
 /// One problem with a physics input: which field (slash path relative to the checked
 /// struct) and why.
