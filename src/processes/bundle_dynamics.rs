@@ -289,10 +289,7 @@ impl Simulation for BundleDynamics {
             ));
         }
         if let Some(base) = &inputs.excitation.base_acceleration {
-            errors.extend(at(
-                "/inputs/excitation/base_acceleration",
-                base.physics().validate(),
-            ));
+            errors.extend(at("/inputs/excitation/base_acceleration", base.validate()));
         }
         for (k, force) in inputs.excitation.point_forces.iter().enumerate() {
             let prefix = format!("/inputs/excitation/point_forces/{k}");

@@ -317,11 +317,23 @@ pub enum BaseAccelerationInput {
         plateau: f64,
         fall: f64,
     },
+    /// A synthetic earthquake matching a target response spectrum, drawn from a seed.
+    SpectrumCompatible(super::synthetic_input::SpectrumCompatibleInput),
 }
 
 impl BaseAccelerationInput {
+    /// Every problem (fields relative to the excitation object).
+    pub fn validate(&self) -> Vec<crate::physics::InputIssue> {
+        match self {
+            Self::SpectrumCompatible(synthetic) => synthetic.validate(),
+            other => other.physics().validate(),
+        }
+    }
+
+    /// The excitation the integrator sees (a synthetic record as its table).
     pub fn physics(&self) -> BaseAcceleration {
         match self {
+            Self::SpectrumCompatible(synthetic) => BaseAcceleration::Table(synthetic.table()),
             Self::HalfSine { amplitude, duration } => BaseAcceleration::HalfSine {
                 amplitude: *amplitude,
                 duration: *duration,
