@@ -33,7 +33,11 @@ async fn a_sweep_over_seeds_runs_one_earthquake_per_seed() {
     let peak = |row: &Value| row["pins.0.max_abs_deflection"].as_f64().unwrap_or(f64::NAN);
     assert!(peak(&rows[0]) > 0.0, "{}", rows[0]);
     assert_eq!(peak(&rows[0]), peak(&rows[2]), "seed 1 twice, two results");
-    assert_ne!(peak(&rows[0]), peak(&rows[1]), "seeds 1 and 2 gave the same result");
+    assert_ne!(
+        peak(&rows[0]),
+        peak(&rows[1]),
+        "seeds 1 and 2 gave the same result"
+    );
 }
 
 #[tokio::test]

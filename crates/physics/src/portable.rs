@@ -12,13 +12,13 @@ pub use crate::random::ln;
 
 /// ln 2 split as in fdlibm: `LN2_HI` has its low 32 bits zero, so k·`LN2_HI` is exact
 /// for |k| < 2²⁰.
-const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-01;
-const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+const LN2_HI: f64 = 0.693_147_180_369_123_8;
+const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
 /// π/2 in three parts (fdlibm's `pio2_1`, `pio2_2`, `pio2_3`), each with 33 significant
 /// bits, so that x − k·π/2 is accurate for |k| < 2²⁰.
-const PIO2_1: f64 = 1.570_796_326_734_125_614_17e+00;
-const PIO2_2: f64 = 6.077_100_506_303_965_976_60e-11;
-const PIO2_3: f64 = 2.022_266_248_711_166_455_80e-21;
+const PIO2_1: f64 = 1.570_796_326_734_125_6;
+const PIO2_2: f64 = 6.077_100_506_303_966e-11;
+const PIO2_3: f64 = 2.022_266_248_711_166_5e-21;
 
 /// eˣ: x = k ln 2 + r with |r| ≤ ln 2 / 2, eʳ by its Taylor series to r¹⁴ (truncation
 /// below 10⁻¹⁷), then scaled by 2ᵏ. Overflows to ∞ above 709.78, underflows to 0 below

@@ -46,8 +46,10 @@ use crate::random::GapRng;
 use crate::response_spectrum::{log_spaced, pseudo_acceleration_uniform};
 use crate::{InputIssue, portable};
 
-/// Most samples of a generated record (2¹⁸: 43 minutes at 100 samples per second).
-pub const MAX_SAMPLES: usize = 1 << 18;
+/// Most samples of a generated record (2¹⁶: 5.5 minutes at 200 samples per second).
+/// Generation costs about samples × check frequencies × rounds oscillator steps: this
+/// keeps the worst request to seconds, checked before any work.
+pub const MAX_SAMPLES: usize = 1 << 16;
 /// Default largest deviation of the spectrum from the target over its band (10 %).
 pub const DEFAULT_TOLERANCE: f64 = 0.1;
 /// Default most correction rounds.
