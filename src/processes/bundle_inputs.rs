@@ -8,7 +8,7 @@ use utoipa::ToSchema;
 use super::inputs::{BeamInput, SolverInput};
 use crate::physics::bundle::{BundleLayout, GapDistribution, GapState, Levels, LocalClosure};
 use crate::physics::contact::{Body, Contact};
-use crate::physics::loads::{BaseAcceleration, PointForce, Table};
+use crate::physics::loads::{BaseAcceleration, PointForce, Pulse, Table};
 
 /// Inputs of `bundle-dynamics`: give either `pins` and `contacts`, or `bundle`.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
@@ -302,11 +302,38 @@ pub enum BaseAccelerationInput {
     },
     /// Samples: time (s), acceleration (m/s²); linear between them, 0 outside.
     Table { time: Vec<f64>, acceleration: Vec<f64> },
+    /// amplitude (m/s²) · sin²(π t / duration (s)) during `duration`, then 0
+    /// (velocity change amplitude · duration / 2).
+    Haversine { amplitude: f64, duration: f64 },
+    /// amplitude (m/s²) · t / duration (s) during `duration`, then 0 at once
+    /// (velocity change amplitude · duration / 2).
+    TerminalPeakSawtooth { amplitude: f64, duration: f64 },
+    /// Linear rise to amplitude (m/s²) in `rise` (s), `plateau` (s) at it, linear fall
+    /// to 0 in `fall` (s); a ramp or the plateau may be 0, not all three (velocity change
+    /// amplitude · (rise/2 + plateau + fall/2)).
+    Trapezoid {
+        amplitude: f64,
+        rise: f64,
+        plateau: f64,
+        fall: f64,
+    },
+    /// A synthetic earthquake matching a target response spectrum, drawn from a seed.
+    SpectrumCompatible(super::synthetic_input::SpectrumCompatibleInput),
 }
 
 impl BaseAccelerationInput {
+    /// Every problem (fields relative to the excitation object).
+    pub fn validate(&self) -> Vec<crate::physics::InputIssue> {
+        match self {
+            Self::SpectrumCompatible(synthetic) => synthetic.validate(),
+            other => other.physics().validate(),
+        }
+    }
+
+    /// The excitation the integrator sees (a synthetic record as its table).
     pub fn physics(&self) -> BaseAcceleration {
         match self {
+            Self::SpectrumCompatible(synthetic) => BaseAcceleration::Table(synthetic.table()),
             Self::HalfSine { amplitude, duration } => BaseAcceleration::HalfSine {
                 amplitude: *amplitude,
                 duration: *duration,
@@ -323,6 +350,27 @@ impl BaseAccelerationInput {
             Self::Table { time, acceleration } => BaseAcceleration::Table(Table {
                 time: time.clone(),
                 values: acceleration.clone(),
+            }),
+            Self::Haversine { amplitude, duration } => BaseAcceleration::Pulse(Pulse::Haversine {
+                amplitude: *amplitude,
+                duration: *duration,
+            }),
+            Self::TerminalPeakSawtooth { amplitude, duration } => {
+                BaseAcceleration::Pulse(Pulse::TerminalPeakSawtooth {
+                    amplitude: *amplitude,
+                    duration: *duration,
+                })
+            }
+            Self::Trapezoid {
+                amplitude,
+                rise,
+                plateau,
+                fall,
+            } => BaseAcceleration::Pulse(Pulse::Trapezoid {
+                amplitude: *amplitude,
+                rise: *rise,
+                plateau: *plateau,
+                fall: *fall,
             }),
         }
     }

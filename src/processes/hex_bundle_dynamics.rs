@@ -532,9 +532,8 @@ fn excitation(
                      pointer: &str,
                      errors: &mut Vec<FieldError>| {
         signal.as_ref().map(|s| {
-            let physics = s.physics();
-            errors.extend(at(pointer, physics.validate()));
-            physics
+            errors.extend(at(pointer, s.validate()));
+            s.physics()
         })
     };
     let pointer = "/inputs/excitation";

@@ -21,7 +21,11 @@ pub mod report;
 /// A process described by its types, and the one adapter to [`Process`].
 pub mod simulation;
 pub mod strict_json;
+/// The `spectrum_compatible` base acceleration: a synthetic earthquake as an input.
+pub mod synthetic_input;
 
+#[cfg(test)]
+mod excitation_tests;
 #[cfg(test)]
 mod robustness_tests;
 #[cfg(test)]

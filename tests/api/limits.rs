@@ -122,6 +122,8 @@ async fn the_shipped_examples_pass_the_default_ceilings() {
         ("bundle-dynamics", "bundle-random-gaps.json"),
         ("bundle-dynamics", "bundle-local-closure.json"),
         ("bundle-dynamics", "bundle-sine-auto.json"),
+        ("bundle-dynamics", "bundle-haversine.json"),
+        ("bundle-dynamics", "bundle-earthquake.json"),
     ] {
         let response = app.post_execution(process, &example(name)).await;
         assert_eq!(response.status(), StatusCode::CREATED, "{name}");

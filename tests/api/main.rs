@@ -12,6 +12,7 @@ mod cors;
 mod dashboard;
 mod database;
 mod dismissal;
+mod earthquakes;
 mod errors;
 mod execution;
 mod limits;

@@ -14,15 +14,21 @@ pub mod hex;
 pub mod integrate;
 pub mod loads;
 pub mod modal;
+/// Elementary functions from `+ − × ÷` only: the same bits on every machine.
+pub mod portable;
 /// A seeded, bit-reproducible random stream and its samplers (gaps, sweep sampling).
 pub mod random;
 /// Exact (up to modal truncation) cantilever / tip-spring impact solution (paper §2).
 pub mod reference;
+/// Pseudo-acceleration response spectra (and shock response spectra) of signals.
+pub mod response_spectrum;
 /// One-sided periodogram and the spectral error function f_err (paper eq. 11).
 pub mod spectrum;
 pub mod stability;
 pub mod static_correction;
 pub mod statistics;
+/// Spectrum-compatible synthetic accelerograms (seeded, bit-reproducible).
+pub mod synthetic;
 
 /// One problem with a physics input: which field (slash path relative to the checked
 /// struct) and why.

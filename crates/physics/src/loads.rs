@@ -1,6 +1,10 @@
 //! Time-dependent loads: base acceleration of the wrapper (applied in the wrapper frame
 //! as the inertial load −M r a(t), i.e. −Γᵢ a(t) on mode i) and point forces at a height.
 
+mod pulse;
+
+pub use pulse::Pulse;
+
 use super::{InputIssue, require_non_negative, require_positive};
 
 /// Imposed acceleration of the wrapper (walls and pin feet), m/s², in the direction of
@@ -17,6 +21,8 @@ pub enum BaseAcceleration {
     },
     /// Samples (s, m/s²), linear between them, 0 before the first and after the last.
     Table(Table),
+    /// A transport or handling shock pulse: haversine, terminal-peak sawtooth, trapezoid.
+    Pulse(Pulse),
 }
 
 impl BaseAcceleration {
@@ -42,6 +48,7 @@ impl BaseAcceleration {
                 }
             }
             BaseAcceleration::Table(table) => table.at(t),
+            BaseAcceleration::Pulse(pulse) => pulse.at(t),
         }
     }
 
@@ -66,6 +73,27 @@ impl BaseAcceleration {
                 time: table.time.clone(),
                 values: table.values.iter().map(|v| factor * v).collect(),
             }),
+            BaseAcceleration::Pulse(pulse) => BaseAcceleration::Pulse(match pulse {
+                Pulse::Haversine { amplitude, duration } => Pulse::Haversine {
+                    amplitude: factor * amplitude,
+                    duration: *duration,
+                },
+                Pulse::TerminalPeakSawtooth { amplitude, duration } => Pulse::TerminalPeakSawtooth {
+                    amplitude: factor * amplitude,
+                    duration: *duration,
+                },
+                Pulse::Trapezoid {
+                    amplitude,
+                    rise,
+                    plateau,
+                    fall,
+                } => Pulse::Trapezoid {
+                    amplitude: factor * amplitude,
+                    rise: *rise,
+                    plateau: *plateau,
+                    fall: *fall,
+                },
+            }),
         }
     }
 
@@ -87,6 +115,7 @@ impl BaseAcceleration {
                 require_positive(&mut issues, "cycles", *cycles);
             }
             BaseAcceleration::Table(table) => issues.extend(table.validate("acceleration")),
+            BaseAcceleration::Pulse(pulse) => issues.extend(pulse.validate()),
         }
         issues
     }
@@ -102,6 +131,18 @@ pub struct Table {
 }
 
 impl Table {
+    /// `signal` sampled every `interval` (s) from 0 to `end` (s) included (the last
+    /// interval shorter when `end` is not a multiple).
+    pub fn sample(signal: impl Fn(f64) -> f64, interval: f64, end: f64) -> Self {
+        let whole = (end / interval).floor() as usize;
+        let mut time: Vec<f64> = (0..=whole).map(|k| k as f64 * interval).collect();
+        if end - whole as f64 * interval > 1e-9 * interval {
+            time.push(end);
+        }
+        let values = time.iter().map(|&t| signal(t)).collect();
+        Self { time, values }
+    }
+
     pub fn at(&self, t: f64) -> f64 {
         let (times, values) = (&self.time, &self.values);
         if times.is_empty() || t < times[0] || t > times[times.len() - 1] {

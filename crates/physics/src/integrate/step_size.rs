@@ -174,6 +174,7 @@ fn excitation_bound(model: &Model<'_>, steps_per_period: f64) -> Option<f64> {
             BaseAcceleration::HalfSine { duration, .. } => 2.0 * duration / steps_per_period,
             BaseAcceleration::Sine { frequency, .. } => 1.0 / (frequency * steps_per_period),
             BaseAcceleration::Table(table) => table.shortest_interval(),
+            BaseAcceleration::Pulse(pulse) => pulse.resolution_period() / steps_per_period,
         });
     }
     for force in &model.point_forces {
