@@ -226,7 +226,8 @@ pub struct Settings {
     /// `auto` makes exact); `None` samples every step. Samples are at t = k·interval ≤
     /// duration.
     pub output_interval: Option<f64>,
-    /// Heights (m) where every pin's deflection is recorded.
+    /// Heights (m) where every line's deflection is recorded (every pin's, along x and y
+    /// in the plane).
     pub output_heights: Vec<f64>,
     /// Contacts whose force histories are recorded, in this order; `None`: every contact.
     /// Statistics are accumulated for every contact regardless.

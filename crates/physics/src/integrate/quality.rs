@@ -3,8 +3,9 @@
 //!
 //! **Step halving.** The run is repeated over its whole duration at Δt/2 and three
 //! results are compared: the peak contact force (largest over all contacts, every
-//! step), the peak deflection (largest |w| at the output heights, every step) and the
-//! total impact count. For a scheme of order p, X(Δt) − X* ≈ (X(Δt) − X(Δt/2)) ·
+//! step), the peak deflection (largest |w| at the output heights, every step; in the
+//! plane over the x and the y lines alike) and the total impact count, all three over
+//! every contact and line whatever `recorded_contacts` (both runs record the same). For a scheme of order p, X(Δt) − X* ≈ (X(Δt) − X(Δt/2)) ·
 //! 2ᵖ/(2ᵖ − 1) (Richardson), so the estimated error of the reported peak is 4/3 of its
 //! relative change for central difference (2 for first-order Tchamwa–Wielgosz). It costs
 //! twice the run. In long chaotic rattling the two runs drift apart whatever the step,

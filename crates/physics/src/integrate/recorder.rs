@@ -1,9 +1,8 @@
 //! What a run records: the sampled histories and their peaks between samples (the
 //! deflections of every line, the forces of the recorded contacts), the per-contact
 //! statistics (and wear work in the plane) and per-line extremes accumulated at every
-//! step, and the energy
-//! accounting (dissipated and external work by the trapezoidal rule on the powers of
-//! each step). It reads the [`State`] and never changes it.
+//! step, and the energy accounting (dissipated and external work by the trapezoidal
+//! rule on the powers of each step). It reads the [`State`] and never changes it.
 
 use pulp::Simd;
 
