@@ -309,7 +309,9 @@ impl Simulation for BundleDynamics {
         let settings = solver.integration(Some(interval), heights);
         // A synthetic record is checked (and generated) as its inputs; the model then sees
         // its table, whose problems would only restate these.
-        if let Some(base @ BaseAccelerationInput::SpectrumCompatible(_)) = &inputs.excitation.base_acceleration {
+        if let Some(base @ BaseAccelerationInput::SpectrumCompatible(_)) =
+            &inputs.excitation.base_acceleration
+        {
             errors.extend(at("/inputs/excitation/base_acceleration", base.validate()));
         }
         let stand_in = StandIn::of(&inputs.pin);
