@@ -743,3 +743,81 @@ fn large_plane_speed() {
         result.energy.relative_residual()
     );
 }
+
+/// One pin in the hexagonal wrapper, a wall contact on every flat at three heights, all
+/// with one gap: the wrapper is 6-fold symmetric, so the shake at θ + 60° gives the
+/// response at θ turned by 60°: the contact on flat j + 1 carries what flat j carried,
+/// and the deflection (x, y) is turned by 60° at every sample.
+#[test]
+fn one_pin_in_the_wrapper_shaken_sixty_degrees_further_gives_the_turned_response() {
+    let basis = basis(6);
+    let geometry = crate::hex::single_pin_in_wrapper(&[0.5, 0.8, 1.0], 5e-5);
+    let shaken = |theta: f64| Model {
+        basis: &basis,
+        pins: 1,
+        damping_ratios: vec![0.02; basis.modes()],
+        contacts: geometry
+            .iter()
+            .map(|c| Contact {
+                left: Body::Pin(0),
+                right: Body::Wall,
+                height: c.height,
+                gap: c.clearance,
+                stiffness: 2e4,
+                damping: 2.0,
+            })
+            .collect(),
+        initial_tip_displacements: vec![],
+        base_acceleration: Some(BaseAcceleration::HalfSine {
+            amplitude: 20.0 * theta.cos(),
+            duration: 0.01,
+        }),
+        point_forces: vec![],
+        plane: Some(Plane {
+            normals: geometry.iter().map(|c| [c.normal.x, c.normal.y]).collect(),
+            base_acceleration_y: Some(BaseAcceleration::HalfSine {
+                amplitude: 20.0 * theta.sin(),
+                duration: 0.01,
+            }),
+        }),
+    };
+    let theta = 0.2;
+    let settings = settings(2e-5, 0.05);
+    let (a, b) = (
+        run(&shaken(theta), &settings),
+        run(&shaken(theta + PI / 3.0), &settings),
+    );
+    let turned = |k: usize| 6 * (k / 6) + (k % 6 + 1) % 6;
+    let peak = a
+        .contact_statistics
+        .iter()
+        .map(|s| s.max_force)
+        .fold(0.0, f64::max);
+    assert!(
+        peak > 0.0,
+        "the pin must hit the wrapper for the check to mean anything"
+    );
+    let impacts: u64 = a.contact_statistics.iter().map(|s| s.impacts).sum();
+    assert!(impacts >= 2);
+    for (k, s) in a.contact_statistics.iter().enumerate() {
+        let t = &b.contact_statistics[turned(k)];
+        assert!(
+            (s.max_force - t.max_force).abs() <= 1e-9 * peak,
+            "contact {k}: {s:?} vs {t:?}"
+        );
+        assert!((s.impulse - t.impulse).abs() <= 1e-9 * peak * 0.05);
+        assert_eq!(s.impacts, t.impacts, "contact {k}");
+        for (f, g) in a.contact_forces[k].iter().zip(&b.contact_forces[turned(k)]) {
+            assert!((f - g).abs() <= 1e-9 * peak);
+        }
+    }
+    let (cos, sin) = ((PI / 3.0).cos(), (PI / 3.0).sin());
+    for (h, (da, db)) in a.deflections.iter().zip(&b.deflections).enumerate() {
+        let scale = da.iter().flatten().fold(0.0f64, |m, w| m.max(w.abs()));
+        for (i, (x, y)) in da[0].iter().zip(&da[1]).enumerate() {
+            let (u, v) = (cos * x - sin * y, sin * x + cos * y);
+            assert!((u - db[0][i]).abs() <= 1e-9 * scale, "height {h}, sample {i}");
+            assert!((v - db[1][i]).abs() <= 1e-9 * scale, "height {h}, sample {i}");
+        }
+    }
+}
