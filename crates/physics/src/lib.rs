@@ -11,6 +11,8 @@ pub mod bundle;
 pub mod contact;
 /// Wire-wrapped hexagonal bundle geometry: lattice, wrapper, wire-helix contacts, gap states.
 pub mod hex;
+/// Impact counting, per-impact tables and statistics (code_aster `POST_DYNA_MODA_T`).
+pub mod impacts;
 pub mod integrate;
 pub mod loads;
 pub mod modal;
