@@ -24,6 +24,8 @@ use crate::InputIssue;
 pub const DEFAULT_CLASSES: usize = 10;
 /// Largest [`ImpactCounting::classes`].
 pub const MAX_CLASSES: usize = 10_000;
+/// Largest [`ImpactCounting::blocks`] (every contact keeps sums per block).
+pub const MAX_BLOCKS: usize = 100;
 /// Default [`ImpactCounting::max_rows`].
 pub const DEFAULT_MAX_ROWS: usize = 100_000;
 /// Most impacts whose peak forces are kept for the histograms (80 MB); beyond that the
@@ -42,7 +44,7 @@ pub struct ImpactCounting {
     /// loaded steps that come back sooner are its rebounds.
     pub rest_time: f64,
     /// Equal blocks of the run over which the statistics are also computed, for their
-    /// spread (code_aster's `NB_BLOC`; ≥ 1).
+    /// spread (code_aster's `NB_BLOC`; 1…[`MAX_BLOCKS`]).
     pub blocks: usize,
     /// Classes of the peak-force histograms (1…[`MAX_CLASSES`]).
     pub classes: usize,
@@ -69,8 +71,11 @@ impl ImpactCounting {
         let mut issues = Vec::new();
         crate::require_non_negative(&mut issues, "force_threshold", self.force_threshold);
         crate::require_non_negative(&mut issues, "rest_time", self.rest_time);
-        if self.blocks == 0 {
-            issues.push(InputIssue::new("blocks", "must be at least 1 (got 0)"));
+        if !(1..=MAX_BLOCKS).contains(&self.blocks) {
+            issues.push(InputIssue::new(
+                "blocks",
+                format!("must be between 1 and {MAX_BLOCKS} (got {})", self.blocks),
+            ));
         }
         if !(1..=MAX_CLASSES).contains(&self.classes) {
             issues.push(InputIssue::new(
@@ -134,8 +139,8 @@ impl ImpactClock {
         }
     }
 
-    /// The block of step n (step 0, the initial state, is in the first).
-    #[inline(always)]
+    /// The block of step n (step 0, the initial state, is in the first): once per step,
+    /// for [`ContactImpacts::record`].
     pub fn block(&self, n: u64) -> usize {
         let k = n.saturating_sub(1).min(self.steps - 1);
         ((k as u128 * self.blocks as u128) / self.steps as u128) as usize
@@ -200,6 +205,7 @@ struct Running {
 #[derive(Debug, Clone, Default)]
 pub struct ImpactLog {
     max_rows: usize,
+    classes: usize,
     /// Rows in the order the impacts ended.
     rows: Vec<Impact>,
     /// Impacts that ended and were not tabulated.
@@ -210,10 +216,11 @@ pub struct ImpactLog {
 }
 
 impl ImpactLog {
-    /// For `contacts` contacts, keeping at most `max_rows` rows.
-    pub fn new(contacts: usize, max_rows: usize) -> Self {
+    /// For `contacts` contacts, as `counting` says (rows kept, histogram classes).
+    pub fn new(contacts: usize, counting: &ImpactCounting) -> Self {
         Self {
-            max_rows,
+            max_rows: counting.max_rows,
+            classes: counting.classes.max(1),
             rows: Vec::new(),
             untabulated: 0,
             peaks: vec![Vec::new(); contacts],
@@ -236,10 +243,10 @@ impl ImpactLog {
     /// The table sorted by start time (then contact), the number of impacts left out,
     /// and the peak-force histograms in `classes` equal classes from 0 to the largest
     /// peak of the run.
-    pub fn finish(mut self, classes: usize) -> (ImpactTable, ImpactHistogram) {
+    pub fn finish(mut self) -> (ImpactTable, ImpactHistogram) {
         self.rows
             .sort_by(|a, b| a.start.total_cmp(&b.start).then(a.contact.cmp(&b.contact)));
-        let classes = classes.max(1);
+        let classes = self.classes;
         let top = self.peaks.iter().flatten().fold(0.0_f64, |m, &f| m.max(f));
         let edges: Vec<f64> = (0..=classes)
             .map(|k| crate::decimal(top * k as f64 / classes as f64))
@@ -328,15 +335,15 @@ impl ContactImpacts {
         }
     }
 
-    /// Step n of a closed contact: its force, its penetration now and a step before,
-    /// and the power its dashpot dissipates (W). Step 0 is the initial state (it can
-    /// start an impact but weighs nothing).
+    /// Step n (in block `block`, [`ImpactClock::block`]) of a closed contact: its force,
+    /// its penetration now and a step before, and the power its dashpot dissipates (W).
+    /// Step 0 is the initial state (it can start an impact but weighs nothing).
     #[inline(always)]
     pub fn record(
         &mut self,
         clock: &ImpactClock,
         log: &mut ImpactLog,
-        n: u64,
+        (n, block): (u64, usize),
         force: f64,
         (penetration, previous): (f64, f64),
         dissipation: f64,
@@ -346,7 +353,6 @@ impl ContactImpacts {
         }
         let dt = clock.dt;
         let (t, weight) = (n as f64 * dt, if n == 0 { 0.0 } else { dt });
-        let block = clock.block(n);
         let sums = &mut self.blocks[block];
         sums.loaded_time += weight;
         sums.impulse += force * weight;
@@ -452,7 +458,11 @@ impl ContactImpacts {
             summary: Summary::of(&total, duration),
             rebounds_per_impact: ratio(total.rebounds as f64, total.impacts as f64),
             mean_duration: ratio(total.duration, total.impacts as f64),
-            min_duration: if total.impacts > 0 { total.min_duration } else { 0.0 },
+            min_duration: if total.impacts > 0 {
+                total.min_duration
+            } else {
+                0.0
+            },
             max_duration: total.max_duration,
             loaded_time: total.loaded_time,
             mean_contact_force: ratio(total.impulse, total.loaded_time),

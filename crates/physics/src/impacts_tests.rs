@@ -9,23 +9,22 @@ const STIFFNESS: f64 = 1e6;
 /// Feeds `forces` (step n = 1, 2, … has force `forces[n − 1]`; a closed contact where
 /// the force is positive) to one contact and returns its statistics, the table and the
 /// histograms.
-fn feed(
-    counting: &ImpactCounting,
-    forces: &[f64],
-) -> (ImpactStatistics, ImpactTable, ImpactHistogram) {
+fn feed(counting: &ImpactCounting, forces: &[f64]) -> (ImpactStatistics, ImpactTable, ImpactHistogram) {
     let clock = ImpactClock::new(counting, DT, forces.len() as u64);
-    let mut log = ImpactLog::new(1, counting.max_rows);
+    let mut log = ImpactLog::new(1, counting);
     let mut contact = ContactImpacts::new(0, 4.0, counting.blocks);
     let mut previous = 0.0;
     for (k, &force) in forces.iter().enumerate() {
         let penetration = force / STIFFNESS;
         if force > 0.0 {
-            contact.record(&clock, &mut log, k as u64 + 1, force, (penetration, previous), 0.0);
+            let n = k as u64 + 1;
+            let at = (n, clock.block(n));
+            contact.record(&clock, &mut log, at, force, (penetration, previous), 0.0);
         }
         previous = penetration;
     }
     let statistics = contact.finish(&clock, &mut log);
-    let (table, histogram) = log.finish(counting.classes);
+    let (table, histogram) = log.finish();
     (statistics, table, histogram)
 }
 
@@ -94,7 +93,10 @@ fn a_rectangular_pulse_has_the_impulse_f_tau_and_its_duration_exactly() {
     assert!((statistics.mean_contact_force - force).abs() < 1e-9);
     assert!((statistics.rms_contact_force - force).abs() < 1e-9);
     assert_eq!(statistics.summary.max_force, force);
-    assert_eq!((statistics.min_duration, statistics.max_duration), (row.duration, row.duration));
+    assert_eq!(
+        (statistics.min_duration, statistics.max_duration),
+        (row.duration, row.duration)
+    );
 }
 
 #[test]
@@ -164,7 +166,10 @@ fn block_statistics_of_a_stationary_pulse_train_have_no_spread() {
         blocks.max_force,
         blocks.impulse,
     ] {
-        assert!(spread.standard_deviation <= 1e-12 * spread.mean.abs(), "{spread:?}");
+        assert!(
+            spread.standard_deviation <= 1e-12 * spread.mean.abs(),
+            "{spread:?}"
+        );
     }
     assert!((blocks.contact_fraction.mean - 0.3).abs() < 1e-12);
     assert!((statistics.summary.impacts_per_second - 40.0 / (400.0 * DT)).abs() < 1e-9);
@@ -216,13 +221,13 @@ fn rows_beyond_the_limit_are_counted_not_tabulated() {
 fn a_contact_closed_at_the_start_counts_one_impact_from_zero() {
     let counting = ImpactCounting::default();
     let clock = ImpactClock::new(&counting, DT, 10);
-    let mut log = ImpactLog::new(1, 10);
+    let mut log = ImpactLog::new(1, &counting);
     let mut contact = ContactImpacts::new(0, 1.0, 1);
     for n in 0..=3 {
-        contact.record(&clock, &mut log, n, 7.0, (1e-6, 1e-6), 0.5);
+        contact.record(&clock, &mut log, (n, 0), 7.0, (1e-6, 1e-6), 0.5);
     }
     let statistics = contact.finish(&clock, &mut log);
-    let (table, _) = log.finish(1);
+    let (table, _) = log.finish();
     assert_eq!(statistics.summary.impacts, 1);
     let row = table.rows[0];
     assert_eq!((row.start, row.approach_velocity, row.energy), (0.0, 0.0, 0.0));
@@ -237,7 +242,7 @@ fn bad_settings_are_named() {
     let counting = ImpactCounting {
         force_threshold: -1.0,
         rest_time: f64::NAN,
-        blocks: 0,
+        blocks: MAX_BLOCKS + 1,
         classes: 0,
         max_rows: 0,
     };

@@ -401,6 +401,7 @@ mod tests {
             duration,
             output_interval: None,
             recorded_contacts: None,
+            impacts: Default::default(),
             output_heights: vec![1.0],
         }
     }

@@ -108,6 +108,7 @@ impl Row {
             duration: self.duration,
             output_interval: Some(1e-3),
             recorded_contacts: None,
+            impacts: Default::default(),
             output_heights: vec![self.length],
         }
     }

@@ -42,6 +42,7 @@
 
 pub use super::statistics::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme};
 use crate::InputIssue;
+pub use crate::impacts::{ImpactCounting, ImpactHistogram, ImpactStatistics, ImpactTable};
 pub use model::{Model, NORMAL_LENGTH_TOLERANCE, Plane, Settings, TimeStep};
 pub use plan::Plan;
 pub use quality::{Check, Quality, StepHalving, Verdict};
@@ -113,6 +114,12 @@ pub struct Simulation {
     /// Per contact: wear work ∫ F·|v_t| dt (J), v_t the relative tangential velocity at
     /// the contact (tangent t = (−n_y, n_x)); empty for the row (no tangential motion).
     pub wear_work: Vec<f64>,
+    /// Per contact: its impacts as `Settings::impacts` counts them, over the run and its
+    /// blocks (`contact_statistics[c].impacts` is the same count).
+    pub impact_statistics: Vec<ImpactStatistics>,
+    /// The per-impact table (its first `max_rows` rows) and the peak-force histograms.
+    pub impact_table: ImpactTable,
+    pub impact_histogram: ImpactHistogram,
     /// Per line (r as in `deflections`).
     pub pin_extremes: Vec<PinExtreme>,
     /// Energy balance at the end of the run.
@@ -163,3 +170,6 @@ mod accuracy_tests;
 
 #[cfg(test)]
 mod plane_tests;
+
+#[cfg(test)]
+mod impact_tests;

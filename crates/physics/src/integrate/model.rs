@@ -6,6 +6,7 @@
 //! `point_forces/0/height`, `output_heights/1`), as everywhere in this crate.
 
 use crate::contact::Contact;
+use crate::impacts::ImpactCounting;
 use crate::loads::{BaseAcceleration, PointForce};
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
@@ -232,6 +233,8 @@ pub struct Settings {
     /// Contacts whose force histories are recorded, in this order; `None`: every contact.
     /// Statistics are accumulated for every contact regardless.
     pub recorded_contacts: Option<Vec<usize>>,
+    /// How impacts are counted, summarised and tabulated.
+    pub impacts: ImpactCounting,
 }
 
 impl Settings {
@@ -270,6 +273,7 @@ impl Settings {
                 ));
             }
         }
+        issues.extend(self.impacts.validate().into_iter().map(|i| i.within("impacts")));
         let mut listed = vec![false; contacts];
         for (k, &c) in self.recorded_contacts.iter().flatten().enumerate() {
             let field = format!("recorded_contacts/{k}");
@@ -347,6 +351,7 @@ mod tests {
             output_interval: Some(1e-3),
             output_heights: vec![1.0, 0.5],
             recorded_contacts: None,
+            impacts: Default::default(),
         }
     }
 
@@ -433,6 +438,7 @@ mod tests {
             output_interval: Some(-1.0),
             output_heights: vec![0.5, 1.2],
             recorded_contacts: Some(vec![1, 2, 1]),
+            impacts: Default::default(),
         };
         assert_eq!(
             fields(settings.validate(1.0, 2)),

@@ -85,6 +85,7 @@ fn settings(dt: f64, duration: f64) -> Settings {
         output_interval: Some(1e-4),
         output_heights: vec![1.0, 0.8],
         recorded_contacts: None,
+        impacts: Default::default(),
     }
 }
 
@@ -492,6 +493,7 @@ fn bad_normals_and_recorded_contacts_are_refused_with_their_paths() {
     let model = triangle(&basis);
     let settings = Settings {
         recorded_contacts: Some(vec![0, 18, 3, 0]),
+        impacts: Default::default(),
         ..settings
     };
     let Err(SimulationError::InvalidSettings(issues)) = Plan::new(&model, &settings) else {
@@ -568,6 +570,7 @@ fn only_the_recorded_contacts_have_histories_in_their_order() {
     let recorded = vec![7, 0, 12];
     let some = Settings {
         recorded_contacts: Some(recorded.clone()),
+        impacts: Default::default(),
         ..every.clone()
     };
     let (all, thinned) = (run(&model, &every), run(&model, &some));
@@ -717,6 +720,7 @@ fn large_plane_speed() {
         time_step: TimeStep::Auto,
         output_interval: Some(1e-3),
         recorded_contacts: Some(vec![0, 1, 2]),
+        impacts: Default::default(),
         ..settings(0.0, 0.015)
     };
     let plan = Plan::new(&model, &settings).expect("a valid model");

@@ -10,6 +10,7 @@ use super::kernels::level_deflections;
 use super::layout::{ContactModel, Layout};
 use super::state::State;
 use super::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme, Settings, Simulation};
+use crate::impacts::{ContactImpacts, ImpactClock, ImpactLog, ImpactStatistics};
 
 /// Powers of a step (W), integrated over time by the trapezoidal rule.
 #[derive(Debug, Clone, Copy, Default)]
@@ -31,6 +32,12 @@ pub(super) struct Recorder {
     pub force_peak: Vec<f64>,
     /// Per lane in the plane (empty for the row): ∫ F |v_t| dt (J).
     pub wear: Vec<f64>,
+    /// Per lane: impacts as counted by `Settings::impacts`, the run's clock for them,
+    /// their table and the current step's block.
+    pub impacts: Vec<ContactImpacts>,
+    pub impact_clock: ImpactClock,
+    pub impact_log: ImpactLog,
+    pub impact_block: usize,
     /// The lanes of the recorded contacts, in the order of their histories.
     recorded: Vec<usize>,
     /// Per output height and line, the highest and lowest deflection since the last
@@ -67,8 +74,14 @@ impl Recorder {
             None => (0..layout.model.contacts.len()).map(|c| lane_of(&c)).collect(),
         };
         let contacts = recorded.len();
+        let counting = &settings.impacts;
+        let steps = layout.step.steps(settings.duration);
         Self {
             statistics: vec![ContactStatistics::default(); lanes],
+            impacts: impacts_by_lane(layout, counting.blocks),
+            impact_clock: ImpactClock::new(counting, layout.dt, steps),
+            impact_log: ImpactLog::new(layout.model.contacts.len(), counting),
+            impact_block: 0,
             max_penetration: vec![f64::NEG_INFINITY; lanes],
             force_peak: vec![0.0; lanes],
             wear: match layout.contact_model {
@@ -97,9 +110,12 @@ impl Recorder {
     pub fn record_initial_contacts(&mut self, layout: &Layout<'_>, state: &State) {
         for (contact, lane) in layout.model.contacts.iter().zip(&layout.contacts.lane) {
             let lane = *lane as usize;
-            if state.penetration[lane] > 0.0 && (contact.stiffness > 0.0 || contact.damping > 0.0) {
+            let penetration = state.penetration[lane];
+            if penetration > 0.0 && (contact.stiffness > 0.0 || contact.damping > 0.0) {
+                let force = state.contact_force[lane];
+                let (clock, log) = (&self.impact_clock, &mut self.impact_log);
+                self.impacts[lane].record(clock, log, (0, 0), force, (penetration, penetration), 0.0);
                 let stats = &mut self.statistics[lane];
-                stats.impacts = 1;
                 stats.first_impact_time = Some(0.0);
                 // The force at t = 0 counts for the peak, as it does in the samples.
                 stats.max_force = state.contact_force[lane];
@@ -218,6 +234,21 @@ impl Recorder {
         for (stats, max) in self.statistics.iter_mut().zip(&self.max_penetration) {
             stats.max_penetration = *max;
         }
+        // Every lane's impacts ended, in contact order; `impacts` counts them as set.
+        let (clock, mut log) = (self.impact_clock, self.impact_log);
+        let mut impacts: Vec<Option<ContactImpacts>> = self.impacts.into_iter().map(Some).collect();
+        let impact_statistics: Vec<ImpactStatistics> = layout
+            .contacts
+            .lane
+            .iter()
+            .map(|&lane| {
+                let contact = impacts[lane as usize].take().expect("one contact per lane");
+                let statistics = contact.finish(&clock, &mut log);
+                self.statistics[lane as usize].impacts = statistics.summary.impacts;
+                statistics
+            })
+            .collect();
+        let (impact_table, impact_histogram) = log.finish();
         Simulation {
             step: layout.step,
             steps,
@@ -237,6 +268,9 @@ impl Recorder {
                 ContactModel::Row => Vec::new(),
                 ContactModel::Plane(_) => layout.contacts.by_contact(&self.wear),
             },
+            impact_statistics,
+            impact_table,
+            impact_histogram,
             pin_extremes: self.pin_extremes,
             energy: self.energy,
             mechanical_energy: self.mechanical_energy,
@@ -244,9 +278,9 @@ impl Recorder {
     }
 }
 
-/// A closed contact's step in its statistics: an impact when it was open a step ago
-/// (`previous` ≤ 0, the first one timed by linear interpolation of the penetration),
-/// contact time, impulse and the largest force.
+/// A closed contact's step in its statistics: the first closure (`previous` ≤ 0, timed
+/// by linear interpolation of the penetration), contact time, impulse and the largest
+/// force.
 #[inline(always)]
 pub(super) fn record_closed_contact(
     stats: &mut ContactStatistics,
@@ -254,11 +288,9 @@ pub(super) fn record_closed_contact(
     (penetration, previous): (f64, f64),
     force: f64,
 ) {
-    if previous <= 0.0 {
-        stats.impacts += 1;
-        if stats.first_impact_time.is_none() {
-            stats.first_impact_time = Some(t - dt * penetration / (penetration - previous));
-        }
+    // (Impacts are counted by `ContactImpacts`, as `Settings::impacts` says.)
+    if previous <= 0.0 && stats.first_impact_time.is_none() {
+        stats.first_impact_time = Some(t - dt * penetration / (penetration - previous));
     }
     stats.contact_time += dt;
     stats.impulse += force * dt;
@@ -266,6 +298,29 @@ pub(super) fn record_closed_contact(
         stats.max_force = force;
         stats.max_force_time = t;
     }
+}
+
+/// Per lane, the impacts of its contact (of none in empty lanes), each with the inverse
+/// of its effective mass: with unit modal masses a force F along the contact's normal
+/// changes the relative normal acceleration by F Σᵢ ψᵢ(z)² per pin it touches (the
+/// normal is a unit vector and x and y share the basis).
+fn impacts_by_lane(layout: &Layout<'_>, blocks: usize) -> Vec<ContactImpacts> {
+    let mut contact_of_lane = vec![usize::MAX; layout.lane_contacts.len()];
+    for (contact, &lane) in layout.contacts.lane.iter().enumerate() {
+        contact_of_lane[lane as usize] = contact;
+    }
+    let (lanes, row, wall) = (layout.lanes, layout.row, layout.wall_row);
+    layout
+        .lane_contacts
+        .iter()
+        .zip(contact_of_lane)
+        .map(|(lane, contact)| {
+            let shape = &layout.level_shapes[lane.shape * lanes..][..row];
+            let pins = usize::from(lane.left != wall) + usize::from(lane.right != wall);
+            let inverse_mass = pins as f64 * shape.iter().map(|psi| psi * psi).sum::<f64>();
+            ContactImpacts::new(contact, inverse_mass, blocks)
+        })
+        .collect()
 }
 
 /// The deflection of every pin at every node, as a [`pulp::WithSimd`] operation.

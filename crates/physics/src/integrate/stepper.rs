@@ -127,7 +127,7 @@ impl<const PLANE: bool> pulp::WithSimd for StepOp<'_, '_, PLANE> {
         debug_assert_eq!(integrator.layout.lanes, lanes::<S>());
         match self.operation {
             Operation::Initial => {
-                integrator.contact_forces_and_statistics::<S, PLANE>(simd, 0.0, false, vectors);
+                integrator.contact_forces_and_statistics::<S, PLANE>(simd, 0, false, vectors);
             }
             // The usual row lengths get a copy of the step where the row length is a
             // constant: every per-row loop is then unrolled, without bounds checks.
@@ -188,15 +188,15 @@ impl<'m> Integrator<'m> {
         integrator
     }
 
-    /// Point loads at time t added to `force` (which holds no other load yet), contact
-    /// forces from the current positions and the dashpot velocity v + lookahead · a
-    /// added too; updates the per-step statistics when `record` and returns the contact
-    /// dissipation power Σ (F − Kc δ) δ̇. `vectors`: the row length in vectors.
+    /// Point loads at step n (t = nΔt) added to `force` (which holds no other load yet),
+    /// contact forces from the current positions and the dashpot velocity v + lookahead · a
+    /// added too; updates the per-step statistics and impacts when `record` and returns
+    /// the contact dissipation power Σ (F − Kc δ) δ̇. `vectors`: the row length in vectors.
     #[inline(always)]
     fn contact_forces_and_statistics<S: Simd, const PLANE: bool>(
         &mut self,
         simd: S,
-        t: f64,
+        n: u64,
         record: bool,
         vectors: usize,
     ) -> f64 {
@@ -208,6 +208,7 @@ impl<'m> Integrator<'m> {
         } = self;
         // The row length from `vectors`, so that it is a constant where `vectors` is.
         let (row, dt) = (vectors * lanes::<S>(), layout.dt);
+        let t = n as f64 * dt;
         for (point, shape) in layout.model.point_forces.iter().zip(&layout.point_force_shapes) {
             let value = point.force.at(t);
             axpy(simd, value, shape, &mut state.force[point.pin * row..][..row]);
@@ -245,13 +246,14 @@ impl<'m> Integrator<'m> {
                 state,
                 recorder,
                 count,
-                (t, record),
+                (n, record),
                 vectors,
             );
         }
         let count = penetrations(simd, &layout.contacts, deflections, &layout.gaps, contact_state);
 
         let mut dissipation_power = 0.0;
+        let at = (n, recorder.impact_block);
         let (lookahead, wall, n) = (layout.dashpot_lookahead, layout.wall_row, vectors);
         let shapes = S::as_simd_f64s(&layout.level_shapes).0;
         let (v, a) = (S::as_simd_f64s(&state.v).0, S::as_simd_f64s(&state.a).0);
@@ -265,6 +267,8 @@ impl<'m> Integrator<'m> {
             &mut recorder.statistics[..lanes],
         );
         let peaks = &mut recorder.force_peak[..lanes];
+        let impacts = &mut recorder.impacts[..lanes];
+        let (clock, log) = (&recorder.impact_clock, &mut recorder.impact_log);
         let closed = &state.closed[..count];
         // Two passes over the closed contacts: the forces first (their dot products are
         // independent of each other, so they overlap), then their projection on the
@@ -283,12 +287,14 @@ impl<'m> Integrator<'m> {
             // The penetration is positive: F = max(0, Kc δ + cc δ̇) (`Contact::force`).
             let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
             forces[j] = force;
-            dissipation_power += (force - contact.stiffness * penetration) * rate;
+            let dissipation = (force - contact.stiffness * penetration) * rate;
+            dissipation_power += dissipation;
             if record && force > peaks[j] {
                 peaks[j] = force;
             }
             if record && contact.active {
                 record_closed_contact(&mut statistics[j], (t, dt), (penetration, previous), force);
+                impacts[j].record(clock, log, at, force, (penetration, previous), dissipation);
             }
         }
         for &j in closed {
@@ -337,14 +343,17 @@ impl<'m> Integrator<'m> {
         vectors: usize,
     ) {
         for n in steps {
-            self.step_body::<S, PLANE>(simd, n as f64 * self.layout.dt, vectors);
+            self.step_body::<S, PLANE>(simd, n, vectors);
         }
     }
 
-    /// One step; `vectors` is the row length in vectors (a constant in the usual cases).
+    /// Step n (to t = nΔt); `vectors` is the row length in vectors (a constant in the
+    /// usual cases).
     #[inline(always)]
-    fn step_body<S: Simd, const PLANE: bool>(&mut self, simd: S, t: f64, vectors: usize) {
+    fn step_body<S: Simd, const PLANE: bool>(&mut self, simd: S, n: u64, vectors: usize) {
         let dt = self.layout.dt;
+        let t = n as f64 * dt;
+        self.recorder.impact_block = self.recorder.impact_clock.block(n);
         let half = 0.5 * dt;
         // q ← qₙ₊₁ and v ← v½ (central difference), or vₙ₊₁ (Tchamwa).
         let first_half = match self.layout.scheme {
@@ -361,7 +370,7 @@ impl<'m> Integrator<'m> {
             S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
             S::as_simd_f64s(&state.a[..pins_state]).0,
         );
-        let contact_damping = self.contact_forces_and_statistics::<S, PLANE>(simd, t, true, vectors);
+        let contact_damping = self.contact_forces_and_statistics::<S, PLANE>(simd, n, true, vectors);
         let Self {
             layout,
             state,
@@ -483,11 +492,12 @@ fn plane_contact_forces<S: Simd>(
     state: &mut State,
     recorder: &mut Recorder,
     count: usize,
-    (t, record): (f64, bool),
+    (step, record): (u64, bool),
     vectors: usize,
 ) -> f64 {
     let mut dissipation_power = 0.0;
     let (lookahead, wall, n, dt) = (layout.dashpot_lookahead, layout.wall_row, vectors, layout.dt);
+    let t = step as f64 * dt;
     let shapes = S::as_simd_f64s(&layout.level_shapes).0;
     let (v, a) = (S::as_simd_f64s(&state.v).0, S::as_simd_f64s(&state.a).0);
     let loads = S::as_mut_simd_f64s(&mut state.force).0;
@@ -500,6 +510,9 @@ fn plane_contact_forces<S: Simd>(
         &mut recorder.statistics[..lanes],
     );
     let (peaks, wear) = (&mut recorder.force_peak[..lanes], &mut recorder.wear[..lanes]);
+    let impacts = &mut recorder.impacts[..lanes];
+    let (clock, log) = (&recorder.impact_clock, &mut recorder.impact_log);
+    let at = (step, recorder.impact_block);
     let closed = &state.closed[..count];
     for &j in closed {
         let j = j as usize;
@@ -514,13 +527,15 @@ fn plane_contact_forces<S: Simd>(
         let sliding = normal_x * rate_y - normal_y * rate_x;
         let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
         forces[j] = force;
-        dissipation_power += (force - contact.stiffness * penetration) * rate;
+        let dissipation = (force - contact.stiffness * penetration) * rate;
+        dissipation_power += dissipation;
         if record {
             if force > peaks[j] {
                 peaks[j] = force;
             }
             if contact.active {
                 record_closed_contact(&mut statistics[j], (t, dt), (penetration, previous), force);
+                impacts[j].record(clock, log, at, force, (penetration, previous), dissipation);
             }
             wear[j] += force * sliding.abs() * dt;
         }

@@ -11,11 +11,11 @@ use crate::loads::{BaseAcceleration, PointForce, Table};
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
 
-fn basis(elements: usize, modes: usize) -> ModalBasis {
+pub(super) fn basis(elements: usize, modes: usize) -> ModalBasis {
     ModalBasis::compute(&default_tube(elements), modes).expect("valid beam")
 }
 
-fn free_model(basis: &ModalBasis, xi: f64, tip: f64) -> Model<'_> {
+pub(super) fn free_model(basis: &ModalBasis, xi: f64, tip: f64) -> Model<'_> {
     Model {
         basis,
         pins: 1,
@@ -28,7 +28,7 @@ fn free_model(basis: &ModalBasis, xi: f64, tip: f64) -> Model<'_> {
     }
 }
 
-fn settings(scheme: Scheme, dt: f64, duration: f64) -> Settings {
+pub(super) fn settings(scheme: Scheme, dt: f64, duration: f64) -> Settings {
     Settings {
         scheme,
         time_step: TimeStep::Fixed(dt),
@@ -37,15 +37,16 @@ fn settings(scheme: Scheme, dt: f64, duration: f64) -> Settings {
         duration,
         output_interval: None,
         recorded_contacts: None,
+        impacts: Default::default(),
         output_heights: vec![1.0],
     }
 }
 
-fn run(model: &Model<'_>, settings: &Settings) -> Simulation {
+pub(super) fn run(model: &Model<'_>, settings: &Settings) -> Simulation {
     simulate(model, settings, &mut |_| ControlFlow::Continue(())).expect("run succeeds")
 }
 
-fn tip_wall(stiffness: f64, gap: f64, damping: f64) -> Contact {
+pub(super) fn tip_wall(stiffness: f64, gap: f64, damping: f64) -> Contact {
     Contact {
         left: Body::Wall,
         right: Body::Pin(0),
@@ -236,7 +237,7 @@ fn critical_step_matches_brute_force_divergence() {
 
 /// A damped two-pin row shaken by a half-sine base shock, with wall and pin–pin
 /// contacts carrying dashpots at two levels.
-fn shaken_two_pin_row(basis: &ModalBasis) -> Model<'_> {
+pub(super) fn shaken_two_pin_row(basis: &ModalBasis) -> Model<'_> {
     let contact = |left, right, height| Contact {
         left,
         right,
