@@ -16,7 +16,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::problem::Problem;
-use crate::processes::{Registry, RunError, RunOutput};
+use crate::processes::{Registry, RunError, RunOutput, impact_report};
 use crate::quality_note::QualityNote;
 
 #[derive(Debug, Parser)]
@@ -150,8 +150,12 @@ fn write_histories(dir: &Path, output: &RunOutput) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     for history in &output.histories {
         let path = dir.join(format!("{}.csv", history.name));
-        std::fs::write(&path, history.to_csv())
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        // The per-impact table in its own columns; every other output is a time history.
+        let text = match impact_report::rows_of(history).filter(|_| history.name == impact_report::TABLE) {
+            Some(rows) => impact_report::table_csv(&rows),
+            None => history.to_csv(),
+        };
+        std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
     Ok(())
 }

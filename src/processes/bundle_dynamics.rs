@@ -8,6 +8,7 @@ use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
 use super::bundle_inputs::{BaseAccelerationInput, BodyInput, BundleInputs, ContactInput};
+use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::inputs::{self, SolverDefaults, at};
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
@@ -106,8 +107,10 @@ pub struct BundleResults {
     pub contacts: Vec<ContactResult>,
     /// The largest force over all contacts; null without contacts.
     pub max_contact_force: Option<PeakForce>,
-    /// Total closures over all contacts.
+    /// Impacts over all contacts, as `output.impacts` counts them.
     pub impacts: u64,
+    /// The run's impacts: counting, totals, histogram, contacts ranked.
+    pub impact_summary: ImpactSummary,
     /// Per pin, its largest deflection.
     pub pins: Vec<PinResult>,
     pub energy: EnergyReport,
@@ -147,6 +150,8 @@ pub struct ContactResult {
     pub first_impact_time: Option<f64>,
     /// Largest penetration (m); ≤ 0 when the contact never closed (smallest clearance).
     pub max_penetration: f64,
+    /// Its impacts as `output.impacts` counts them (`impacts` above is their number).
+    pub impact_statistics: ContactImpacts,
 }
 
 /// The largest contact force of the run.
@@ -240,6 +245,7 @@ impl Simulation for BundleDynamics {
             description: "As displacements, each value the deflection of largest magnitude (signed) reached at \
                           any step of its output interval",
         },
+        impact_report::TABLE_OUTPUT,
     ];
 
     type Inputs = BundleInputs;
@@ -306,7 +312,8 @@ impl Simulation for BundleDynamics {
             ));
         }
         let interval = inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL);
-        let settings = solver.integration(Some(interval), heights);
+        let mut settings = solver.integration(Some(interval), heights);
+        settings.impacts = impact_report::counting(inputs.output.impacts.as_ref(), inputs.output.blocks);
         // A synthetic record is checked (and generated) as its inputs; the model then sees
         // its table, whose problems would only restate these.
         if let Some(base @ BaseAccelerationInput::SpectrumCompatible(_)) =
@@ -361,10 +368,13 @@ impl Simulation for BundleDynamics {
         if plan.inputs.output.heights.is_some() {
             history_drivers.push("/inputs/output/heights".to_owned());
         }
+        history_drivers.push("/inputs/output/impacts/max_rows".to_owned());
+        let table =
+            impact_report::table_values(&plan.settings.impacts, plan.contacts.len(), stepping.pass_steps);
         WorkEstimate {
             modal_dofs: (plan.pins * plan.basis.modes()) as f64,
             contacts: plan.contacts.len() as f64,
-            history_values: samples * columns as f64,
+            history_values: samples * columns as f64 + table,
             work_drivers: [
                 "/inputs/solver/duration",
                 "/inputs/solver/time_step",
@@ -392,7 +402,8 @@ impl Simulation for BundleDynamics {
             .contacts
             .iter()
             .zip(&simulation.contact_statistics)
-            .map(|(c, s)| ContactResult {
+            .zip(impact_report::contact_reports(&simulation))
+            .map(|((c, s), impact_statistics)| ContactResult {
                 contact: c.into(),
                 max_force: s.max_force,
                 max_force_time: s.max_force_time,
@@ -401,6 +412,7 @@ impl Simulation for BundleDynamics {
                 impulse: s.impulse,
                 first_impact_time: s.first_impact_time,
                 max_penetration: s.max_penetration,
+                impact_statistics,
             })
             .collect();
         let max_contact_force = simulation
@@ -438,6 +450,7 @@ impl Simulation for BundleDynamics {
             contacts,
             max_contact_force,
             impacts: simulation.contact_statistics.iter().map(|s| s.impacts).sum(),
+            impact_summary: impact_report::summary(&simulation, &plan.settings.impacts),
             pins,
             energy: simulation.energy.into(),
             time_step: simulation.step.time_step,
@@ -476,6 +489,11 @@ fn bundle_metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Valu
     };
     metrics.extend(entries("contacts", "max_force"));
     metrics.extend(entries("pins", "max_abs_deflection"));
+    metrics.extend(super::metrics::item_scalars(
+        document,
+        "contacts",
+        "impact_statistics",
+    ));
     metrics
 }
 
@@ -510,11 +528,13 @@ fn histories(prepared: &Plan, simulation: crate::physics::integrate::Simulation)
         time: simulation.time.clone(),
         series,
     };
+    let table = impact_report::table_history(&simulation.impact_table);
     vec![
         history("contact_forces", named("c", simulation.contact_forces)),
         history("displacements", displacement_series),
         history("contact_forces_peaks", named("c", simulation.contact_force_peaks)),
         history("displacements_peaks", peak_series),
+        table,
     ]
 }
 

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use super::impact_report::ImpactsInput;
 use super::inputs::{BeamInput, SolverInput};
 use crate::physics::bundle::{BundleLayout, GapDistribution, GapState, Levels, LocalClosure};
 use crate::physics::contact::{Body, Contact};
@@ -411,4 +412,10 @@ pub struct OutputInput {
     pub interval: Option<f64>,
     /// Heights (m) of the deflections recorded for every pin; default: the pin tips.
     pub heights: Option<Vec<f64>>,
+    /// How impacts are counted and tabulated; default: every closure is an impact.
+    pub impacts: Option<ImpactsInput>,
+    /// Equal blocks of the run over which the impact statistics are also computed,
+    /// reported as their mean and standard deviation (code_aster's NB_BLOC; 1…100).
+    #[schema(minimum = 1, maximum = 100, default = 1)]
+    pub blocks: Option<usize>,
 }

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
+use super::impact_report::{self, ContactImpacts, ImpactSummary, ImpactsInput};
 use super::inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
@@ -108,6 +109,12 @@ fn default_reference_modes() -> usize {
 pub struct OutputInput {
     /// Time between two history samples (s), a whole number of steps; default: every step.
     pub interval: Option<f64>,
+    /// How impacts are counted and tabulated; default: every closure is an impact.
+    pub impacts: Option<ImpactsInput>,
+    /// Equal blocks of the run over which the impact statistics are also computed,
+    /// reported as their mean and standard deviation (code_aster's NB_BLOC; 1…100).
+    #[schema(minimum = 1, maximum = 100, default = 1)]
+    pub blocks: Option<usize>,
 }
 
 /// Validated inputs, ready to run.
@@ -177,8 +184,13 @@ pub struct CantileverModel {
 pub struct NumericalResults {
     /// Time of the first closure (s), interpolated between steps; null if none.
     pub first_impact_time: Option<f64>,
-    /// Closures after a separation (the first counts).
+    /// Impacts, as `output.impacts` counts them (default: closures after a separation,
+    /// the reference's count).
     pub impacts: u64,
+    /// The contact's impact statistics and peak-force histogram.
+    pub impact_statistics: ContactImpacts,
+    /// The counting used, the histogram's classes and the ranking (of one contact).
+    pub impact_summary: ImpactSummary,
     /// Largest contact force over every step (N).
     pub max_contact_force: f64,
     /// Its time (s).
@@ -360,6 +372,7 @@ impl Simulation for CantileverImpact {
             title: "Contact force (N), peaks",
             description: PEAKS,
         },
+        impact_report::TABLE_OUTPUT,
     ];
 
     type Inputs = CantileverInputs;
@@ -380,7 +393,8 @@ impl Simulation for CantileverImpact {
         let contact_stiffness = contact_stiffness(&inputs.contact, tip_stiffness, &mut errors);
         let solver = inputs::solver(&inputs.solver, SOLVER_DEFAULTS, &mut errors);
         inputs::check_output_interval(inputs.output.interval, &mut errors);
-        let settings = solver.integration(inputs.output.interval, vec![spec.length]);
+        let mut settings = solver.integration(inputs.output.interval, vec![spec.length]);
+        settings.impacts = impact_report::counting(inputs.output.impacts.as_ref(), inputs.output.blocks);
         let stand_in = StandIn::of(&inputs.beam);
         let beam_refused = errors.iter().any(|e| e.pointer.starts_with("/inputs/beam"));
         model_check::check(
@@ -443,10 +457,12 @@ impl Simulation for CantileverImpact {
         if plan.settings.output_interval.is_none() {
             history_drivers.push("/inputs/solver/time_step".to_owned());
         }
+        history_drivers.push("/inputs/output/impacts/max_rows".to_owned());
         WorkEstimate {
             modal_dofs: plan.basis.modes() as f64,
             contacts: 1.0,
-            history_values: samples * 12.0,
+            history_values: samples * 12.0
+                + impact_report::table_values(&plan.settings.impacts, 1, stepping.pass_steps),
             work_drivers: [
                 "/inputs/solver/duration",
                 "/inputs/solver/time_step",
@@ -506,6 +522,8 @@ impl Simulation for CantileverImpact {
             numerical: NumericalResults {
                 first_impact_time: stats.first_impact_time,
                 impacts: stats.impacts,
+                impact_statistics: impact_report::contact_reports(&simulation).remove(0),
+                impact_summary: impact_report::summary(&simulation, &plan.settings.impacts),
                 max_contact_force: stats.max_force,
                 max_contact_force_time: stats.max_force_time,
                 contact_time: stats.contact_time,
@@ -569,6 +587,7 @@ impl Simulation for CantileverImpact {
                 simulation.contact_force_peaks[0].clone(),
                 reference_peaks.contact_force,
             ),
+            impact_report::table_history(&simulation.impact_table),
         ];
         Ok(Output { results, histories })
     }

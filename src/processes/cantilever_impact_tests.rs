@@ -91,7 +91,8 @@ fn default_case_reproduces_the_public_values() {
             "tip_displacement",
             "contact_force",
             "tip_displacement_peaks",
-            "contact_force_peaks"
+            "contact_force_peaks",
+            "impacts"
         ]
     );
     assert_eq!(

@@ -11,6 +11,7 @@ use utoipa::ToSchema;
 use super::basis_report::BasisReport;
 use super::bundle_dynamics::{PeakDeflectionResult, PeakForce};
 use super::hex_inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
+use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::inputs::{self, SolverDefaults, at};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryOutput, Output, Simulation};
@@ -85,8 +86,10 @@ pub struct HexResults {
     pub contacts: Vec<HexContactResult>,
     /// The largest force over all contacts; null without contacts.
     pub max_contact_force: Option<PeakForce>,
-    /// Total closures over all contacts.
+    /// Impacts over all contacts, as `output.impacts` counts them.
     pub impacts: u64,
+    /// The run's impacts: counting, totals, histogram, contacts ranked.
+    pub impact_summary: ImpactSummary,
     /// Contacts whose force histories were recorded (`c<k>` columns), in column order.
     pub recorded_contacts: Vec<usize>,
     /// Per pin: position and largest deflections along x and y.
@@ -169,7 +172,7 @@ pub struct HexContactResult {
     pub max_force: f64,
     /// Its time (s); 0 when the contact never closed.
     pub max_force_time: f64,
-    /// Closures after a separation (the first counts).
+    /// Impacts, as `output.impacts` counts them (default: closures after a separation).
     pub impacts: u64,
     /// Total time closed (s).
     pub contact_time: f64,
@@ -181,6 +184,8 @@ pub struct HexContactResult {
     pub max_penetration: f64,
     /// Wear work rate (1/T) ∫ F·|v_t| dt (W), v_t the sliding velocity across the normal.
     pub wear_work_rate: f64,
+    /// Its impacts as `output.impacts` counts them (`impacts` above is their number).
+    pub impact_statistics: ContactImpacts,
 }
 
 /// One pin's position and largest deflections.
@@ -246,6 +251,7 @@ impl Simulation for HexBundleDynamics {
             description: "As displacements, each value the deflection of largest magnitude (signed) reached at \
                           any step of its output interval",
         },
+        impact_report::TABLE_OUTPUT,
     ];
 
     type Inputs = HexInputs;
@@ -282,6 +288,8 @@ impl Simulation for HexBundleDynamics {
         let excitation = excitation(&inputs.excitation, &mut errors);
         let solver = inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
         inputs::check_output_interval(inputs.output.interval, &mut errors);
+        let counting = impact_report::counting(inputs.output.impacts.as_ref(), inputs.output.blocks);
+        errors.extend(impact_report::errors(&counting));
         let heights = output_heights(&inputs, &mut errors);
 
         let Some(bundle) = bundle else {
@@ -330,6 +338,7 @@ impl Simulation for HexBundleDynamics {
         let basis = inputs.pin.basis(&levels, "/inputs/pin")?;
         let settings = Settings {
             recorded_contacts: Some(recorded),
+            impacts: counting,
             ..solver.integration(
                 Some(inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL)),
                 heights,
@@ -373,10 +382,13 @@ impl Simulation for HexBundleDynamics {
         if plan.inputs.output.heights.is_some() {
             history_drivers.push("/inputs/output/heights".to_owned());
         }
+        history_drivers.push("/inputs/output/impacts/max_rows".to_owned());
+        let table =
+            impact_report::table_values(&plan.settings.impacts, plan.contacts.len(), stepping.pass_steps);
         WorkEstimate {
             modal_dofs: (lines * plan.basis.modes()) as f64,
             contacts: plan.contacts.len() as f64,
-            history_values: samples * columns as f64,
+            history_values: samples * columns as f64 + table,
             work_drivers: [
                 "/inputs/solver/duration",
                 "/inputs/solver/time_step",
@@ -402,8 +414,9 @@ impl Simulation for HexBundleDynamics {
             .iter()
             .zip(&plan.contacts)
             .zip(&simulation.contact_statistics)
+            .zip(impact_report::contact_reports(&simulation))
             .enumerate()
-            .map(|(k, ((g, c), s))| HexContactResult {
+            .map(|(k, (((g, c), s), impact_statistics))| HexContactResult {
                 level: g.level,
                 height: g.height,
                 wire_pin: g.wire_pin,
@@ -422,6 +435,7 @@ impl Simulation for HexBundleDynamics {
                 first_impact_time: s.first_impact_time,
                 max_penetration: s.max_penetration,
                 wear_work_rate: simulation.wear_work.get(k).copied().unwrap_or(0.0) / duration,
+                impact_statistics,
             })
             .collect();
         let max_contact_force = simulation
@@ -471,6 +485,7 @@ impl Simulation for HexBundleDynamics {
             contacts,
             max_contact_force,
             impacts: simulation.contact_statistics.iter().map(|s| s.impacts).sum(),
+            impact_summary: impact_report::summary(&simulation, &plan.settings.impacts),
             recorded_contacts,
             pins,
             energy: simulation.energy.into(),
@@ -759,6 +774,7 @@ fn histories(plan: &Plan, simulation: integrate::Simulation) -> Vec<History> {
         time: simulation.time.clone(),
         series,
     };
+    let table = impact_report::table_history(&simulation.impact_table);
     vec![
         history("contact_forces", named(&contact_names, simulation.contact_forces)),
         history(
@@ -779,6 +795,7 @@ fn histories(plan: &Plan, simulation: integrate::Simulation) -> Vec<History> {
                 simulation.deflection_peaks.into_iter().flatten().collect(),
             ),
         ),
+        table,
     ]
 }
 

@@ -10,6 +10,7 @@ use serde::Deserialize;
 use utoipa::ToSchema;
 
 use super::bundle_inputs::{BaseAccelerationInput, DistributionInput};
+use super::impact_report::ImpactsInput;
 use super::inputs::{BeamInput, SectionInput, SolverInput};
 use crate::physics::bundle::GapDistribution;
 use crate::physics::hex::{FlatOffset, Handedness, HexGapState, HexGaps, HexLayout, PinZone, ZoneClosure};
@@ -178,6 +179,12 @@ pub struct HexOutputInput {
     /// Contacts whose force histories are recorded (statistics are kept for every
     /// contact); default: the wall contacts.
     pub contacts: Option<ContactSelectionInput>,
+    /// How impacts are counted and tabulated; default: every closure is an impact.
+    pub impacts: Option<ImpactsInput>,
+    /// Equal blocks of the run over which the impact statistics are also computed,
+    /// reported as their mean and standard deviation (code_aster's NB_BLOC; 1…100).
+    #[schema(minimum = 1, maximum = 100, default = 1)]
+    pub blocks: Option<usize>,
 }
 
 /// A selection of contacts.

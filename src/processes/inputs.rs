@@ -444,6 +444,7 @@ impl SolverSettings {
             output_interval,
             output_heights,
             recorded_contacts: None,
+            impacts: Default::default(),
         }
     }
 }

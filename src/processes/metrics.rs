@@ -34,6 +34,23 @@ pub fn flatten_scalars(document: &Value) -> Vec<(String, Value)> {
     out
 }
 
+/// The scalars of `field` (an object) in every item of the array `list`, as
+/// `list.k.field.name` (`contacts.3.impact_statistics.impacts_per_second`).
+pub fn item_scalars(document: &Value, list: &str, field: &str) -> Vec<(String, Value)> {
+    let Some(items) = document[list].as_array() else {
+        return Vec::new();
+    };
+    items
+        .iter()
+        .enumerate()
+        .flat_map(|(k, item)| {
+            flatten_scalars(&item[field])
+                .into_iter()
+                .map(move |(name, value)| (format!("{list}.{k}.{field}.{name}"), value))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,6 +13,7 @@ pub mod cantilever_impact;
 pub mod cost;
 pub mod hex_bundle_dynamics;
 pub mod hex_inputs;
+pub mod impact_report;
 pub mod inputs;
 pub mod metrics;
 pub mod model_check;

@@ -104,7 +104,7 @@ pub fn settings_pointer(path: &str) -> Option<String> {
         "tolerance" => "/inputs/solver/tolerance",
         "duration" => "/inputs/solver/duration",
         "output_interval" => "/inputs/output/interval",
-        _ => return None,
+        _ => return super::impact_report::settings_pointer(path).map(str::to_owned),
     };
     Some(pointer.to_owned())
 }

@@ -55,8 +55,17 @@ fn shape_problems(
         // Flattened structs: each part names some of the properties.
         let mut named = serde_json::Map::new();
         let mut problems = Vec::new();
-        for part in parts {
+        // A part can be flattened itself (an `allOf` of its own parts).
+        fn gather<'a>(part: &'a Value, components: &'a HashMap<String, Value>, out: &mut Vec<&'a Value>) {
             let part = resolve(part, components);
+            match part["allOf"].as_array() {
+                Some(parts) => parts.iter().for_each(|p| gather(p, components, out)),
+                None => out.push(part),
+            }
+        }
+        let mut flat = Vec::new();
+        parts.iter().for_each(|p| gather(p, components, &mut flat));
+        for part in flat {
             for (key, property) in part["properties"].as_object().into_iter().flatten() {
                 named.insert(key.clone(), property.clone());
             }

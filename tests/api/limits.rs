@@ -96,7 +96,8 @@ async fn histories_above_the_ceiling_point_at_the_output_interval() {
     })
     .await;
     // row17: 0.2 s sampled every 1e-4 s is 2001 samples of 1 + 180 + 1 + 17 columns,
-    // twice (each history and its peaks).
+    // twice (each history and its peaks), and the per-impact table's default 100 000
+    // rows of 10 values (180 contacts could make more in its ~10⁵ steps).
     let body = example("bundle-row17.json");
     let response = app.post_execution("bundle-dynamics", &body).await;
     let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/too-costly").await;
@@ -110,7 +111,7 @@ async fn histories_above_the_ceiling_point_at_the_output_interval() {
         "{problem}"
     );
     assert_eq!(problem["exceeded"][0]["quantity"], "history_values");
-    assert_eq!(problem["exceeded"][0]["estimate"], 2.0 * 2001.0 * 199.0);
+    assert_eq!(problem["exceeded"][0]["estimate"], 2.0 * 2001.0 * 199.0 + 1e6);
 }
 
 #[tokio::test]
@@ -267,4 +268,40 @@ async fn history_responses_are_thinned_to_the_cap_whatever_is_asked() {
         .await;
     assert_eq!(window["points"], 51);
     assert_eq!(window["thinned"], false);
+}
+
+#[tokio::test]
+async fn a_per_impact_table_above_the_ceiling_points_at_its_rows() {
+    let app = spawn_validating(CostLimits {
+        max_history_values: 1e6,
+        ..CostLimits::default()
+    })
+    .await;
+    // The cantilever's histories hold 12 values a sample: 1001 samples at 1e-4 s over
+    // 0.1 s. A table of up to 10⁵ rows (one impact every two of its 10⁴ steps at most:
+    // 5000 rows) stays within 10⁶ values; its histories too.
+    let mut body = example("cantilever-impact.json");
+    body["inputs"]["solver"]["duration"] = json!(0.1);
+    body["inputs"]["output"] = json!({"interval": 1e-4});
+    assert_eq!(
+        app.post_execution("cantilever-impact", &body).await.status(),
+        StatusCode::CREATED
+    );
+    // Over 10 s, 10⁶ steps could make 5·10⁵ impacts: 10⁵ rows kept, 10⁶ values, plus
+    // the histories: refused, at the table's size among the drivers.
+    body["inputs"]["solver"]["duration"] = json!(10.0);
+    body["inputs"]["output"] = json!({"interval": 1e-2});
+    let response = app.post_execution("cantilever-impact", &body).await;
+    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/too-costly").await;
+    assert!(
+        pointers(&problem).contains(&"/inputs/output/impacts/max_rows".to_owned()),
+        "{problem}"
+    );
+    assert_eq!(problem["exceeded"][0]["estimate"], 12.0 * 1001.0 + 1e6);
+    // Fewer rows fit.
+    body["inputs"]["output"]["impacts"] = json!({"max_rows": 1000});
+    assert_eq!(
+        app.post_execution("cantilever-impact", &body).await.status(),
+        StatusCode::CREATED
+    );
 }

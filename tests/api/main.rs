@@ -15,6 +15,7 @@ mod dismissal;
 mod earthquakes;
 mod errors;
 mod execution;
+mod impacts;
 mod limits;
 mod listing;
 mod load;

@@ -414,8 +414,8 @@ async fn killing_a_worker_mid_job_loses_no_job_and_completes_none_twice() {
     .unwrap();
     assert_eq!(attempt, 2, "the killed worker's job was claimed again");
     assert_eq!(
-        owner_histories, 4,
-        "tip_displacement, contact_force and their peaks"
+        owner_histories, 5,
+        "tip_displacement, contact_force, their peaks and the impacts"
     );
     let results = get_json(&client, &format!("{address}/jobs/{victim}/results")).await;
     assert!(results["comparison"]["f_err"].is_number(), "{results}");

@@ -89,6 +89,7 @@ impl ImpactCounting {
 
 /// One impact of one contact.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct Impact {
     /// Contact index.
     pub contact: usize,

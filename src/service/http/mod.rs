@@ -10,6 +10,7 @@ pub mod dashboard;
 pub mod error;
 pub mod extract;
 mod history_view;
+pub mod impacts;
 pub mod job_inputs;
 pub mod jobs;
 pub mod landing;
@@ -99,6 +100,7 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/jobs/{jobId}", get(jobs::status).delete(jobs::dismiss))
         .route("/jobs/{jobId}/results", get(results::results))
         .route("/jobs/{jobId}/inputs", get(job_inputs::inputs))
+        .route("/jobs/{jobId}/results/impacts", get(impacts::impacts))
         .route("/jobs/{jobId}/results/{output}", get(results::output))
         .route("/jobs/{jobId}/results/{output}/spectrum", get(spectra::spectrum))
         .route("/sweeps", get(sweeps::list).post(sweeps::create))

@@ -17,7 +17,7 @@ use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityRequirement
 use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
 use utoipa::{Modify, OpenApi};
 
-use super::{job_inputs, jobs, landing, models, processes, results, spectra, sweep_models, sweeps};
+use super::{impacts, job_inputs, jobs, landing, models, processes, results, spectra, sweep_models, sweeps};
 use crate::processes::Registry;
 use crate::service::queue::JobStatus;
 
@@ -192,6 +192,7 @@ impl Modify for ResourceLinks {
         job_inputs::inputs,
         results::results,
         results::output,
+        impacts::impacts,
         spectra::spectrum,
         sweeps::create,
         sweeps::list,
@@ -216,6 +217,7 @@ impl Modify for ResourceLinks {
         crate::processes::report::StepHalvingReport,
         models::HistoryDocument,
         models::Series,
+        impacts::ImpactPage,
         spectra::SpectrumDocument,
         spectra::SpectrumComparison,
         models::LandingPage,

@@ -112,6 +112,10 @@ pub async fn spectrum(
 ) -> Result<Response, ApiError> {
     let format = Format::from_query(query.format.as_deref(), Format::Json)?;
     require_finite([("f_min", query.f_min), ("f_max", query.f_max)], "Hz")?;
+    // The per-impact table is no time series.
+    if output == crate::processes::impact_report::TABLE {
+        return Err(Problem::no_such_output(&job_id, &format!("{output}/spectrum")).into());
+    }
     // A response holds at most the service's cap of rows, as for histories.
     query.max_points = Some(capped_max_points(query.max_points, state.max_history_points)?);
     respond(

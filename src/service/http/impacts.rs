@@ -1,0 +1,140 @@
+//! `/jobs/{jobId}/results/impacts`: the per-impact table of a run, one row per impact
+//! sorted by start time, as CSV or JSON, filtered by contact and paged.
+
+use axum::extract::{Extension, Path, State};
+use axum::http::HeaderMap;
+use axum::response::Response;
+
+use super::AppState;
+use super::error::ApiError;
+use super::extract::ApiQuery;
+use super::history_view::{Format, respond};
+use crate::physics::impacts::Impact;
+use crate::problem::Problem;
+use crate::processes::impact_report::{self, TABLE};
+use crate::service::auth::Tenant;
+use crate::service::store;
+
+/// Query of `GET /jobs/{jobId}/results/impacts`.
+#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct ImpactsQuery {
+    /// `csv` or `json` (default: JSON, or CSV when `Accept` prefers `text/csv`).
+    #[param(pattern = "^(csv|json)$")]
+    pub format: Option<String>,
+    /// Only these contacts, comma-separated indices (e.g. `3,17`); default: all.
+    pub contact: Option<String>,
+    /// Rows to skip (after the filter); default 0.
+    pub offset: Option<usize>,
+    /// Rows to return at most (1 or more); default and ceiling: the service's
+    /// `--max-history-points`.
+    #[param(minimum = 1)]
+    pub limit: Option<usize>,
+}
+
+/// One page of the per-impact table.
+#[derive(Debug, serde::Serialize, utoipa::ToSchema)]
+pub struct ImpactPage {
+    /// `impacts`.
+    pub output: String,
+    /// Rows matching the filter, over every page.
+    pub total_rows: usize,
+    /// Index of this page's first row among them.
+    pub offset: usize,
+    /// The rows (contact, start s, peak_time s, peak_force N, impulse N·s, duration s,
+    /// approach_velocity m/s, rebounds, dissipated J, energy J).
+    pub rows: Vec<Impact>,
+    /// The query of the next page, when there is one (`offset=…&limit=…`, plus the filter).
+    pub next: Option<String>,
+}
+
+/// The per-impact table
+///
+/// Every impact of the run's contacts (as `output.impacts` counted them: force
+/// threshold, rest time), sorted by start time then contact: CSV
+/// `contact,start,peak_time,peak_force,impulse,duration,approach_velocity,rebounds,dissipated,energy`
+/// or JSON pages. `contact` filters, `offset` and `limit` page. The table holds the
+/// first `output.impacts.max_rows` impacts to end; the results' `impact_summary` says
+/// how many were left out.
+#[utoipa::path(get, path = "/jobs/{jobId}/results/impacts", operation_id = "getResultImpacts", tag = "Results",
+    params(("jobId" = String, Path, description = "Job id"), ImpactsQuery),
+    responses(
+        (status = 200, description = "Rows of the per-impact table",
+            content((ImpactPage = "application/json"), (String = "text/csv")),
+            headers(("ETag" = String))),
+        (status = 304, description = "Unchanged since the `If-None-Match` tag"),
+        (status = 400, description = "Invalid query parameter", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json"),
+        (status = 404, description = "No such job, results not ready, or a job without a table",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
+pub async fn impacts(
+    State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
+    Path(job_id): Path<String>,
+    ApiQuery(query): ApiQuery<ImpactsQuery>,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
+    let contacts = parse_contacts(query.contact.as_deref())?;
+    if query.limit == Some(0) {
+        return Err(Problem::invalid_query("`limit` must be at least 1").into());
+    }
+    let limit = query.limit.unwrap_or(usize::MAX).min(state.max_history_points);
+    let offset = query.offset.unwrap_or(0);
+    let filter = query.contact.clone();
+    respond(
+        &state,
+        &tenant,
+        &job_id,
+        TABLE,
+        &headers,
+        format,
+        "rendering the impacts",
+        move |stored| {
+            let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
+            let rows = impact_report::rows_of(&history)
+                .ok_or_else(|| ApiError::Internal("the stored impacts are not a table".into()))?;
+            let selected: Vec<Impact> = rows
+                .into_iter()
+                .filter(|r| contacts.as_ref().is_none_or(|c| c.contains(&r.contact)))
+                .collect();
+            let page: Vec<Impact> = selected.iter().skip(offset).take(limit).copied().collect();
+            if format == Format::Csv {
+                return Ok(impact_report::table_csv(&page).into_bytes());
+            }
+            let end = offset.saturating_add(page.len());
+            let next = (end < selected.len()).then(|| {
+                let filter = filter.map(|f| format!("&contact={f}")).unwrap_or_default();
+                format!("offset={end}&limit={}{filter}", page.len().max(1))
+            });
+            let document = ImpactPage {
+                output: TABLE.to_owned(),
+                total_rows: selected.len(),
+                offset,
+                rows: page,
+                next,
+            };
+            serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
+        },
+    )
+    .await
+}
+
+/// The `contact` filter: comma-separated indices; 400 on anything else.
+fn parse_contacts(text: Option<&str>) -> Result<Option<Vec<usize>>, ApiError> {
+    let Some(text) = text else {
+        return Ok(None);
+    };
+    text.split(',')
+        .map(|part| {
+            part.trim().parse::<usize>().map_err(|_| {
+                Problem::invalid_query(format!(
+                    "`contact` must list contact indices separated by commas (0, 1, …), not `{part}`"
+                ))
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Some)
+        .map_err(Into::into)
+}

@@ -1,0 +1,190 @@
+//! Impact statistics over HTTP (issue 19): the per-impact table of a job as CSV and JSON
+//! pages, filtered by contact, adding up to the results document's totals; counting
+//! settings that merge rebounds; bad counting settings refused at their pointers.
+
+use std::sync::Arc;
+
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use chocmodal::processes::bundle_dynamics::BundleDynamics;
+use chocmodal::processes::cantilever_impact::CantileverImpact;
+
+use crate::helpers::{TestApp, assert_problem, spawn_app_with_processes};
+
+async fn spawn() -> TestApp {
+    spawn_app_with_processes(vec![Arc::new(CantileverImpact), Arc::new(BundleDynamics)], |_| {}).await
+}
+
+fn example(name: &str) -> Value {
+    let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+async fn run(app: &TestApp, process: &str, body: &Value) -> (String, Value) {
+    let response = app.post_execution(process, body).await;
+    assert_eq!(response.status(), StatusCode::CREATED);
+    let id = response.json::<Value>().await.unwrap()["jobID"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    let status = app.wait_until_finished(&id).await;
+    assert_eq!(status["status"], "successful", "{status}");
+    let results = app.get_json(&format!("/jobs/{id}/results")).await;
+    (id, results)
+}
+
+fn column(csv: &str, name: &str) -> Vec<f64> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let k = header.iter().position(|h| *h == name).unwrap();
+    lines
+        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// The public cantilever case: the reference counts its impacts exactly (closures of the
+/// semi-analytic solution); with the default counting the numerical table has as many
+/// rows, they add up to the contact's impulse and their largest peak is its largest
+/// force.
+#[tokio::test]
+async fn the_impact_table_serves_every_impact_and_adds_up_to_the_results() {
+    let app = spawn().await;
+    let mut body = example("cantilever-impact.json");
+    body["inputs"]["solver"]["duration"] = json!(0.2);
+    let (id, results) = run(&app, "cantilever-impact", &body).await;
+    let numerical = &results["numerical"];
+    let impacts = numerical["impacts"].as_u64().unwrap();
+    assert!(impacts >= 2, "{numerical}");
+    assert_eq!(impacts, results["reference"]["impacts"].as_u64().unwrap());
+    assert_eq!(
+        results["outputs"]["impacts"]["href"],
+        format!("/jobs/{id}/results/impacts")
+    );
+
+    let csv = app
+        .get(&format!("/jobs/{id}/results/impacts?format=csv"))
+        .await
+        .text()
+        .await
+        .unwrap();
+    assert_eq!(
+        csv.lines().next(),
+        Some(
+            "contact,start,peak_time,peak_force,impulse,duration,approach_velocity,rebounds,dissipated,energy"
+        )
+    );
+    assert_eq!(csv.lines().count() as u64, impacts + 1);
+    let impulse: f64 = column(&csv, "impulse").iter().sum();
+    let total = numerical["impulse"].as_f64().unwrap();
+    assert!((impulse - total).abs() <= 1e-9 * total, "{impulse} vs {total}");
+    let peak = column(&csv, "peak_force").into_iter().fold(0.0, f64::max);
+    assert_eq!(peak, numerical["max_contact_force"].as_f64().unwrap());
+    let statistics = &numerical["impact_statistics"];
+    assert_eq!(statistics["impacts"].as_u64(), Some(impacts));
+    assert_eq!(
+        statistics["histogram"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_u64().unwrap())
+            .sum::<u64>(),
+        impacts
+    );
+    // The approach energy ½ m v² never exceeds the energy the release put in (no
+    // excitation; damping only removes energy).
+    let initial = numerical["energy"]["initial"].as_f64().unwrap();
+    assert!(statistics["max_impact_energy"].as_f64().unwrap() <= initial);
+
+    // JSON pages: one row at a time, the next page named, the filter kept.
+    let page = app
+        .get_json(&format!("/jobs/{id}/results/impacts?limit=1&contact=0"))
+        .await;
+    assert_eq!(page["total_rows"].as_u64(), Some(impacts));
+    assert_eq!(page["rows"].as_array().unwrap().len(), 1);
+    assert_eq!(page["next"], "offset=1&limit=1&contact=0");
+    let second = app
+        .get_json(&format!("/jobs/{id}/results/impacts?offset=1&limit=1&contact=0"))
+        .await;
+    assert!(second["rows"][0]["start"].as_f64() >= page["rows"][0]["start"].as_f64());
+    // Accept: text/csv gives the CSV; a contact the model lacks has no rows.
+    let by_accept = app
+        .client
+        .get(app.url(&format!("/jobs/{id}/results/impacts?contact=7")))
+        .header("accept", "text/csv")
+        .send()
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    assert_eq!(by_accept.lines().count(), 1);
+    for query in ["contact=x", "limit=0", "offset=-1", "colour=red"] {
+        let response = app.get(&format!("/jobs/{id}/results/impacts?{query}")).await;
+        assert_eq!(response.status(), StatusCode::BAD_REQUEST, "{query}");
+    }
+}
+
+/// A rest time longer than the flights between the cantilever's impacts merges them
+/// into one impact whose rebounds are the others; the loaded time and impulse do not
+/// change.
+#[tokio::test]
+async fn a_rest_time_merges_rebounds_into_one_impact() {
+    let app = spawn().await;
+    let mut body = example("cantilever-impact.json");
+    body["inputs"]["solver"]["duration"] = json!(0.2);
+    let (_, plain) = run(&app, "cantilever-impact", &body).await;
+    body["inputs"]["output"] = json!({"impacts": {"rest_time": 0.2}, "blocks": 4});
+    let (id, merged) = run(&app, "cantilever-impact", &body).await;
+    let (a, b) = (&plain["numerical"], &merged["numerical"]);
+    assert_eq!(b["impacts"], 1);
+    let rows = app.get_json(&format!("/jobs/{id}/results/impacts")).await;
+    assert_eq!(
+        rows["rows"][0]["rebounds"].as_u64(),
+        Some(a["impacts"].as_u64().unwrap() - 1)
+    );
+    let (x, y) = (&a["impact_statistics"], &b["impact_statistics"]);
+    for field in ["loaded_time", "impulse"] {
+        let (x, y) = (x[field].as_f64().unwrap(), y[field].as_f64().unwrap());
+        // Summed by block in one run, at once in the other.
+        assert!((x - y).abs() <= 1e-12 * x, "{field}: {x} vs {y}");
+    }
+    assert_eq!(y["blocks"]["blocks"], 4);
+    assert_eq!(b["impact_summary"]["rest_time"], 0.2);
+}
+
+#[tokio::test]
+async fn bad_counting_settings_are_refused_at_their_pointers() {
+    let app = spawn().await;
+    for process in ["cantilever-impact", "bundle-dynamics"] {
+        let mut body = example(if process == "cantilever-impact" {
+            "cantilever-impact.json"
+        } else {
+            "bundle-row17.json"
+        });
+        body["inputs"]["output"] = json!({
+            "impacts": {"force_threshold": -1.0, "rest_time": -0.1, "classes": 10001},
+            "blocks": 0
+        });
+        let response = app.post_execution(process, &body).await;
+        let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
+        let pointers: Vec<&str> = problem["errors"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e["pointer"].as_str().unwrap())
+            .collect();
+        for pointer in [
+            "/inputs/output/impacts/force_threshold",
+            "/inputs/output/impacts/rest_time",
+            "/inputs/output/impacts/classes",
+            "/inputs/output/blocks",
+        ] {
+            assert!(pointers.contains(&pointer), "{process}: {pointer} in {problem}");
+        }
+        body["inputs"]["output"] = json!({"impacts": {"classes": 0}});
+        let response = app.post_execution(process, &body).await;
+        let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
+        assert_eq!(problem["errors"][0]["pointer"], "/inputs/output/impacts/classes");
+    }
+}
