@@ -402,6 +402,27 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
         2,
         "the {verdict} badge in the quality card and next to the peak force"
     );
+    // Its impacts: one table row per impact of that contact (up to a page of 50), the
+    // run's histogram with every impact, and a statistic picker for the grid.
+    let impacts = contacts[strongest as usize]["impacts"].as_u64().unwrap();
+    assert!(impacts > 0);
+    let table = element(&dom, &format!("data-impacts-table=\"{strongest}\""), "</table>");
+    assert_eq!(
+        tags(table, "data-impact=").len() as u64,
+        impacts.min(50),
+        "{table}"
+    );
+    let histogram = element(&dom, "data-plot=\"impact-histogram\"", "</figure>");
+    let counted: f64 = tags(histogram, "data-value=")
+        .iter()
+        .map(|bar| number(bar, "data-value"))
+        .sum();
+    assert_eq!(
+        counted as u64,
+        results["impact_summary"]["impacts"].as_u64().unwrap()
+    );
+    let picker = element(&dom, "data-picker=\"statistic\"", "</select>");
+    assert!(picker.matches("<option").count() >= 10, "{picker}");
 
     // The calibration map: every run a cell, validity as aggregated, and the contour.
     let dom = load(

@@ -31,6 +31,7 @@ pub const ASSETS: &[Asset] = &[
     asset!("lists.js", JS),
     asset!("job.js", JS),
     asset!("hex.js", JS),
+    asset!("impacts.js", JS),
     asset!("sweep.js", JS),
     asset!("submit.js", JS),
     asset!("style.css", "text/css; charset=utf-8"),

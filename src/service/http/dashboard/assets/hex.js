@@ -1,19 +1,18 @@
 // `hex-bundle-dynamics`: a cross-section of the bundle at one level (the wrapper's
 // hexagon, pins as circles, the level's contacts as segments from the wire's pin toward
-// what it touches, coloured by peak force, impact count or wear work rate), a level
-// slider, and the force history of a clicked contact (histories exist for the recorded
-// contacts only: `output.contacts`). Then each pin's largest deflections and histories.
+// what it touches, coloured by any impact statistic or the wear work rate), a level
+// slider, and the force history and impacts of a clicked contact (histories exist for
+// the recorded contacts only: `output.contacts`; statistics and impacts for every one).
+// Then the run's impacts, and each pin's largest deflections and histories.
 
 import {api, card, errorBox, fmt, h, keyValueTable, replace, withUnit} from './util.js';
 import {barChart, figure, linePlot, svgElement as s, viridis} from './plot.js';
 import {envelope, envelopeSeries, history, qualityBadge, reportedPeak, seriesOf, thinned} from './job.js';
+import {STATISTICS, contactImpacts, impactsCard, statisticPicker} from './impacts.js';
 
-/** What the segments may be coloured by. */
-const MEASURES = {
-  max_force: {label: 'peak force', unit: 'N'},
-  impacts: {label: 'impact count', unit: ''},
-  wear_work_rate: {label: 'wear work rate', unit: 'W'},
-};
+/** What the segments may be coloured by: every impact statistic, and the wear work rate. */
+const WEAR = {wear_work_rate: {label: 'wear work rate', unit: 'W', of: (c) => c.wear_work_rate}};
+const MEASURES = {...STATISTICS, ...WEAR};
 const SIZE = 560;
 
 export async function hexBundle(box, id, results) {
@@ -36,6 +35,13 @@ export async function hexBundle(box, id, results) {
     ['energy balance residual', `${fmt(energy.relative_residual, 3)} (relative)`],
   ])));
   if (contacts.length && pins.length) box.append(crossSectionCard(id, results, levels, contacts, pins, peak));
+  const describe = (k) => {
+    const c = contacts[k];
+    return `c${k}: pin ${c.wire_pin} on ${c.touched_pin === null ? `flat ${c.touched_flat}` : `pin ${c.touched_pin}`}` +
+      ` at level ${c.level}`;
+  };
+  const impacts = impactsCard(results, results.impact_summary, describe);
+  if (impacts) box.append(impacts);
   if (pins.length) box.append(await pinsCard(id, results, pins));
 }
 
@@ -52,8 +58,8 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
   const label = h('span', {class: 'mono'});
   const slider = h('input', {type: 'range', min: 0, max: levels.length - 1, step: 1, value: level,
     'aria-label': 'level', 'data-level-slider': '', oninput: (event) => { level = Number(event.target.value); draw(); }});
-  const colour = h('select', {'aria-label': 'colour by', onchange: (event) => { measure = event.target.value; draw(); }},
-    Object.entries(MEASURES).map(([key, m]) => h('option', {value: key}, m.label)));
+  const colour = statisticPicker((key) => { measure = key; draw(); }, WEAR);
+  const impactsBox = h('div');
   const draw = () => {
     const z = levels[level];
     replace(label, `level ${level}: z = ${fmt(z.height, 4)} m, wires at ${fmt(z.wire_angle)}°` +
@@ -72,6 +78,7 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
       ['impacts', fmt(c.impacts)], ['time in contact', withUnit(c.contact_time, 's')],
       ['impulse', withUnit(c.impulse, 'N·s')], ['wear work rate', withUnit(c.wear_work_rate, 'W')],
     ], {class: 'kv wide'}));
+    replace(impactsBox, contactImpacts(id, k, c));
     if (!recorded.has(k)) {
       replace(plotBox, h('p', {class: 'muted', 'data-unrecorded': k}, `No history for c${k}: only the contacts of ` +
         `output.contacts are recorded (e.g. {"type": "list", "contacts": [${k}]}); its statistics above are complete.`));
@@ -90,7 +97,7 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
   draw();
   if (selected >= 0) select(selected);
   return card('Cross-section', h('p', {class: 'inline'}, h('label', {}, 'Level ', slider), ' ', label),
-    h('p', {class: 'inline'}, h('label', {}, 'Colour by ', colour)), drawing, detail, plotBox);
+    h('p', {class: 'inline'}, h('label', {}, 'Colour by ', colour)), drawing, detail, plotBox, impactsBox);
 }
 
 /**
@@ -108,7 +115,9 @@ function crossSection(results, pins, contacts, shown, measure, selected, onselec
     const a = (k * Math.PI) / 3;
     return `${X(corner * Math.cos(a)).toFixed(1)},${Y(corner * Math.sin(a)).toFixed(1)}`;
   }).join(' ');
-  const top = Math.max(...contacts.map((c) => c[measure]), 0) || 1;
+  const m = MEASURES[measure];
+  const valueOf = (c) => m.of(c) ?? 0;
+  const top = Math.max(...contacts.map(valueOf), 0) || 1;
   const radius = (g.pin_diameter / 2) * scale;
   const circles = pins.map((p) => s('circle', {class: 'pin', cx: X(p.position[0]).toFixed(1), cy: Y(p.position[1]).toFixed(1),
     r: radius.toFixed(1), fill: '#eef1f4', stroke: '#9aa5b1'}, s('title', {}, `pin ${p.pin} (ring ${p.ring})`)));
@@ -125,19 +134,18 @@ function crossSection(results, pins, contacts, shown, measure, selected, onselec
       const reach = apothem - (from[0] * c.normal[0] + from[1] * c.normal[1]);
       to = [from[0] + reach * c.normal[0], from[1] + reach * c.normal[1]];
     }
-    const value = c[measure];
+    const value = valueOf(c);
     const line = s('line', {class: k === selected ? 'contact selected' : 'contact',
       x1: X(from[0]).toFixed(1), y1: Y(from[1]).toFixed(1), x2: X(to[0]).toFixed(1), y2: Y(to[1]).toFixed(1),
       stroke: value > 0 ? viridis(value / top) : '#c5ccd4', 'stroke-width': k === selected ? 6 : 3.5,
       'stroke-linecap': 'round', 'data-contact': k, 'data-value': value, style: 'cursor: pointer'},
-    s('title', {}, `c${k}: ${MEASURES[measure].label} ${fmt(value)} ${MEASURES[measure].unit}`));
+    s('title', {}, `c${k}: ${m.label} ${fmt(value)} ${m.unit}`));
     line.addEventListener('click', () => onselect(k));
     return line;
   });
   const svg = s('svg', {viewBox: `0 0 ${SIZE} ${SIZE}`, role: 'img', class: 'chart cross-section',
     'aria-label': 'bundle cross-section', style: `max-width: ${SIZE}px`},
   s('polygon', {points: hexagon, fill: 'none', stroke: '#17212e', 'stroke-width': 2}), circles, numbers, segments);
-  const m = MEASURES[measure];
   return figure('cross-section', `Contacts of the level, coloured by ${m.label}`,
     h('span', {class: 'muted'}, ` dark: 0, yellow: ${fmt(top, 3)} ${m.unit} (the largest over all levels); ` +
       'grey: never loaded; click a contact for its history'), svg, {'data-contacts-shown': shown.length});

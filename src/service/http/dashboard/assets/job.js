@@ -11,6 +11,7 @@ import {FINISHED, ApiProblem, api, badge, card, download, errorBox, fmt, fmtElap
   leaves, poll, progressBar, replace, withUnit} from './util.js';
 import {barChart, heatMap, linePlot} from './plot.js';
 import {hexBundle} from './hex.js';
+import {STATISTICS, contactImpacts, impactsCard, statisticPicker} from './impacts.js';
 
 /** Points asked of a history for a plot (min/max thinning keeps every peak). */
 const PLOT_POINTS = 2400;
@@ -114,8 +115,10 @@ function downloadsCard(id, results) {
         h('th', {}, name),
         h('td', {}, download(`${link.href}?format=csv`, `${name}.csv`), ' ',
           download(`${link.href}?format=json`, `${name}.json`), ' ',
-          download(`${link.href}/spectrum?format=csv`, `${name}-spectrum.csv`)))))),
-  h('p', {class: 'muted'}, 'CSV histories at full resolution; spectra are one-sided power spectral densities.'));
+          // The per-impact table is no time series: it has no spectrum.
+          name === 'impacts' ? null : download(`${link.href}/spectrum?format=csv`, `${name}-spectrum.csv`)))))),
+  h('p', {class: 'muted'}, 'CSV histories at full resolution; spectra are one-sided power spectral densities; ' +
+    '`impacts` is one row per impact.'));
 }
 
 /** What each verdict tells the user. */
@@ -212,6 +215,8 @@ async function cantilever(box, id, results) {
         row('time step', `${fmt(n.time_step)} (critical ${fmt(n.critical_time_step)})`, '', 's'),
         row('modes', fmt((n.frequencies_hz || []).length), fmt(r.modes)))),
     (r.notes || []).map((note) => h('p', {class: 'muted'}, note))));
+  append(box, impactsCard(results, n.impact_summary, () => 'the tip contact'),
+    card('Impacts of the tip contact', contactImpacts(id, 0, {impact_statistics: n.impact_statistics})));
   const plots = h('div');
   const spectrumBox = h('div');
   append(box, card('Histories', plots), card('Power spectra', spectrumBox));
@@ -289,27 +294,34 @@ async function bundle(box, id, results) {
     }
     positions.sort((a, b) => a.order[0] - b.order[0] || a.order[1] - b.order[1]);
     const heights = [...new Set(contacts.map((c) => c.height))].sort((a, b) => a - b);
-    const top = Math.max(...contacts.map((c) => c.max_force), 0);
+    let statistic = 'max_force';
     let selected = contacts.reduce((best, c, k) => (c.max_force > contacts[best].max_force ? k : best), 0);
     const gridBox = h('div');
+    const statistics = statisticPicker((key) => { statistic = key; drawGrid(); });
     const picker = h('select', {'aria-label': 'contact', 'data-picker': 'contact',
       onchange: (event) => select(Number(event.target.value))},
     contacts.map((c, k) => h('option', {value: k},
       `c${k}: ${side(c.left)} – ${side(c.right)} at ${fmt(c.height)} m (max ${fmt(c.max_force, 3)} N)`)));
     const detail = h('div');
     const plotBox = h('div');
-    const drawGrid = () => replace(gridBox, heatMap({id: 'max-force-grid', title: 'Peak contact force by level and position',
-      caption: h('span', {class: 'muted'}, ' click a cell to see its history'),
-      xValues: positions.map((p) => p.key.replace('|', '–')), yValues: heights.map((z) => `${fmt(z, 3)} m`),
-      xLabel: 'between (left – right)', yLabel: 'height', domain: [0, top || 1], colorLabel: 'N',
-      cellHeight: 36,
-      cells: contacts.map((c, k) => ({
-        i: positions.findIndex((p) => p.key === `${c.left}|${c.right}`), j: heights.indexOf(c.height),
-        value: c.max_force, text: fmt(c.max_force, 2),
-        title: `c${k}: ${side(c.left)} – ${side(c.right)} at ${fmt(c.height)} m: max ${fmt(c.max_force)} N` +
-          ` at ${fmt(c.max_force_time)} s, ${c.impacts} impacts`,
-        attrs: {'data-contact': k, class: k === selected ? 'selected' : null}, onclick: () => select(k),
-      }))}));
+    const drawGrid = () => {
+      const m = STATISTICS[statistic];
+      const value = (c) => m.of(c) ?? 0;
+      const top = Math.max(...contacts.map(value), 0);
+      replace(gridBox, heatMap({id: 'max-force-grid', title: `${m.label[0].toUpperCase()}${m.label.slice(1)} by level and position`,
+        caption: h('span', {class: 'muted'}, ' click a cell to see its history and impacts'),
+        xValues: positions.map((p) => p.key.replace('|', '–')), yValues: heights.map((z) => `${fmt(z, 3)} m`),
+        xLabel: 'between (left – right)', yLabel: 'height', domain: [0, top || 1], colorLabel: m.unit,
+        cellHeight: 36,
+        cells: contacts.map((c, k) => ({
+          i: positions.findIndex((p) => p.key === `${c.left}|${c.right}`), j: heights.indexOf(c.height),
+          value: value(c), text: fmt(value(c), 2),
+          title: `c${k}: ${side(c.left)} – ${side(c.right)} at ${fmt(c.height)} m: ${m.label} ${fmt(value(c))} ${m.unit}` +
+            `; max ${fmt(c.max_force)} N at ${fmt(c.max_force_time)} s, ${c.impacts} impacts`,
+          attrs: {'data-contact': k, class: k === selected ? 'selected' : null}, onclick: () => select(k),
+        }))}));
+    };
+    const impactsBox = h('div');
     const select = async (k) => {
       selected = k;
       picker.value = String(k);
@@ -320,6 +332,7 @@ async function bundle(box, id, results) {
         ['gap', withUnit(c.gap, 'm')], ['max force', `${withUnit(c.max_force, 'N')} at ${withUnit(c.max_force_time, 's')}`],
         ['impacts', fmt(c.impacts)], ['time in contact', withUnit(c.contact_time, 's')], ['impulse', withUnit(c.impulse, 'N·s')],
       ], {class: 'kv wide'}));
+      replace(impactsBox, contactImpacts(id, k, c));
       try {
         const [doc, peaks] = await Promise.all([history(id, 'contact_forces', `c${k}`),
           envelope(id, results, 'contact_forces', `c${k}`)]);
@@ -330,8 +343,10 @@ async function bundle(box, id, results) {
         replace(plotBox, errorBox(error));
       }
     };
-    append(box, card('Contact forces', gridBox, h('p', {class: 'inline'}, h('label', {}, 'Contact ', picker)),
-      detail, plotBox));
+    append(box, card('Contact forces', h('p', {class: 'inline'}, h('label', {}, 'Show ', statistics)), gridBox,
+      h('p', {class: 'inline'}, h('label', {}, 'Contact ', picker)), detail, plotBox, impactsBox),
+    impactsCard(results, results.impact_summary,
+      (k) => `c${k}: ${side(contacts[k].left)} – ${side(contacts[k].right)} at ${fmt(contacts[k].height)} m`));
     await select(selected);
   }
   if (pins.length) {
@@ -369,6 +384,7 @@ async function generic(box, id, results) {
     .filter(([, v]) => typeof v !== 'object' || v === null);
   append(box, card('Results', keyValueTable(scalars.map(([p, v]) => [h('code', {}, p.slice(1)), fmt(v)]))));
   for (const name of Object.keys(results.outputs || {})) {
+    if (name === 'impacts') continue;
     const names = await seriesNames(id, name);
     const doc = await history(id, name, names.slice(0, 6).join(','));
     append(box, card(name, linePlot({id: name, title: name, series: seriesOf(doc), xLabel: 'time (s)', yLabel: name,
