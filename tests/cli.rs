@@ -1,5 +1,5 @@
 //! The `chocmodal run` command through the real binary: results on stdout, histories
-//! as CSV with `--out`, invalid inputs as a problem document on stderr with exit 2.
+//! and the per-impact table as CSV with `--out`, invalid inputs as a problem document on stderr with exit 2.
 
 use std::io::Write;
 use std::process::{Command, Stdio};
@@ -36,6 +36,19 @@ fn run_prints_the_results_document_and_writes_csv_histories() {
         assert_eq!(lines.next(), Some("time,numerical,reference"));
         assert_eq!(lines.count(), 50_001, "{name}: one row per step");
     }
+    // The per-impact table in its own columns: one row per impact the results count.
+    let csv = std::fs::read_to_string(out.join("impacts.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some(
+            "contact,start,peak_time,peak_force,impulse,duration,approach_velocity,rebounds,dissipated,energy"
+        )
+    );
+    assert_eq!(
+        lines.count() as u64,
+        document["numerical"]["impacts"].as_u64().unwrap()
+    );
     std::fs::remove_dir_all(&out).ok();
 }
 
