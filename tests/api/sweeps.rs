@@ -732,6 +732,10 @@ async fn a_random_gap_campaign_tabulates_peak_forces_per_contact() {
         "impacts",
         "contacts.0.max_force",
         "contacts.7.max_force",
+        "impact_summary.impacts",
+        "contacts.7.impact_statistics.impacts_per_second",
+        "contacts.7.impact_statistics.max_impact_energy",
+        "contacts.7.impact_statistics.mean_duration",
     ] {
         assert!(columns.contains(&expected), "{expected} missing from {columns:?}");
     }
@@ -747,6 +751,15 @@ async fn a_random_gap_campaign_tabulates_peak_forces_per_contact() {
             peak, largest,
             "the overall peak is the largest contact peak: {row}"
         );
+        let counted: f64 = (0..8)
+            .map(|k| {
+                row[format!("contacts.{k}.impact_statistics.impacts")]
+                    .as_f64()
+                    .unwrap()
+            })
+            .sum();
+        assert_eq!(row["impact_summary.impacts"].as_f64(), Some(counted), "{row}");
+        assert_eq!(row["impacts"].as_f64(), Some(counted), "{row}");
     }
     let statistics = &results["aggregates"]["statistics"][0]["metrics"];
     assert!(
