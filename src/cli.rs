@@ -157,5 +157,41 @@ fn write_histories(dir: &Path, output: &RunOutput) -> Result<(), String> {
         };
         std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
+    if let Some(text) = contacts_csv(&output.document) {
+        let path = dir.join("contacts.csv");
+        std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    }
     Ok(())
+}
+
+/// The results' `contacts`, one row each: `contact` then every scalar of the entry
+/// (its description, its statistics and its impact statistics, dotted), for pandas and
+/// spreadsheets. `None` for a process without a contact list.
+fn contacts_csv(document: &serde_json::Value) -> Option<String> {
+    let contacts = document["contacts"].as_array().filter(|c| !c.is_empty())?;
+    let rows: Vec<Vec<(String, serde_json::Value)>> = contacts
+        .iter()
+        .map(crate::processes::metrics::flatten_scalars)
+        .collect();
+    let header: Vec<&str> = rows[0].iter().map(|(name, _)| name.as_str()).collect();
+    let cell = |value: &serde_json::Value| match value {
+        serde_json::Value::String(text) if text.contains([',', '"']) => {
+            format!("\"{}\"", text.replace('"', "\"\""))
+        }
+        serde_json::Value::String(text) => text.clone(),
+        other => other.to_string(),
+    };
+    let mut out = format!("contact,{}\n", header.join(","));
+    for (k, row) in rows.iter().enumerate() {
+        let cells: Vec<String> = header
+            .iter()
+            .map(|name| {
+                row.iter()
+                    .find(|(n, _)| n == name)
+                    .map_or_else(String::new, |(_, v)| cell(v))
+            })
+            .collect();
+        out.push_str(&format!("{k},{}\n", cells.join(",")));
+    }
+    Some(out)
 }

@@ -53,6 +53,65 @@ fn run_prints_the_results_document_and_writes_csv_histories() {
 }
 
 #[test]
+fn a_bundle_run_writes_its_contact_statistics_as_csv() {
+    let out = std::env::temp_dir().join(format!("chocmodal-cli-contacts-{}", std::process::id()));
+    let mut body: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(format!(
+            "{}/examples/bundle-row17.json",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    body["inputs"]["solver"]["duration"] = serde_json::json!(0.02);
+    let mut child = chocmodal()
+        .args(["run", "bundle-dynamics", "-", "--out"])
+        .arg(&out)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(body.to_string().as_bytes())
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let document: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let csv = std::fs::read_to_string(out.join("contacts.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let contacts = document["contacts"].as_array().unwrap();
+    assert_eq!(rows.len(), contacts.len());
+    let impacts = header
+        .iter()
+        .position(|h| *h == "impact_statistics.impacts")
+        .unwrap();
+    let force = header.iter().position(|h| *h == "max_force").unwrap();
+    for (row, contact) in rows.iter().zip(contacts) {
+        assert_eq!(row[impacts].parse::<u64>().ok(), contact["impacts"].as_u64());
+        // serde_json's default float parsing may be one ulp off.
+        let (written, reported) = (
+            row[force].parse::<f64>().unwrap(),
+            contact["max_force"].as_f64().unwrap(),
+        );
+        assert!(
+            (written - reported).abs() <= 1e-15 * reported.abs(),
+            "{written} vs {reported}"
+        );
+    }
+    std::fs::remove_dir_all(&out).ok();
+}
+
+#[test]
 fn invalid_inputs_give_a_problem_document_and_exit_status_2() {
     let mut child = chocmodal()
         .args(["run", "cantilever-impact", "-"])

@@ -312,3 +312,52 @@ fn excitation_forms_are_exclusive() {
     let pointers: Vec<String> = errors(&orphan).into_iter().map(|(p, _)| p).collect();
     assert_eq!(pointers, ["/inputs/excitation/direction"]);
 }
+
+/// Impacts in the plane: every contact's impacts in the table add up to its impulse
+/// along the normal, and the summary counts them all.
+#[test]
+fn the_impact_table_adds_up_to_every_contacts_impulse() {
+    let output = run(&inputs());
+    let doc = &output.document;
+    let table = output.histories.last().expect("the impacts table");
+    let rows = crate::processes::impact_report::rows_of(table).expect("a table");
+    let contacts = contacts(doc);
+    let mut total = 0;
+    for (k, contact) in contacts.iter().enumerate() {
+        let mine: Vec<_> = rows.iter().filter(|r| r.contact == k).collect();
+        assert_eq!(
+            mine.len() as u64,
+            contact["impacts"].as_u64().unwrap(),
+            "contact {k}"
+        );
+        let impulse: f64 = mine.iter().map(|r| r.impulse).sum();
+        let expected = contact["impulse"].as_f64().unwrap();
+        assert!(
+            (impulse - expected).abs() <= 1e-12 * expected.max(1e-300),
+            "contact {k}"
+        );
+        total += mine.len() as u64;
+    }
+    assert!(total > 0, "the case must exercise contacts");
+    assert_eq!(doc["impact_summary"]["impacts"].as_u64(), Some(total));
+    assert_eq!(doc["impacts"].as_u64(), Some(total));
+}
+
+#[test]
+fn bad_counting_settings_are_refused_at_their_pointers() {
+    let bad = with(
+        inputs(),
+        "/output/impacts",
+        json!({"force_threshold": -1.0, "rest_time": -1.0, "classes": 0}),
+    );
+    let errors = errors(&with(bad, "/output/blocks", json!(101)));
+    let pointers: Vec<&str> = errors.iter().map(|(p, _)| p.as_str()).collect();
+    for pointer in [
+        "/inputs/output/impacts/force_threshold",
+        "/inputs/output/impacts/rest_time",
+        "/inputs/output/impacts/classes",
+        "/inputs/output/blocks",
+    ] {
+        assert!(pointers.contains(&pointer), "{pointer} in {errors:?}");
+    }
+}
