@@ -170,8 +170,8 @@ async fn a_200_000_sample_record_uploads_streams_back_and_drives_a_sweep_over_it
         (true, true),
         "CSV round trip"
     );
-    // Read with Rust's correctly rounded parser (serde_json's default one may be off by
-    // an ulp): the served text must name the stored doubles exactly.
+    // Read with Rust's own correctly rounded parser: the served text must name the
+    // stored doubles exactly.
     let text = app
         .get(&format!("/signals/{id}/samples?format=json"))
         .await
