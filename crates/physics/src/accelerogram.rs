@@ -56,7 +56,7 @@ impl RecordSummary {
         let mut square_integral = 0.0;
         for k in 1..time.len() {
             let h = time[k] - time[k - 1];
-            if !(h > 0.0) {
+            if h.is_nan() || h <= 0.0 {
                 return None;
             }
             shortest = shortest.min(h);
