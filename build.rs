@@ -28,6 +28,8 @@ const VARIABLES: [&str; 5] = [
 
 fn main() {
     println!("cargo::rerun-if-changed=build.rs");
+    // sqlx embeds the migrations at compile time: a new one must rebuild the package.
+    println!("cargo::rerun-if-changed=migrations");
     for variable in VARIABLES {
         println!("cargo::rerun-if-env-changed={variable}");
     }

@@ -12,12 +12,15 @@ use std::io::Read;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use clap::{Parser, Subcommand};
 
 use crate::problem::Problem;
+use crate::processes::signal_input::{SignalLibrary, SignalSource, signal_keys};
 use crate::processes::{Registry, RunError, RunOutput, impact_report};
 use crate::quality_note::QualityNote;
+use crate::signal_record::{self, RecordFormat};
 
 #[derive(Debug, Parser)]
 #[command(
@@ -118,10 +121,13 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
         }
         ControlFlow::Continue(())
     };
-    let output = process.run(&inputs, &mut progress).map_err(|e| match e {
-        RunError::Invalid(invalid) => CliFailure::Problem(Problem::invalid_inputs(&invalid)),
-        other => CliFailure::Failed(other.to_string()),
-    })?;
+    let signals = record_files(&inputs, &body_directory(&args.body));
+    let output = process
+        .run_with(&inputs, &signals, &mut progress)
+        .map_err(|e| match e {
+            RunError::Invalid(invalid) => CliFailure::Problem(Problem::invalid_inputs(&invalid)),
+            other => CliFailure::Failed(other.to_string()),
+        })?;
     if show_progress {
         eprintln!();
     }
@@ -132,6 +138,42 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
         Some(dir) => dir.join(format!("{name}.csv")).display().to_string(),
         None => format!("{name}.csv"),
     }))
+}
+
+/// Where the record files a job names are looked for: the job file's directory (the
+/// working directory for a job read from stdin).
+fn body_directory(source: &str) -> PathBuf {
+    match Path::new(source).parent() {
+        Some(dir) if source != "-" && !dir.as_os_str().is_empty() => dir.to_owned(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// The record files named by the job's signal references (`{"type": "signal", "path":
+/// "record.csv"}`, or a path given as its `id`), read and checked as `POST /signals`
+/// would (CSV `time,acceleration` or JSON); a file that cannot be read or is refused is
+/// reported at its reference's pointer.
+fn record_files(inputs: &serde_json::Value, directory: &Path) -> SignalLibrary {
+    let mut library = SignalLibrary::new(SignalSource::Files);
+    for key in signal_keys(inputs) {
+        let path = directory.join(&key);
+        let read = std::fs::read_to_string(&path)
+            .map_err(|e| format!("cannot read the record file {}: {e}", path.display()))
+            .and_then(|text| {
+                let format = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
+                    RecordFormat::Json
+                } else {
+                    RecordFormat::sniff(&text)
+                };
+                signal_record::parse(&text, format, None, usize::MAX)
+                    .map_err(|e| format!("the record file {}: {e}", path.display()))
+            });
+        match read {
+            Ok(record) => library.insert(key, Arc::new(record)),
+            Err(why) => library.insert_error(key, why),
+        }
+    }
+    library
 }
 
 fn read_body(source: &str) -> Result<String, String> {

@@ -20,6 +20,8 @@ pub mod processes;
 pub mod quality_note;
 /// The HTTP service: OGC API – Processes, SQLite job queue, workers, results store.
 pub mod service;
+/// Accelerograms as clients send them (CSV or JSON) into checked records, and back.
+pub mod signal_record;
 /// Sweeps: expansion of axes into runs, results tables and aggregates (pure).
 pub mod sweep;
 

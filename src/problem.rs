@@ -150,6 +150,47 @@ impl Problem {
         )
     }
 
+    /// 404: the tenant has no signal with this id.
+    pub fn no_such_signal(id: &str) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/no-such-signal"),
+            "No such signal",
+            404,
+            format!("there is no signal `{id}`"),
+        )
+    }
+
+    /// 422: an uploaded record is refused: `errors` at each sample or member at fault
+    /// (`/acceleration/17`; a CSV record's details name the line).
+    pub fn invalid_signal(errors: Vec<FieldError>) -> Self {
+        let detail = match errors.as_slice() {
+            [one] => format!("{}: {}", one.pointer, one.detail),
+            many => format!("{} problems with the record; see `errors`", many.len()),
+        };
+        Self {
+            errors,
+            ..Self::new(
+                format!("{CHOCMODAL_PROBLEMS}/invalid-signal"),
+                "Invalid signal",
+                422,
+                detail,
+            )
+        }
+    }
+
+    /// 409: the signal cannot be deleted while queued or running jobs refer to it.
+    pub fn signal_in_use(id: &str, jobs: i64) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/signal-in-use"),
+            "Signal in use",
+            409,
+            format!(
+                "signal `{id}` is referred to by {jobs} queued or running job(s); delete it once they \
+                 have finished, or dismiss them"
+            ),
+        )
+    }
+
     /// 422: the sweep would expand into more runs than this service accepts at once.
     pub fn sweep_too_large(runs: u128, limit: usize) -> Self {
         Self {

@@ -246,3 +246,84 @@ fn a_poor_result_warns_on_stderr_and_keeps_its_document_on_stdout() {
         "expected the line `{expected}` on stderr, got: {stderr}"
     );
 }
+
+/// Two pins between the walls, tip contacts with 0.1 mm gaps, shaken by
+/// `base_acceleration` for 0.03 s at a fixed 10 µs step.
+fn bundle_body(base_acceleration: serde_json::Value) -> serde_json::Value {
+    let contact = |left: serde_json::Value, right: serde_json::Value| serde_json::json!({"left": left, "right": right, "height": 1.8, "gap": 1e-4, "stiffness": 2e6, "damping": 20.0});
+    serde_json::json!({"inputs": {
+        "pin": {"length": 1.8, "young_modulus": 2.1e11, "density": 7800.0,
+                "section": {"type": "tube", "outer_diameter": 0.0097, "inner_diameter": 0.0085},
+                "added_mass_per_length": 0.6, "elements": 20, "modes": 6, "damping_ratio": 0.01},
+        "pins": 2,
+        "contacts": [contact("wall".into(), 0.into()), contact(0.into(), 1.into()), contact(1.into(), "wall".into())],
+        "excitation": {"base_acceleration": base_acceleration},
+        "solver": {"time_step": 1e-5, "duration": 0.03, "check": "none"},
+        "output": {"interval": 1e-4}
+    }})
+}
+
+/// A job file naming a record file (`path`, or a path as its `id`, relative to the job
+/// file) computes what the same record inline as a `table` does; a record file with a
+/// bad line is refused at the reference's pointer, naming the line.
+#[test]
+fn run_reads_a_record_file_named_by_a_signal_reference() {
+    let dir = tempfile::TempDir::new().unwrap();
+    let time: Vec<f64> = (0..301).map(|k| k as f64 * 1e-4).collect();
+    let acceleration: Vec<f64> = time
+        .iter()
+        .map(|t| 20.0 * (std::f64::consts::TAU * 10.0 * t).sin())
+        .collect();
+    let mut csv = String::from("time,acceleration\n");
+    for (t, a) in time.iter().zip(&acceleration) {
+        csv.push_str(&format!("{t:e},{a:e}\n"));
+    }
+    std::fs::write(dir.path().join("record.csv"), &csv).unwrap();
+    let run_file = |name: &str, body: serde_json::Value| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, body.to_string()).unwrap();
+        chocmodal()
+            .args(["run", "bundle-dynamics"])
+            .arg(&path)
+            .output()
+            .unwrap()
+    };
+    let documents: Vec<serde_json::Value> = [
+        serde_json::json!({"type": "signal", "path": "record.csv"}),
+        serde_json::json!({"type": "signal", "id": "record.csv", "scale": 1.0}),
+        serde_json::json!({"type": "table", "time": time, "acceleration": acceleration}),
+    ]
+    .into_iter()
+    .enumerate()
+    .map(|(k, signal)| {
+        let output = run_file(&format!("job{k}.json"), bundle_body(signal));
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        serde_json::from_slice(&output.stdout).expect("JSON on stdout")
+    })
+    .collect();
+    assert!(
+        documents[2]["impacts"].as_u64().unwrap_or(0) > 0,
+        "{}",
+        documents[2]
+    );
+    assert_eq!(documents[0], documents[2], "path reference vs inline table");
+    assert_eq!(documents[1], documents[2], "path as id vs inline table");
+
+    std::fs::write(dir.path().join("bad.csv"), "time,acceleration\n0,1\n0.1,oops\n").unwrap();
+    let output = run_file(
+        "bad.json",
+        bundle_body(serde_json::json!({"type": "signal", "path": "bad.csv"})),
+    );
+    assert_eq!(output.status.code(), Some(2));
+    let problem: serde_json::Value = serde_json::from_slice(&output.stderr).expect("problem JSON on stderr");
+    assert_eq!(
+        problem["errors"][0]["pointer"],
+        "/inputs/excitation/base_acceleration/path"
+    );
+    let detail = problem["errors"][0]["detail"].as_str().unwrap();
+    assert!(detail.contains("line 3") && detail.contains("oops"), "{detail}");
+}

@@ -81,10 +81,11 @@ fn pointer_of(inputs: &BundleInputs, path: &str, pins_refused: bool) -> Option<S
         ("initial_tip_displacements", None, "") => "/inputs/initial/tip_displacements".to_owned(),
         ("initial_tip_displacements", Some(p), "") => format!("/inputs/initial/tip_displacements/{p}"),
         ("base_acceleration", _, _)
-            if matches!(
-                inputs.excitation.base_acceleration,
-                Some(BaseAccelerationInput::SpectrumCompatible(_))
-            ) =>
+            if inputs
+                .excitation
+                .base_acceleration
+                .as_ref()
+                .is_some_and(BaseAccelerationInput::is_checked_apart) =>
         {
             return None;
         }
@@ -252,6 +253,10 @@ impl Simulation for BundleDynamics {
     type Results = BundleResults;
     type Plan = Plan;
 
+    fn signals(inputs: &mut BundleInputs) -> Vec<super::signal_input::SignalSlot<'_>> {
+        inputs.excitation.signal_references()
+    }
+
     fn prepare(inputs: BundleInputs) -> Result<Plan, InvalidInputs> {
         let length = inputs.pin.length;
         let mut errors: Vec<FieldError> = at("/inputs/pin", inputs.pin.validate());
@@ -314,10 +319,11 @@ impl Simulation for BundleDynamics {
         let interval = inputs.output.interval.unwrap_or(DEFAULT_OUTPUT_INTERVAL);
         let mut settings = solver.integration(Some(interval), heights);
         settings.impacts = impact_report::counting(inputs.output.impacts.as_ref(), inputs.output.blocks);
-        // A synthetic record is checked (and generated) as its inputs; the model then sees
-        // its table, whose problems would only restate these.
-        if let Some(base @ BaseAccelerationInput::SpectrumCompatible(_)) =
-            &inputs.excitation.base_acceleration
+        // A synthetic record is checked (and generated) as its inputs, a stored signal was
+        // checked when uploaded; the model then sees their tables, whose problems would
+        // only restate these.
+        if let Some(base) = &inputs.excitation.base_acceleration
+            && base.is_checked_apart()
         {
             errors.extend(at("/inputs/excitation/base_acceleration", base.validate()));
         }

@@ -289,6 +289,18 @@ pub struct ExcitationInput {
     pub point_forces: Vec<PointForceInput>,
 }
 
+impl ExcitationInput {
+    /// The stored signals referenced, with their pointers.
+    pub fn signal_references(&mut self) -> Vec<super::signal_input::SignalSlot<'_>> {
+        self.base_acceleration
+            .as_mut()
+            .and_then(BaseAccelerationInput::signal_mut)
+            .map(|signal| ("/inputs/excitation/base_acceleration".to_owned(), signal))
+            .into_iter()
+            .collect()
+    }
+}
+
 /// Base acceleration a(t).
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
@@ -320,6 +332,8 @@ pub enum BaseAccelerationInput {
     },
     /// A synthetic earthquake matching a target response spectrum, drawn from a seed.
     SpectrumCompatible(super::synthetic_input::SpectrumCompatibleInput),
+    /// A stored accelerogram (`POST /signals`) by its `id`, times `scale` (default 1).
+    Signal(super::signal_input::SignalInput),
 }
 
 impl BaseAccelerationInput {
@@ -327,14 +341,33 @@ impl BaseAccelerationInput {
     pub fn validate(&self) -> Vec<crate::physics::InputIssue> {
         match self {
             Self::SpectrumCompatible(synthetic) => synthetic.validate(),
+            Self::Signal(signal) => signal.validate(),
             other => other.physics().validate(),
         }
     }
 
-    /// The excitation the integrator sees (a synthetic record as its table).
+    /// Whether this signal is checked as its own inputs ([`Self::validate`]) rather than
+    /// through the table the integrator sees: a synthetic record (generated from them)
+    /// and a stored signal (checked when it was uploaded). Problems the model check
+    /// finds in their tables would only restate those, at members the request lacks.
+    pub fn is_checked_apart(&self) -> bool {
+        matches!(self, Self::SpectrumCompatible(_) | Self::Signal(_))
+    }
+
+    /// The stored signal this refers to, if it is one.
+    pub fn signal_mut(&mut self) -> Option<&mut super::signal_input::SignalInput> {
+        match self {
+            Self::Signal(signal) => Some(signal),
+            _ => None,
+        }
+    }
+
+    /// The excitation the integrator sees (a synthetic record or a stored signal as its
+    /// table).
     pub fn physics(&self) -> BaseAcceleration {
         match self {
             Self::SpectrumCompatible(synthetic) => BaseAcceleration::Table(synthetic.table()),
+            Self::Signal(signal) => BaseAcceleration::Table(signal.table()),
             Self::HalfSine { amplitude, duration } => BaseAcceleration::HalfSine {
                 amplitude: *amplitude,
                 duration: *duration,

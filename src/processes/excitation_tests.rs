@@ -244,3 +244,92 @@ fn the_shock_and_earthquake_examples_are_valid() {
         }
     }
 }
+
+/// A record shared by the stored-signal tests: a 30 m/s² half-sine of 0.2 s sampled
+/// every millisecond.
+fn stored_record() -> (Vec<f64>, Vec<f64>) {
+    let time: Vec<f64> = (0..=200).map(|k| k as f64 * 1e-3).collect();
+    let values = time
+        .iter()
+        .map(|t| 30.0 * (std::f64::consts::PI * t / 0.2).sin())
+        .collect();
+    (time, values)
+}
+
+fn library_with(key: &str, time: &[f64], values: &[f64]) -> super::signal_input::SignalLibrary {
+    use super::signal_input::{SignalLibrary, SignalSource};
+    let mut library = SignalLibrary::new(SignalSource::Stored);
+    library.insert(
+        key,
+        std::sync::Arc::new(crate::physics::loads::Table {
+            time: time.to_vec(),
+            values: values.to_vec(),
+        }),
+    );
+    library
+}
+
+// A stored signal is the table it holds times its scale: the same run as the inline
+// table of −2 × the record, bit for bit. Without the record (an unknown id) it is a 422
+// at the id; a scale that would overflow the record is a 422 at the scale.
+#[test]
+fn a_stored_signal_is_its_table_times_its_scale() {
+    let (time, values) = stored_record();
+    let library = library_with("rec", &time, &values);
+    let by_reference = lone_pin(json!({"type": "signal", "id": "rec", "scale": -2.0}), 0.3);
+    let scaled: Vec<f64> = values.iter().map(|a| -2.0 * a).collect();
+    let inline = lone_pin(
+        json!({"type": "table", "time": time, "acceleration": scaled}),
+        0.3,
+    );
+    BundleDynamics
+        .validate_with(&by_reference, &library)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let stored = BundleDynamics
+        .run_with(&by_reference, &library, &mut |_| ControlFlow::Continue(()))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let pasted = run(&inline);
+    assert!(final_tip_deflection(&pasted).abs() > 0.0);
+    assert_eq!(stored.document, pasted.document);
+    assert_eq!(stored.histories, pasted.histories);
+
+    let unknown = errors(&by_reference);
+    assert_eq!(
+        unknown[0].0, "/inputs/excitation/base_acceleration/id",
+        "{unknown:?}"
+    );
+    let huge = lone_pin(json!({"type": "signal", "id": "rec", "scale": 1e307}), 0.3);
+    let refused = BundleDynamics.validate_with(&huge, &library).unwrap_err().0;
+    assert_eq!(
+        refused[0].pointer, "/inputs/excitation/base_acceleration/scale",
+        "{refused:?}"
+    );
+}
+
+// The hexagonal bundle takes a stored signal as either component of its excitation;
+// an unknown id is refused at that component's pointer.
+#[test]
+fn the_hexagonal_bundle_takes_a_stored_signal_as_a_component() {
+    use super::hex_bundle_dynamics::HexBundleDynamics;
+    let (time, values) = stored_record();
+    let library = library_with("rec", &time, &values);
+    let inputs = json!({
+        "pin": {"length": 0.6, "young_modulus": 2.1e11, "density": 7800.0,
+                "section": {"type": "tube", "outer_diameter": 0.0097, "inner_diameter": 0.0085},
+                "added_mass_per_length": 0.6, "elements": 12, "modes": 4, "static_correction": "none"},
+        "bundle": {"rings": 1, "pitch": 0.0107, "wire_diameter": 0.001, "wire_lead": 0.3,
+                   "wrapper_flat_to_flat": 0.0305},
+        "contact": {"stiffness": 2e6, "damping": 20.0},
+        "gaps": {"type": "uniform", "pin_pin": 5e-5, "pin_wall": 1e-4},
+        "excitation": {"base_acceleration_y": {"type": "signal", "id": "rec"}},
+        "solver": {"duration": 0.01, "check": "none"}
+    });
+    HexBundleDynamics
+        .validate_with(&inputs, &library)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let refused = HexBundleDynamics.validate(&inputs).unwrap_err().0;
+    assert_eq!(
+        refused[0].pointer, "/inputs/excitation/base_acceleration_y/id",
+        "{refused:?}"
+    );
+}

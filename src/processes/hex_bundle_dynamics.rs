@@ -258,6 +258,10 @@ impl Simulation for HexBundleDynamics {
     type Results = HexResults;
     type Plan = Plan;
 
+    fn signals(inputs: &mut HexInputs) -> Vec<super::signal_input::SignalSlot<'_>> {
+        inputs.excitation.signal_references()
+    }
+
     fn prepare(inputs: HexInputs) -> Result<Plan, InvalidInputs> {
         let (length, elements) = (inputs.pin.length, inputs.pin.elements);
         let pin_issues = inputs.pin.validate();

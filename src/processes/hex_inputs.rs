@@ -168,6 +168,23 @@ pub struct HexExcitationInput {
     pub base_acceleration_y: Option<BaseAccelerationInput>,
 }
 
+impl HexExcitationInput {
+    /// The stored signals referenced, with their pointers.
+    pub fn signal_references(&mut self) -> Vec<super::signal_input::SignalSlot<'_>> {
+        [
+            ("base_acceleration", &mut self.base_acceleration),
+            ("base_acceleration_x", &mut self.base_acceleration_x),
+            ("base_acceleration_y", &mut self.base_acceleration_y),
+        ]
+        .into_iter()
+        .filter_map(|(member, signal)| {
+            let signal = signal.as_mut()?.signal_mut()?;
+            Some((format!("/inputs/excitation/{member}"), signal))
+        })
+        .collect()
+    }
+}
+
 /// History sampling and selection.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]

@@ -19,6 +19,8 @@ pub mod metrics;
 pub mod model_check;
 /// The shared parts of results documents (quality, energy) as serialized types.
 pub mod report;
+/// The `signal` base acceleration: a stored accelerogram by id, or a file for the CLI.
+pub mod signal_input;
 /// A process described by its types, and the one adapter to [`Process`].
 pub mod simulation;
 pub mod strict_json;
@@ -183,6 +185,27 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs>;
     /// Runs the computation on inputs that passed [`Process::validate`].
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError>;
+    /// [`Process::validate`], the stored signals the inputs refer to (`{"type":
+    /// "signal", "id"}`) taken from `signals`; an unknown one is an invalid input at its
+    /// pointer. Default: a process that takes no signal ignores them.
+    fn validate_with(
+        &self,
+        inputs: &serde_json::Value,
+        signals: &signal_input::SignalLibrary,
+    ) -> Result<WorkEstimate, InvalidInputs> {
+        let _ = signals;
+        self.validate(inputs)
+    }
+    /// [`Process::run`] with the stored signals of [`Process::validate_with`].
+    fn run_with(
+        &self,
+        inputs: &serde_json::Value,
+        signals: &signal_input::SignalLibrary,
+        progress: &mut ProgressFn<'_>,
+    ) -> Result<RunOutput, RunError> {
+        let _ = signals;
+        self.run(inputs, progress)
+    }
     /// The scalar results of a results document as `(dotted.name, value)` pairs: the
     /// metric columns of a sweep's results table. Default: the numbers and booleans of
     /// nested objects ([`metrics::flatten_scalars`]); a process adds entries

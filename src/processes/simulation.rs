@@ -13,6 +13,7 @@ use serde::de::DeserializeOwned;
 use utoipa::openapi::{RefOr, Schema};
 use utoipa::{PartialSchema, ToSchema};
 
+use super::signal_input::{SignalLibrary, SignalSlot};
 use super::{
     CostLimits, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate, inputs,
 };
@@ -54,6 +55,13 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
     /// Validated inputs, ready to run (the step resolved, the basis built).
     type Plan: Send;
 
+    /// The stored signals the inputs refer to, with the pointers of their objects: the
+    /// adapter attaches their records from a [`SignalLibrary`] before [`Self::prepare`]
+    /// (none by default).
+    fn signals(inputs: &mut Self::Inputs) -> Vec<SignalSlot<'_>> {
+        let _ = inputs;
+        Vec::new()
+    }
     /// Checks the inputs and builds the plan; every problem found, with its pointer
     /// (starting with `/inputs`).
     fn prepare(inputs: Self::Inputs) -> Result<Self::Plan, InvalidInputs>;
@@ -69,9 +77,20 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
     }
 }
 
-/// Parses, prepares and checks against the absolute ceilings.
-fn plan<S: Simulation>(json: &serde_json::Value) -> Result<(S::Plan, WorkEstimate), InvalidInputs> {
-    let inputs: S::Inputs = inputs::parse(json)?;
+/// Parses, attaches the stored signals referenced, prepares and checks against the
+/// absolute ceilings.
+fn plan<S: Simulation>(
+    json: &serde_json::Value,
+    signals: &SignalLibrary,
+) -> Result<(S::Plan, WorkEstimate), InvalidInputs> {
+    let mut inputs: S::Inputs = inputs::parse(json)?;
+    let unresolved: Vec<_> = S::signals(&mut inputs)
+        .into_iter()
+        .filter_map(|(pointer, signal)| signal.resolve(signals, &pointer).err())
+        .collect();
+    if !unresolved.is_empty() {
+        return Err(InvalidInputs(unresolved));
+    }
     let plan = S::prepare(inputs)?;
     let estimate = S::estimate(&plan);
     CostLimits::check_absolute(&estimate).map_err(|refused| InvalidInputs(refused.errors))?;
@@ -114,11 +133,28 @@ impl<S: Simulation> Process for S {
     }
 
     fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs> {
-        plan::<S>(inputs).map(|(_, estimate)| estimate)
+        self.validate_with(inputs, &SignalLibrary::default())
+    }
+
+    fn validate_with(
+        &self,
+        inputs: &serde_json::Value,
+        signals: &SignalLibrary,
+    ) -> Result<WorkEstimate, InvalidInputs> {
+        plan::<S>(inputs, signals).map(|(_, estimate)| estimate)
     }
 
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
-        let (plan, _) = plan::<S>(inputs)?;
+        self.run_with(inputs, &SignalLibrary::default(), progress)
+    }
+
+    fn run_with(
+        &self,
+        inputs: &serde_json::Value,
+        signals: &SignalLibrary,
+        progress: &mut ProgressFn<'_>,
+    ) -> Result<RunOutput, RunError> {
+        let (plan, _) = plan::<S>(inputs, signals)?;
         let output = S::run(plan, progress)?;
         let document = serde_json::to_value(&output.results)
             .map_err(|e| RunError::Failed(format!("results document: {e}")))?;

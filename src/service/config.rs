@@ -75,6 +75,12 @@ pub struct ServeArgs {
     /// Largest accepted request body (bytes).
     #[arg(long, env = "CHOCMODAL_MAX_BODY_BYTES", default_value_t = 1 << 20)]
     pub max_body_bytes: usize,
+    /// Largest body of `POST /signals` (bytes): an accelerogram upload, CSV or JSON.
+    #[arg(long, env = "CHOCMODAL_MAX_SIGNAL_BYTES", default_value_t = DEFAULT_MAX_SIGNAL_BYTES)]
+    pub max_signal_bytes: usize,
+    /// Most samples of one stored signal (accelerogram).
+    #[arg(long, env = "CHOCMODAL_MAX_SIGNAL_SAMPLES", default_value_t = DEFAULT_MAX_SIGNAL_SAMPLES)]
+    pub max_signal_samples: usize,
     /// Most runs one sweep may expand into; larger sweeps are refused (422).
     #[arg(long, env = "CHOCMODAL_MAX_SWEEP_RUNS", default_value_t = DEFAULT_MAX_SWEEP_RUNS)]
     pub max_sweep_runs: usize,
@@ -155,6 +161,10 @@ pub struct ServiceConfig {
     pub retention: Option<Duration>,
     /// Largest accepted request body (bytes).
     pub max_body_bytes: usize,
+    /// Largest body of `POST /signals` (bytes).
+    pub max_signal_bytes: usize,
+    /// Most samples of one stored signal.
+    pub max_signal_samples: usize,
     /// Lease of a running job; heartbeats renew it at a third of this.
     pub lease: Duration,
     /// Claims of one job before a lost worker fails it.
@@ -197,6 +207,11 @@ pub struct ServiceConfig {
 pub const DEFAULT_MAX_SWEEP_RUNS: usize = 10_000;
 /// Default limit of queued jobs per tenant: two sweeps of the largest size.
 pub const DEFAULT_MAX_QUEUED_JOBS: u64 = 2 * DEFAULT_MAX_SWEEP_RUNS as u64;
+/// Default body limit of `POST /signals`: 48 MiB, a million samples of CSV
+/// `time,acceleration` at full precision.
+pub const DEFAULT_MAX_SIGNAL_BYTES: usize = 48 << 20;
+/// Default limit of samples per stored signal: 1.4 hours at 200 samples per second.
+pub const DEFAULT_MAX_SIGNAL_SAMPLES: usize = 1_000_000;
 /// Default cap of rows per history response.
 pub const DEFAULT_MAX_HISTORY_POINTS: usize = 500_000;
 
@@ -222,6 +237,8 @@ impl ServiceConfig {
             workers: default_workers(),
             retention: Some(Duration::from_secs(30 * 86_400)),
             max_body_bytes: 1 << 20,
+            max_signal_bytes: DEFAULT_MAX_SIGNAL_BYTES,
+            max_signal_samples: DEFAULT_MAX_SIGNAL_SAMPLES,
             lease: Duration::from_secs(30),
             max_attempts: 3,
             shutdown_grace: Duration::from_secs(30),
@@ -276,6 +293,8 @@ impl ServiceConfig {
         Ok(Self {
             bind: args.bind,
             max_body_bytes: args.max_body_bytes,
+            max_signal_bytes: args.max_signal_bytes,
+            max_signal_samples: args.max_signal_samples.max(2),
             max_sweep_runs: args.max_sweep_runs,
             auth,
             metrics_public: args.metrics_public,

@@ -15,6 +15,7 @@ pub mod http;
 pub mod metrics;
 pub mod queue;
 mod server;
+pub mod signals;
 pub mod spectrum_table;
 mod startup;
 pub mod store;

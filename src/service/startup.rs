@@ -128,6 +128,9 @@ impl Engine {
             limits: config.limits,
             max_queued_jobs: config.max_queued_jobs,
             max_history_points: config.max_history_points,
+            signals: self.queue.signals(),
+            max_signal_bytes: config.max_signal_bytes,
+            max_signal_samples: config.max_signal_samples,
         }
     }
 

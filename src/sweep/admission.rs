@@ -21,6 +21,7 @@ use super::input_schema;
 use super::spec::{self, SweepError, SweepSpec};
 use super::{InvalidRuns, Run};
 use crate::processes::cost::Excess;
+use crate::processes::signal_input::SignalLibrary;
 use crate::processes::{CostLimits, FieldError, InvalidInputs, Process, Registry, TooCostly};
 
 /// At most this many field errors are reported for the runs of one sweep.
@@ -82,15 +83,21 @@ pub struct RefusedRuns {
     pub errors: Vec<FieldError>,
 }
 
-/// Admits the sweep requested by `body`, or says why not.
-pub fn admit(body: &Value, registry: &Registry, limits: &AdmissionLimits) -> Result<Admitted, Refusal> {
+/// Admits the sweep requested by `body`, or says why not; `signals` holds the stored
+/// signals its runs may refer to.
+pub fn admit(
+    body: &Value,
+    registry: &Registry,
+    limits: &AdmissionLimits,
+    signals: &SignalLibrary,
+) -> Result<Admitted, Refusal> {
     let spec = spec::parse(body, limits.max_runs).map_err(Refusal::Request)?;
     let process = registry
         .get(&spec.process)
         .ok_or_else(|| Refusal::NoSuchProcess(spec.process.clone()))?;
     check_pointers(&spec, process.as_ref())
         .map_err(|errors| Refusal::Request(SweepError::Invalid(errors)))?;
-    let runs = admit_runs(&spec, process.as_ref(), &limits.cost)?;
+    let runs = admit_runs(&spec, process.as_ref(), &limits.cost, signals)?;
     Ok(Admitted { spec, runs })
 }
 
@@ -125,9 +132,10 @@ fn admit_runs(
     spec: &SweepSpec,
     process: &dyn Process,
     limits: &CostLimits,
+    signals: &SignalLibrary,
 ) -> Result<Vec<AdmittedRun>, Refusal> {
     let runs = spec.expand();
-    let problems = validate_in_parallel(&runs, process, limits);
+    let problems = validate_in_parallel(&runs, process, limits, signals);
     let mut invalid: Vec<(usize, InvalidInputs)> = Vec::new();
     let mut costly: Vec<(usize, TooCostly)> = Vec::new();
     for (index, problem) in problems {
@@ -174,6 +182,7 @@ fn validate_in_parallel(
     runs: &[Run],
     process: &dyn Process,
     limits: &CostLimits,
+    signals: &SignalLibrary,
 ) -> Vec<(usize, RunProblem)> {
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
@@ -186,7 +195,7 @@ fn validate_in_parallel(
                 scope.spawn(move || {
                     runs.iter()
                         .filter_map(|run| {
-                            let problem = match process.validate(&run.inputs) {
+                            let problem = match process.validate_with(&run.inputs, signals) {
                                 Err(invalid) => RunProblem::Invalid(invalid),
                                 Ok(estimate) => RunProblem::TooCostly(limits.check(&estimate).err()?),
                             };
@@ -276,7 +285,13 @@ mod tests {
 
     #[test]
     fn every_run_is_admitted_in_order_and_invalid_ones_are_recorded() {
-        let admitted = admit(&calibration(), &Registry::builtin(), &limits()).unwrap();
+        let admitted = admit(
+            &calibration(),
+            &Registry::builtin(),
+            &limits(),
+            &SignalLibrary::default(),
+        )
+        .unwrap();
         assert_eq!(admitted.runs.len(), 32);
         assert_eq!(admitted.runs[5].inputs["solver"]["time_step"], json!(1e-5));
         assert_eq!(admitted.runs[5].inputs["contact"]["rk"], json!(1.0));
@@ -291,7 +306,9 @@ mod tests {
     fn invalid_runs_refuse_the_sweep_unless_recorded_naming_each_run() {
         let mut body = calibration();
         body["invalid_runs"] = json!("refuse");
-        let Err(Refusal::InvalidRuns(refused)) = admit(&body, &Registry::builtin(), &limits()) else {
+        let Err(Refusal::InvalidRuns(refused)) =
+            admit(&body, &Registry::builtin(), &limits(), &SignalLibrary::default())
+        else {
             panic!("the calibration grid has invalid runs");
         };
         assert_eq!(refused.runs, 32);
@@ -317,14 +334,23 @@ mod tests {
             },
             ..limits()
         };
-        let valid = admit(&calibration(), &Registry::builtin(), &super::tests::limits())
-            .unwrap()
-            .runs
-            .iter()
-            .filter(|run| run.invalid.is_none())
-            .count();
-        let Err(Refusal::TooCostly { runs, exceeded }) = admit(&calibration(), &Registry::builtin(), &limits)
-        else {
+        let valid = admit(
+            &calibration(),
+            &Registry::builtin(),
+            &super::tests::limits(),
+            &SignalLibrary::default(),
+        )
+        .unwrap()
+        .runs
+        .iter()
+        .filter(|run| run.invalid.is_none())
+        .count();
+        let Err(Refusal::TooCostly { runs, exceeded }) = admit(
+            &calibration(),
+            &Registry::builtin(),
+            &limits,
+            &SignalLibrary::default(),
+        ) else {
             panic!("every valid run is above a work ceiling of 1 update");
         };
         // Invalid runs have no estimate: the valid ones are refused, even when recorded.
@@ -340,7 +366,7 @@ mod tests {
         body["axes"][1]["pointer"] = json!("/contact/rkk");
         body["axes"][0]["pointer"] = json!("/reference/mode");
         let Err(Refusal::Request(SweepError::Invalid(errors))) =
-            admit(&body, &Registry::builtin(), &limits())
+            admit(&body, &Registry::builtin(), &limits(), &SignalLibrary::default())
         else {
             panic!("both pointers name no input");
         };
@@ -383,12 +409,12 @@ mod tests {
         let mut body = calibration();
         body["process"] = json!("no-such");
         assert_eq!(
-            admit(&body, &Registry::builtin(), &limits()).unwrap_err(),
+            admit(&body, &Registry::builtin(), &limits(), &SignalLibrary::default()).unwrap_err(),
             Refusal::NoSuchProcess("no-such".into())
         );
         body["samples"] = json!(3);
         assert!(matches!(
-            admit(&body, &Registry::builtin(), &limits()),
+            admit(&body, &Registry::builtin(), &limits(), &SignalLibrary::default()),
             Err(Refusal::Request(SweepError::Invalid(_)))
         ));
         let small = AdmissionLimits {
@@ -396,7 +422,13 @@ mod tests {
             ..limits()
         };
         assert_eq!(
-            admit(&calibration(), &Registry::builtin(), &small).unwrap_err(),
+            admit(
+                &calibration(),
+                &Registry::builtin(),
+                &small,
+                &SignalLibrary::default()
+            )
+            .unwrap_err(),
             Refusal::Request(SweepError::TooLarge { runs: 32, limit: 10 })
         );
     }

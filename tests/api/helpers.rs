@@ -142,6 +142,16 @@ pub async fn spawn_app_with_shipped_processes_on(backend: Backend) -> TestApp {
     .await
 }
 
+/// Starts a service on a fresh database of `backend` that also offers the `extra`
+/// processes, with `configure`'s settings.
+pub async fn spawn_app_with_processes_on(
+    backend: Backend,
+    extra: Vec<Arc<dyn Process>>,
+    configure: impl FnOnce(&mut ServiceConfig),
+) -> TestApp {
+    spawn_app_serving(TestStore::new(backend).await, extra, configure).await
+}
+
 async fn spawn_app_serving(
     store: TestStore,
     extra: Vec<Arc<dyn Process>>,

@@ -27,6 +27,7 @@ mod responsiveness;
 mod results;
 mod robustness;
 mod scale_out;
+mod signals;
 mod spectra;
 mod sweeps;
 mod tenants;

@@ -6,6 +6,8 @@
 //! being checked (`section/outer_diameter`); callers prefix it with where that struct
 //! sits in their own input document (`/inputs/beam/`).
 
+/// Summary figures of an accelerogram: sampling, PGA, Arias intensity.
+pub mod accelerogram;
 pub mod beam;
 pub mod bundle;
 pub mod contact;

@@ -49,6 +49,12 @@ fn landing_links() -> Vec<Link> {
         .titled("Jobs"),
         Link::new("/sweeps", "https://chocmodal.dev/rel/sweeps", "application/json")
             .titled("Sweeps: many runs of a process with aggregated results"),
+        Link::new(
+            "/signals",
+            "https://chocmodal.dev/rel/signals",
+            "application/json",
+        )
+        .titled("Signals: accelerograms stored once, referenced by jobs and sweeps"),
         Link::new("/healthz", "status", "application/json").titled("Liveness"),
         Link::new("/metrics", "monitor", "text/plain").titled("Prometheus metrics"),
     ]

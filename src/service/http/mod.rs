@@ -18,6 +18,8 @@ pub mod models;
 pub mod openapi;
 pub mod processes;
 pub mod results;
+pub mod signal_models;
+pub mod signals;
 pub mod spectra;
 pub mod sweep_models;
 pub mod sweeps;
@@ -27,6 +29,7 @@ use std::time::{Duration, Instant};
 
 use axum::Router;
 use axum::extract::{DefaultBodyLimit, MatchedPath, Request, State};
+use axum::handler::Handler;
 use axum::http::{StatusCode, Uri, header};
 use axum::middleware::{self, Next};
 use axum::response::{IntoResponse, Response};
@@ -40,6 +43,7 @@ use tracing::Level;
 use super::auth::TokenTable;
 use super::metrics::Metrics;
 use super::queue::JobQueue;
+use super::signals::SignalStore;
 use super::worker::RunningJobs;
 use crate::problem::Problem;
 use crate::processes::{CostLimits, Registry};
@@ -64,6 +68,12 @@ pub struct AppState {
     pub max_queued_jobs: Option<u64>,
     /// Most rows of one history response.
     pub max_history_points: usize,
+    /// Stored signals (accelerograms) of every tenant.
+    pub signals: SignalStore,
+    /// Largest body of `POST /signals` (bytes; the general limit does not apply there).
+    pub max_signal_bytes: usize,
+    /// Most samples of one stored signal.
+    pub max_signal_samples: usize,
 }
 
 /// Settings of the layers around the routes.
@@ -104,6 +114,18 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/jobs/{jobId}/results/{output}", get(results::output))
         .route("/jobs/{jobId}/results/{output}/spectrum", get(spectra::spectrum))
         .route("/sweeps", get(sweeps::list).post(sweeps::create))
+        // A record is far larger than an execution request: this route has its own
+        // body limit (the innermost limit is the one that applies).
+        .route(
+            "/signals",
+            get(signals::list).post(signals::create.layer(DefaultBodyLimit::max(state.max_signal_bytes))),
+        )
+        .route(
+            "/signals/{signalId}",
+            get(signals::metadata).delete(signals::delete),
+        )
+        .route("/signals/{signalId}/samples", get(signals::samples))
+        .route("/signals/{signalId}/spectrum", get(signals::spectrum))
         .route("/sweeps/{sweepId}", get(sweeps::status).delete(sweeps::dismiss))
         .route("/sweeps/{sweepId}/results", get(sweeps::results))
         .merge(dashboard::routes())

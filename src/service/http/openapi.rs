@@ -17,7 +17,10 @@ use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityRequirement
 use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
 use utoipa::{Modify, OpenApi};
 
-use super::{impacts, job_inputs, jobs, landing, models, processes, results, spectra, sweep_models, sweeps};
+use super::{
+    impacts, job_inputs, jobs, landing, models, processes, results, signal_models, signals, spectra, sweep_models,
+    sweeps,
+};
 use crate::processes::Registry;
 use crate::service::queue::JobStatus;
 
@@ -53,6 +56,23 @@ pub struct ProblemSchema {
     /// A run above the cost ceilings (422 `too-costly`): each ceiling exceeded.
     #[schema(required = false)]
     exceeded: Vec<ExcessSchema>,
+}
+
+/// A signal (accelerogram) as JSON: `time` with `acceleration`, or `sampling_rate` with
+/// `acceleration` (the samples of `GET /signals/{id}/samples` come as `time` and
+/// `acceleration`).
+#[derive(Debug, utoipa::ToSchema)]
+#[schema(as = SignalUpload)]
+#[allow(dead_code)]
+pub struct SignalUploadSchema {
+    /// Sample times (s), non-negative and strictly increasing.
+    #[schema(required = false)]
+    time: Vec<f64>,
+    /// Samples per second (Hz, positive), instead of `time`: times k / sampling_rate.
+    #[schema(required = false)]
+    sampling_rate: f64,
+    /// Accelerations (m/s²), finite, one per time.
+    acceleration: Vec<f64>,
 }
 
 /// A cost ceiling a run exceeds.
@@ -137,6 +157,10 @@ const LINKS: &[(&str, &str, &str, &str, &str, &str, &str)] = &[
     ("/sweeps", "post", "201", "results", "getSweepResults", "sweepId", "$response.body#/sweepID"),
     ("/sweeps", "post", "201", "dismiss", "dismissSweep", "sweepId", "$response.body#/sweepID"),
     ("/sweeps", "post", "201", "runs", "getJobs", "sweepID", "$response.body#/sweepID"),
+    ("/signals", "post", "201", "metadata", "getSignal", "signalId", "$response.body#/id"),
+    ("/signals", "post", "201", "samples", "getSignalSamples", "signalId", "$response.body#/id"),
+    ("/signals", "post", "201", "spectrum", "getSignalSpectrum", "signalId", "$response.body#/id"),
+    ("/signals", "post", "201", "delete", "deleteSignal", "signalId", "$response.body#/id"),
 ];
 
 impl Modify for ResourceLinks {
@@ -199,6 +223,12 @@ impl Modify for ResourceLinks {
         sweeps::status,
         sweeps::dismiss,
         sweeps::results,
+        signals::create,
+        signals::list,
+        signals::metadata,
+        signals::delete,
+        signals::samples,
+        signals::spectrum,
     ),
     components(schemas(
         ProblemSchema,
@@ -230,6 +260,11 @@ impl Modify for ResourceLinks {
         crate::sweep::SweepAxis,
         crate::sweep::SweepRequest,
         sweep_models::SweepResults,
+        SignalUploadSchema,
+        signal_models::SignalMetadata,
+        signal_models::SignalList,
+        signal_models::SignalSpectrum,
+        signal_models::DampedSpectrum,
         // The `inputs` of each shipped process (also served by `/processes/{id}`).
     )),
     tags(
@@ -238,6 +273,7 @@ impl Modify for ResourceLinks {
         (name = "Jobs", description = "Queued, running and finished jobs"),
         (name = "Results", description = "Results documents and time histories"),
         (name = "Sweeps", description = "Many runs of a process over axes of its inputs, as one resource with aggregated results"),
+        (name = "Signals", description = "Accelerograms stored once and referenced by jobs and sweeps (`{\"type\": \"signal\", \"id\"}`), with their response spectra"),
         (name = "Operations", description = "Health and metrics"),
     )
 )]

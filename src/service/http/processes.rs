@@ -103,11 +103,14 @@ pub async fn execute(
         .get(&process_id)
         .ok_or_else(|| Problem::no_such_process(&process_id))?;
     let ExecutionInputs(inputs) = body?;
+    // The stored signals the inputs refer to, the tenant's only: resolved now, so that an
+    // unknown or foreign id is refused at its pointer before anything is queued.
+    let signals = state.signals.library(tenant.as_str(), &inputs).await?;
     let inputs = Arc::new(inputs);
     // Validation may expand generators and check large inputs: keep it off the runtime.
     let validated = {
         let inputs = inputs.clone();
-        tokio::task::spawn_blocking(move || process.validate(&inputs))
+        tokio::task::spawn_blocking(move || process.validate_with(&inputs, &signals))
             .await
             .map_err(|e| ApiError::Internal(format!("validation panicked: {e}")))?
     };

@@ -53,6 +53,8 @@ pub async fn create(
     body: Result<JsonBody, ApiError>,
 ) -> Result<Response, ApiError> {
     let JsonBody(body) = body?;
+    // The tenant's stored signals the base inputs or an axis refer to.
+    let signals = state.signals.library(tenant.as_str(), &body).await?;
     let registry = state.registry.clone();
     let limits = AdmissionLimits {
         max_runs: state.max_sweep_runs,
@@ -60,7 +62,7 @@ pub async fn create(
     };
     // Expanding and validating thousands of runs is CPU work: off the runtime.
     let Admitted { spec, runs } =
-        tokio::task::spawn_blocking(move || admission::admit(&body, &registry, &limits))
+        tokio::task::spawn_blocking(move || admission::admit(&body, &registry, &limits, &signals))
             .await
             .map_err(|e| ApiError::Internal(format!("sweep admission panicked: {e}")))?
             .map_err(refusal)?;

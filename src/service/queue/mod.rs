@@ -200,6 +200,11 @@ impl JobQueue {
         &self.clock
     }
 
+    /// The stored signals of the same database, stamped by the same clock.
+    pub fn signals(&self) -> super::signals::SignalStore {
+        super::signals::SignalStore::new(self.db.clone(), self.clock.clone())
+    }
+
     fn now(&self) -> i64 {
         self.clock.now_ms()
     }

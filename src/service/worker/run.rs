@@ -17,6 +17,7 @@ use super::WorkerContext;
 use crate::problem::{CHOCMODAL_PROBLEMS, Problem};
 use crate::processes::{RunError, RunOutput};
 use crate::service::queue::{ClaimedJob, Lease};
+use crate::service::signals::SignalReadError;
 use crate::service::store;
 
 /// How often a running job checks, by a read, that its row still says it is ours (so a
@@ -52,6 +53,22 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
             }
         }
     }
+    // The stored signals the job refers to (the job keeps references, not samples:
+    // `processes::signal_input`). A signal missing now is reported by the run, at its
+    // pointer, as invalid inputs.
+    let signals = match ctx.queue.signals().library(&job.tenant, &job.inputs).await {
+        Ok(library) => library,
+        Err(SignalReadError::Database(error)) => {
+            tracing::warn!(job = %lease.job_id, %error, "cannot load the job's signals; handing it back");
+            record(&lease, "hand back", ctx.queue.hand_back(&lease).await);
+            return;
+        }
+        Err(error) => {
+            tracing::error!(job = %lease.job_id, %error, "a signal of the job cannot be read");
+            record(&lease, "fail", ctx.queue.fail(&lease, &crashed_problem()).await);
+            return;
+        }
+    };
     tracing::info!(job = %lease.job_id, process = %process_id, attempt = lease.attempt, "job started");
     let control = ctx.running.insert(&lease.job_id);
 
@@ -69,8 +86,10 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
                     ControlFlow::Continue(())
                 }
             };
-            let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| process.run(&inputs, &mut progress)))
-                .map_err(|payload| panic_message(payload.as_ref()));
+            let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| {
+                process.run_with(&inputs, &signals, &mut progress)
+            }))
+            .map_err(|payload| panic_message(payload.as_ref()));
             let _ = sender.send(outcome);
         });
     if let Err(error) = spawned {

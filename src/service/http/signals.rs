@@ -1,0 +1,558 @@
+//! `/signals`: accelerograms uploaded once (CSV or JSON), their metadata, the tenant's
+//! list, deletion, the samples streamed back, and their response spectra.
+//!
+//! An upload may be far larger than an execution request (a 200 000-sample record is
+//! about 9 MB of CSV): `POST /signals` has its own body limit (`--max-signal-bytes`) and
+//! sample limit (`--max-signal-samples`), both stated in the 413 that refuses more.
+
+use std::sync::Arc;
+
+use axum::Json;
+use axum::body::{Body, Bytes};
+use axum::extract::rejection::BytesRejection;
+use axum::extract::{Extension, Path, Query, State};
+use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+
+use super::AppState;
+use super::error::ApiError;
+use super::extract::ApiQuery;
+use super::history_view::Format;
+use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
+use super::models::Link;
+use super::signal_models::{DampedSpectrum, SignalList, SignalMetadata, SignalSpectrum};
+use crate::physics::response_spectrum::{self, log_spaced};
+use crate::problem::Problem;
+use crate::processes::columns_csv;
+use crate::service::auth::Tenant;
+use crate::service::signals::SignalReadError;
+use crate::service::signals::create::CreateError;
+use crate::service::signals::delete::Deletion;
+use crate::signal_record::{self, RecordError, RecordFormat};
+
+/// Rows per chunk of a streamed record.
+const STREAM_ROWS: usize = 4096;
+
+/// Query of `POST /signals`.
+#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct UploadQuery {
+    /// Samples per second (Hz, positive) of a CSV record of accelerations alone (one
+    /// column); times are then k / sampling_rate from 0.
+    pub sampling_rate: Option<f64>,
+}
+
+impl From<SignalReadError> for ApiError {
+    fn from(error: SignalReadError) -> Self {
+        match error {
+            SignalReadError::Database(error) => ApiError::Database(error),
+            corrupt => ApiError::Internal(corrupt.to_string()),
+        }
+    }
+}
+
+/// The format of an upload from its `Content-Type` (sniffed from the text without one).
+fn upload_format(headers: &HeaderMap, text: &str) -> Result<RecordFormat, ApiError> {
+    let Some(content_type) = headers.get(header::CONTENT_TYPE) else {
+        return Ok(RecordFormat::sniff(text));
+    };
+    let content_type = content_type.to_str().unwrap_or_default().to_ascii_lowercase();
+    let essence = content_type.split(';').next().unwrap_or_default().trim();
+    match essence {
+        "text/csv" | "application/csv" | "text/plain" => Ok(RecordFormat::Csv),
+        "application/json" => Ok(RecordFormat::Json),
+        json if json.ends_with("+json") => Ok(RecordFormat::Json),
+        other => Err(Problem::unsupported_media_type(format!(
+            "a signal is `text/csv` or `application/json`, not `{other}`"
+        ))
+        .into()),
+    }
+}
+
+/// Upload a signal
+///
+/// An accelerogram (m/s²) as CSV, `time,acceleration` (s, m/s²; header optional), or the
+/// acceleration alone with `?sampling_rate=`; or as JSON, `{"time": [...],
+/// "acceleration": [...]}` or `{"sampling_rate": 200, "acceleration": [...]}`. Times
+/// non-negative and strictly increasing, every value finite, at least 2 samples. Stored
+/// once: `201 Created`, `Location: /signals/{id}` and its metadata; jobs refer to it as
+/// `{"type": "signal", "id": "<id>", "scale": 1.0}`. A bad record is a 422
+/// `invalid-signal` with an error per sample at fault (`/acceleration/17`, the detail
+/// naming the CSV line); a body or record over this route's limits is a 413 stating them.
+#[utoipa::path(post, path = "/signals", operation_id = "createSignal", tag = "Signals",
+    params(UploadQuery),
+    request_body(description = "CSV `time,acceleration` (or one column with `sampling_rate`), or JSON `{\"time\", \"acceleration\"}` / `{\"sampling_rate\", \"acceleration\"}`",
+        content((String = "text/csv"), (super::openapi::SignalUploadSchema = "application/json"))),
+    responses(
+        (status = 201, description = "Signal stored", body = SignalMetadata,
+            headers(("Location" = String, description = "`/signals/{id}`"))),
+        (status = 400, description = "Malformed JSON or bad query parameter", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 413, description = "Body or record over this route's limits (stated in the detail)", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 415, description = "Neither CSV nor JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 422, description = "Invalid record (`invalid-signal`): non-numeric or non-finite samples, times not increasing, a sampling rate not positive",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
+pub async fn create(
+    State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
+    ApiQuery(query): ApiQuery<UploadQuery>,
+    headers: HeaderMap,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Response, ApiError> {
+    if let Some(rate) = query.sampling_rate
+        && !(rate.is_finite() && rate > 0.0)
+    {
+        return Err(Problem::invalid_query(format!(
+            "`sampling_rate` must be a positive number of samples per second (got {rate})"
+        ))
+        .into());
+    }
+    let bytes = body.map_err(|rejection| -> ApiError {
+        if rejection.status() == StatusCode::PAYLOAD_TOO_LARGE {
+            Problem::payload_too_large(format!(
+                "the record is larger than this service accepts for a signal: {} bytes \
+                 (`--max-signal-bytes`)",
+                state.max_signal_bytes
+            ))
+            .into()
+        } else {
+            Problem::malformed_body(format!("cannot read the request body: {rejection}")).into()
+        }
+    })?;
+    let text = String::from_utf8(bytes.to_vec())
+        .map_err(|_| Problem::malformed_body("the body is not valid UTF-8"))?;
+    let format = upload_format(&headers, &text)?;
+    if format == RecordFormat::Json && query.sampling_rate.is_some() {
+        return Err(Problem::invalid_query(
+            "`sampling_rate` in the query goes with a CSV record; a JSON record gives it as its \
+             `sampling_rate` member",
+        )
+        .into());
+    }
+    let max_samples = state.max_signal_samples;
+    let parsed = tokio::task::spawn_blocking(move || {
+        signal_record::parse(&text, format, query.sampling_rate, max_samples)
+    })
+    .await
+    .map_err(|e| ApiError::Internal(format!("parsing a signal panicked: {e}")))?;
+    let record = parsed.map_err(|error| -> ApiError {
+        match error {
+            RecordError::Malformed(detail) => Problem::malformed_body(detail).into(),
+            RecordError::Invalid(errors) => Problem::invalid_signal(errors).into(),
+            RecordError::TooLarge { samples, limit } => Problem::payload_too_large(format!(
+                "the record has {samples} samples; this service stores at most {limit} per signal \
+                 (`--max-signal-samples`)"
+            ))
+            .into(),
+        }
+    })?;
+    let stored = state
+        .signals
+        .create(tenant.as_str(), &record)
+        .await
+        .map_err(|error| match error {
+            CreateError::Database(error) => ApiError::Database(error),
+            unchecked => ApiError::Internal(unchecked.to_string()),
+        })?;
+    tracing::info!(signal = %stored.id, samples = stored.samples, %tenant, "signal stored");
+    let mut headers = HeaderMap::new();
+    headers.insert(
+        header::LOCATION,
+        HeaderValue::from_str(&format!("/signals/{}", stored.id)).expect("uuid is a valid header value"),
+    );
+    Ok((
+        StatusCode::CREATED,
+        headers,
+        Json(SignalMetadata::from_record(&stored)),
+    )
+        .into_response())
+}
+
+/// A signal's metadata
+///
+/// Samples, duration, sampling, PGA, Arias intensity, upload time, and links to its
+/// samples and response spectrum.
+#[utoipa::path(get, path = "/signals/{signalId}", operation_id = "getSignal", tag = "Signals",
+    params(("signalId" = String, Path, description = "Signal id")),
+    responses(
+        (status = 200, description = "The signal's metadata", body = SignalMetadata),
+        (status = 404, description = "No such signal (`no-such-signal`)", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json")))]
+pub async fn metadata(
+    State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
+    Path(signal_id): Path<String>,
+) -> Result<Json<SignalMetadata>, ApiError> {
+    let record = state
+        .signals
+        .get(tenant.as_str(), &signal_id)
+        .await?
+        .ok_or_else(|| Problem::no_such_signal(&signal_id))?;
+    Ok(Json(SignalMetadata::from_record(&record)))
+}
+
+/// Query of `GET /signals`.
+#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct ListQuery {
+    /// Signals per page, 1 to 1000 (default 10).
+    #[param(minimum = 1, maximum = 1000)]
+    pub limit: Option<u32>,
+    /// Opaque position from a `next` link.
+    pub cursor: Option<i64>,
+    /// OGC format parameter (accepted, ignored).
+    pub f: Option<String>,
+}
+
+/// List signals
+///
+/// The tenant's signals, newest first; `limit` per page, the `next` link gives the
+/// following page.
+#[utoipa::path(get, path = "/signals", operation_id = "getSignals", tag = "Signals",
+    params(ListQuery),
+    responses(
+        (status = 200, description = "A page of signals", body = SignalList),
+        (status = 400, description = "Invalid query parameter", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json")))]
+pub async fn list(
+    State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
+    ApiQuery(query): ApiQuery<ListQuery>,
+) -> Result<Json<SignalList>, ApiError> {
+    let limit = query.limit.unwrap_or(DEFAULT_LIMIT);
+    if !(1..=MAX_LIMIT).contains(&limit) {
+        return Err(
+            Problem::invalid_query(format!("`limit` must be an integer from 1 to {MAX_LIMIT}")).into(),
+        );
+    }
+    let mut signals = state
+        .signals
+        .list(tenant.as_str(), limit + 1, query.cursor)
+        .await?;
+    let more = signals.len() > limit as usize;
+    signals.truncate(limit as usize);
+    let href = |cursor: Option<i64>| match cursor {
+        Some(cursor) => format!("/signals?limit={limit}&cursor={cursor}"),
+        None => format!("/signals?limit={limit}"),
+    };
+    let mut links = vec![Link::new(href(query.cursor), "self", "application/json")];
+    if let (true, Some(last)) = (more, signals.last()) {
+        links.push(Link::new(href(Some(last.seq)), "next", "application/json"));
+    }
+    Ok(Json(SignalList {
+        signals: signals.iter().map(SignalMetadata::from_record).collect(),
+        links,
+    }))
+}
+
+/// Delete a signal
+///
+/// The signal and its samples are gone; finished jobs keep their results. Refused (409
+/// `signal-in-use`) while a queued or running job refers to it, so that every job finds
+/// its record when it runs.
+#[utoipa::path(delete, path = "/signals/{signalId}", operation_id = "deleteSignal", tag = "Signals",
+    params(("signalId" = String, Path, description = "Signal id")),
+    responses(
+        (status = 204, description = "Deleted"),
+        (status = 404, description = "No such signal (`no-such-signal`)", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json"),
+        (status = 409, description = "Queued or running jobs refer to it (`signal-in-use`)", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json")))]
+pub async fn delete(
+    State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
+    Path(signal_id): Path<String>,
+) -> Result<Response, ApiError> {
+    match state.signals.delete(tenant.as_str(), &signal_id).await? {
+        Deletion::Deleted => {
+            tracing::info!(signal = %signal_id, %tenant, "signal deleted");
+            Ok(StatusCode::NO_CONTENT.into_response())
+        }
+        Deletion::NotFound => Err(Problem::no_such_signal(&signal_id).into()),
+        Deletion::InUse { jobs } => Err(Problem::signal_in_use(&signal_id, jobs).into()),
+    }
+}
+
+/// Query of `GET /signals/{signalId}/samples`.
+#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct SamplesQuery {
+    /// `csv` (`time,acceleration`) or `json` (`{"time", "acceleration"}`); default from
+    /// `Accept` (CSV when it prefers `text/csv`), else JSON.
+    pub format: Option<String>,
+}
+
+/// A signal's samples
+///
+/// The whole record, streamed, as it was stored (bit for bit: each number the shortest
+/// text that reads back as the same double): CSV `time,acceleration` or JSON `{"time":
+/// [...], "acceleration": [...]}`, the upload formats.
+#[utoipa::path(get, path = "/signals/{signalId}/samples", operation_id = "getSignalSamples", tag = "Signals",
+    params(("signalId" = String, Path, description = "Signal id"), SamplesQuery),
+    responses(
+        (status = 200, description = "The samples", content((String = "text/csv"), (super::openapi::SignalUploadSchema = "application/json"))),
+        (status = 400, description = "Invalid query parameter", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json"),
+        (status = 404, description = "No such signal (`no-such-signal`)", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json")))]
+pub async fn samples(
+    State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
+    Path(signal_id): Path<String>,
+    ApiQuery(query): ApiQuery<SamplesQuery>,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
+    let record = state
+        .signals
+        .record(tenant.as_str(), &signal_id)
+        .await?
+        .ok_or_else(|| Problem::no_such_signal(&signal_id))?;
+    let record = Arc::new(record);
+    let chunks: Box<dyn Iterator<Item = String> + Send> = match format {
+        Format::Csv => Box::new(signal_record::csv_chunks(record, STREAM_ROWS)),
+        Format::Json => Box::new(signal_record::json_chunks(record, STREAM_ROWS)),
+    };
+    let stream =
+        futures_util::stream::iter(chunks.map(|chunk| Ok::<_, std::convert::Infallible>(Bytes::from(chunk))));
+    Ok((
+        [(
+            header::CONTENT_TYPE,
+            HeaderValue::from_static(format.content_type()),
+        )],
+        Body::from_stream(stream),
+    )
+        .into_response())
+}
+
+/// Default frequency grid of a spectrum (Hz, points).
+pub const DEFAULT_F_MIN: f64 = 0.1;
+pub const DEFAULT_F_MAX: f64 = 100.0;
+pub const DEFAULT_POINTS: usize = 200;
+/// Most frequencies and damping ratios of one spectrum request.
+pub const MAX_POINTS: usize = 2000;
+pub const MAX_DAMPINGS: usize = 10;
+/// Most oscillator sub-steps one spectrum request may take (about 10 s of computing):
+/// each frequency f steps through every sample interval, in sub-steps of at most 1/64
+/// of its period.
+pub const MAX_SPECTRUM_STEPS: f64 = 2e9;
+
+/// What `GET /signals/{id}/spectrum` asks for.
+#[derive(Debug, Clone, PartialEq)]
+struct SpectrumRequest {
+    dampings: Vec<f64>,
+    f_min: f64,
+    f_max: f64,
+    points: usize,
+    format: Option<String>,
+}
+
+/// Parses `damping` (repeatable or comma-separated; default 0.05), `f_min`, `f_max`,
+/// `points`, `format`; anything else is refused.
+fn parse_spectrum_query(pairs: &[(String, String)]) -> Result<SpectrumRequest, Problem> {
+    let number = |name: &str, text: &str| -> Result<f64, Problem> {
+        text.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| Problem::invalid_query(format!("`{name}`: `{text}` is not a finite number")))
+    };
+    let mut request = SpectrumRequest {
+        dampings: Vec::new(),
+        f_min: DEFAULT_F_MIN,
+        f_max: DEFAULT_F_MAX,
+        points: DEFAULT_POINTS,
+        format: None,
+    };
+    for (key, value) in pairs {
+        match key.as_str() {
+            "damping" => {
+                for text in value.split(',').filter(|s| !s.trim().is_empty()) {
+                    let xi = number("damping", text)?;
+                    if !(0.0..1.0).contains(&xi) {
+                        return Err(Problem::invalid_query(format!(
+                            "`damping`: {xi} is not a damping ratio in [0, 1)"
+                        )));
+                    }
+                    request.dampings.push(xi);
+                }
+            }
+            "f_min" => request.f_min = number("f_min", value)?,
+            "f_max" => request.f_max = number("f_max", value)?,
+            "points" => {
+                request.points = value
+                    .parse()
+                    .ok()
+                    .filter(|n| (2..=MAX_POINTS).contains(n))
+                    .ok_or_else(|| {
+                        Problem::invalid_query(format!("`points` must be an integer from 2 to {MAX_POINTS}"))
+                    })?;
+            }
+            "format" => request.format = Some(value.clone()),
+            other => {
+                return Err(Problem::invalid_query(format!(
+                    "unknown query parameter `{other}` (expected damping, f_min, f_max, points, format)"
+                )));
+            }
+        }
+    }
+    if request.dampings.is_empty() {
+        request.dampings.push(0.05);
+    }
+    if request.dampings.len() > MAX_DAMPINGS {
+        return Err(Problem::invalid_query(format!(
+            "`damping`: at most {MAX_DAMPINGS} damping ratios per request"
+        )));
+    }
+    if !(request.f_min > 0.0 && request.f_max > request.f_min) {
+        return Err(Problem::invalid_query(format!(
+            "the frequency grid needs 0 < f_min < f_max (got f_min {} Hz, f_max {} Hz)",
+            request.f_min, request.f_max
+        )));
+    }
+    Ok(request)
+}
+
+/// A signal's response spectrum
+///
+/// The pseudo-acceleration response spectrum PSA(f, ξ) = ω² max|u| of the record (m/s²),
+/// u the relative displacement of an oscillator ü + 2ξωu̇ + ω²u = −a(t) at rest at the
+/// first sample, the maximum taken over the record and one damped period after it (the
+/// shock response spectrum of a pulse). Exact stepping between samples
+/// (`physics::response_spectrum`, docs/signals.md). Frequencies: `points` log-spaced from
+/// `f_min` to `f_max` (Hz; default 200 from 0.1 to 100). `damping`: ratios, repeatable
+/// or comma-separated (default 0.05). `format=csv` (or `Accept: text/csv`):
+/// `frequency,psa_<damping>...`.
+#[utoipa::path(get, path = "/signals/{signalId}/spectrum", operation_id = "getSignalSpectrum", tag = "Signals",
+    params(
+        ("signalId" = String, Path, description = "Signal id"),
+        ("damping" = Option<String>, Query, description = "Damping ratios in [0, 1), repeatable or comma-separated (default 0.05)"),
+        ("f_min" = Option<f64>, Query, description = "Lowest frequency (Hz, default 0.1)"),
+        ("f_max" = Option<f64>, Query, description = "Highest frequency (Hz, default 100)"),
+        ("points" = Option<usize>, Query, description = "Number of log-spaced frequencies, 2 to 2000 (default 200)"),
+        ("format" = Option<String>, Query, description = "`csv` or `json` (default from `Accept`, else JSON)"),
+    ),
+    responses(
+        (status = 200, description = "The spectrum", body = SignalSpectrum, content_type = "application/json"),
+        (status = 400, description = "Invalid query parameter, or a grid too costly for this record", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json"),
+        (status = 404, description = "No such signal (`no-such-signal`)", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json")))]
+pub async fn spectrum(
+    State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
+    Path(signal_id): Path<String>,
+    query: Result<Query<Vec<(String, String)>>, axum::extract::rejection::QueryRejection>,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
+    let request = parse_spectrum_query(&pairs)?;
+    let format = Format::from_query(request.format.as_deref(), Format::preferred(&headers))?;
+    let metadata = state
+        .signals
+        .get(tenant.as_str(), &signal_id)
+        .await?
+        .ok_or_else(|| Problem::no_such_signal(&signal_id))?;
+    let frequencies = log_spaced(request.f_min, request.f_max, request.points);
+    // Each frequency steps through every sample, plus 64 sub-steps per period over the
+    // record where its period is shorter than the sample interval.
+    let steps = request.dampings.len() as f64
+        * frequencies
+            .iter()
+            .map(|f| metadata.samples as f64 + 64.0 * f * metadata.duration)
+            .sum::<f64>();
+    if steps > MAX_SPECTRUM_STEPS {
+        return Err(Problem::invalid_query(format!(
+            "this grid takes about {steps:.2e} oscillator steps on this record ({} samples over {} s), \
+             more than the limit of {MAX_SPECTRUM_STEPS:.0e}: ask for fewer `points`, fewer damping \
+             ratios or a lower `f_max`",
+            metadata.samples, metadata.duration
+        ))
+        .into());
+    }
+    let record = state
+        .signals
+        .record(tenant.as_str(), &signal_id)
+        .await?
+        .ok_or_else(|| Problem::no_such_signal(&signal_id))?;
+    let dampings = request.dampings.clone();
+    let spectra = tokio::task::spawn_blocking(move || {
+        dampings
+            .iter()
+            .map(|&xi| response_spectrum::pseudo_acceleration(&record, &frequencies, xi))
+            .collect::<Result<Vec<_>, _>>()
+    })
+    .await
+    .map_err(|e| ApiError::Internal(format!("a response spectrum panicked: {e}")))?
+    .map_err(|e| ApiError::Internal(format!("a stored signal's spectrum failed: {e}")))?;
+    let frequencies = spectra.first().map(|s| s.frequencies.clone()).unwrap_or_default();
+    let document = SignalSpectrum {
+        signal: signal_id,
+        frequencies,
+        pseudo_acceleration: spectra
+            .into_iter()
+            .map(|s| DampedSpectrum {
+                damping: s.damping,
+                values: s.pseudo_acceleration,
+            })
+            .collect(),
+        pga: metadata.pga,
+    };
+    let body = match format {
+        Format::Json => serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))?,
+        Format::Csv => {
+            let series: Vec<(String, Vec<f64>)> = document
+                .pseudo_acceleration
+                .iter()
+                .map(|s| (format!("psa_{}", s.damping), s.values.clone()))
+                .collect();
+            columns_csv("frequency", &document.frequencies, &series).into_bytes()
+        }
+    };
+    Ok((
+        [(
+            header::CONTENT_TYPE,
+            HeaderValue::from_static(format.content_type()),
+        )],
+        body,
+    )
+        .into_response())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pairs(items: &[(&str, &str)]) -> Vec<(String, String)> {
+        items.iter().map(|(k, v)| ((*k).into(), (*v).into())).collect()
+    }
+
+    #[test]
+    fn dampings_may_be_repeated_or_comma_separated() {
+        let request = parse_spectrum_query(&pairs(&[
+            ("damping", "0.02,0.05"),
+            ("damping", "0.1"),
+            ("points", "50"),
+        ]))
+        .unwrap();
+        assert_eq!(request.dampings, vec![0.02, 0.05, 0.1]);
+        assert_eq!(request.points, 50);
+        assert_eq!(parse_spectrum_query(&[]).unwrap().dampings, vec![0.05]);
+    }
+
+    #[test]
+    fn bad_spectrum_queries_are_refused() {
+        for bad in [
+            &[("damping", "1.0")][..],
+            &[("damping", "abc")],
+            &[("f_min", "0")],
+            &[("f_min", "10"), ("f_max", "5")],
+            &[("points", "1")],
+            &[("dampnig", "0.05")],
+        ] {
+            assert!(parse_spectrum_query(&pairs(bad)).is_err(), "{bad:?}");
+        }
+    }
+}
