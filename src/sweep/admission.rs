@@ -2,8 +2,9 @@
 //!
 //! A sweep is admitted whole or not at all. Its request is checked ([`spec::parse`]),
 //! its process looked up, each axis pointer checked against the process's inputs schema
-//! ([`input_schema`]: a typo would otherwise fail every run), its axes expanded into
-//! runs, and every run's inputs validated
+//! ([`input_schema`]: a typo would otherwise fail every run; the problems of the base
+//! inputs come in the same 422, from the first run without those axes), its axes
+//! expanded into runs, and every run's inputs validated
 //! by the process as an execution request's would be, its estimated cost compared with
 //! the service's ceilings. A run above a ceiling refuses the sweep; an invalid run
 //! refuses it too, unless the request says `invalid_runs: record` (the run is then
@@ -88,8 +89,10 @@ pub fn admit(body: &Value, registry: &Registry, limits: &AdmissionLimits) -> Res
     let process = registry
         .get(&spec.process)
         .ok_or_else(|| Refusal::NoSuchProcess(spec.process.clone()))?;
-    check_pointers(&spec, process.as_ref())
-        .map_err(|errors| Refusal::Request(SweepError::Invalid(errors)))?;
+    if let Err(mut errors) = check_pointers(&spec, process.as_ref()) {
+        errors.extend(first_run_errors(&spec, process.as_ref(), &errors));
+        return Err(Refusal::Request(SweepError::Invalid(errors)));
+    }
     let runs = admit_runs(&spec, process.as_ref(), &limits.cost)?;
     Ok(Admitted { spec, runs })
 }
@@ -110,6 +113,31 @@ fn check_pointers(spec: &SweepSpec, process: &dyn Process) -> Result<(), Vec<Fie
         })
         .collect();
     if errors.is_empty() { Ok(()) } else { Err(errors) }
+}
+
+/// The problems of the first run of `spec` without the axes whose pointer is refused
+/// (`refused`, at `/axes/{k}/pointer`): those of the base inputs and the other axes,
+/// reported with the refused pointers rather than once they are fixed.
+fn first_run_errors(spec: &SweepSpec, process: &dyn Process, refused: &[FieldError]) -> Vec<FieldError> {
+    let mut kept = spec.clone();
+    kept.axes = spec
+        .axes
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| refused.iter().all(|e| e.pointer != format!("/axes/{k}/pointer")))
+        .map(|(_, axis)| axis.clone())
+        .collect();
+    let Some(first) = kept.expand().into_iter().next() else {
+        return Vec::new();
+    };
+    match process.validate(&first.inputs) {
+        Ok(_) => Vec::new(),
+        Err(invalid) => run_errors(
+            &kept,
+            std::slice::from_ref(&first),
+            std::iter::once((0, invalid.0.as_slice())),
+        ),
+    }
 }
 
 /// Why the process does not take a generated run as it is.
@@ -188,7 +216,9 @@ fn validate_in_parallel(
                         .filter_map(|run| {
                             let problem = match process.validate(&run.inputs) {
                                 Err(invalid) => RunProblem::Invalid(invalid),
-                                Ok(estimate) => RunProblem::TooCostly(limits.check(&estimate).err()?),
+                                Ok(validated) => {
+                                    RunProblem::TooCostly(limits.check(&validated.estimate).err()?)
+                                }
                             };
                             Some((run.index, problem))
                         })

@@ -142,6 +142,16 @@ pub async fn spawn_app_with_shipped_processes_on(backend: Backend) -> TestApp {
     .await
 }
 
+/// Starts a service on `store` (a restart when it already holds jobs) that also offers
+/// the `extra` processes.
+pub async fn spawn_app_in_with_processes(
+    store: TestStore,
+    extra: Vec<Arc<dyn Process>>,
+    configure: impl FnOnce(&mut ServiceConfig),
+) -> TestApp {
+    spawn_app_serving(store, extra, configure).await
+}
+
 async fn spawn_app_serving(
     store: TestStore,
     extra: Vec<Arc<dyn Process>>,

@@ -29,3 +29,4 @@ mod scale_out;
 mod spectra;
 mod sweeps;
 mod tenants;
+mod warnings;

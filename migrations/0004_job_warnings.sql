@@ -1,0 +1,5 @@
+-- Plausibility warnings of a job's inputs (JSON array of {code, pointer, message}),
+-- found when it was submitted and shown with its status. NULL for jobs submitted before
+-- warnings existed, and for sweep runs (their results documents carry them).
+
+ALTER TABLE jobs ADD COLUMN warnings TEXT;
