@@ -379,6 +379,16 @@ async fn impossible_values_are_refused_at_their_field_with_the_bound() {
         "{errors:?}"
     );
 
+    // In a bundle too: the step count is the duration's fault, not the step's, the
+    // modes' or the pins' (its work and history ceilings only restate it).
+    let mut bundle = example("bundle-sine-auto.json")["inputs"].clone();
+    bundle["solver"]["duration"] = json!(1e308);
+    let errors = refused(&app, "bundle-dynamics", &bundle).await;
+    assert!(
+        !errors.is_empty() && errors.iter().all(|(p, _)| p == "/inputs/solver/duration"),
+        "{errors:?}"
+    );
+
     // Numbers at sensible precision: 0.1 + 0.2 m is "0.3 m".
     let mut inputs = base.clone();
     inputs["beam"]["section"] = json!({"type": "tube", "outer_diameter": 0.1 + 0.2, "inner_diameter": 0.5});
