@@ -22,7 +22,7 @@ use super::input_schema;
 use super::spec::{self, SweepError, SweepSpec};
 use super::{InvalidRuns, Run};
 use crate::processes::cost::Excess;
-use crate::processes::{CostLimits, FieldError, InvalidInputs, Process, Registry, TooCostly};
+use crate::processes::{CostLimits, FieldError, InvalidInputs, Process, Registry, TooCostly, Warning};
 
 /// At most this many field errors are reported for the runs of one sweep.
 pub const MAX_RUN_ERRORS: usize = 100;
@@ -50,6 +50,8 @@ pub struct AdmittedRun {
     pub inputs: Value,
     /// Why the process refuses them, for a run recorded as failed (`invalid_runs: record`).
     pub invalid: Option<InvalidInputs>,
+    /// Plausibility warnings about them (none for an invalid run).
+    pub warnings: Vec<Warning>,
 }
 
 /// Why a sweep is not admitted; each variant's doc says its HTTP status and problem type.
@@ -155,13 +157,17 @@ fn admit_runs(
     limits: &CostLimits,
 ) -> Result<Vec<AdmittedRun>, Refusal> {
     let runs = spec.expand();
-    let problems = validate_in_parallel(&runs, process, limits);
+    let outcomes = validate_in_parallel(&runs, process, limits);
     let mut invalid: Vec<(usize, InvalidInputs)> = Vec::new();
     let mut costly: Vec<(usize, TooCostly)> = Vec::new();
-    for (index, problem) in problems {
-        match problem {
-            RunProblem::Invalid(inputs) => invalid.push((index, inputs)),
-            RunProblem::TooCostly(refused) => costly.push((index, refused)),
+    let mut warnings: HashMap<usize, Vec<Warning>> = HashMap::new();
+    for (index, outcome) in outcomes {
+        match outcome {
+            Ok(found) => {
+                warnings.insert(index, found);
+            }
+            Err(RunProblem::Invalid(inputs)) => invalid.push((index, inputs)),
+            Err(RunProblem::TooCostly(refused)) => costly.push((index, refused)),
         }
     }
     if !costly.is_empty() {
@@ -182,6 +188,7 @@ fn admit_runs(
             .into_iter()
             .map(|run| AdmittedRun {
                 invalid: invalid.remove(&run.index),
+                warnings: warnings.remove(&run.index).unwrap_or_default(),
                 inputs: run.inputs,
             })
             .collect());
@@ -196,13 +203,13 @@ fn admit_runs(
     )))
 }
 
-/// The problem of each run the process refuses or that is above a ceiling, by run
-/// number (in no particular order); one chunk of runs per core.
+/// By run number (in no particular order), the warnings about each run the process
+/// accepts within the ceilings, or its problem; one chunk of runs per core.
 fn validate_in_parallel(
     runs: &[Run],
     process: &dyn Process,
     limits: &CostLimits,
-) -> Vec<(usize, RunProblem)> {
+) -> Vec<(usize, Result<Vec<Warning>, RunProblem>)> {
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .min(runs.len().max(1));
@@ -213,14 +220,15 @@ fn validate_in_parallel(
             .map(|runs| {
                 scope.spawn(move || {
                     runs.iter()
-                        .filter_map(|run| {
-                            let problem = match process.validate(&run.inputs) {
-                                Err(invalid) => RunProblem::Invalid(invalid),
-                                Ok(validated) => {
-                                    RunProblem::TooCostly(limits.check(&validated.estimate).err()?)
-                                }
+                        .map(|run| {
+                            let outcome = match process.validate(&run.inputs) {
+                                Err(invalid) => Err(RunProblem::Invalid(invalid)),
+                                Ok(validated) => match limits.check(&validated.estimate) {
+                                    Ok(()) => Ok(validated.warnings),
+                                    Err(refused) => Err(RunProblem::TooCostly(refused)),
+                                },
                             };
-                            Some((run.index, problem))
+                            (run.index, outcome)
                         })
                         .collect::<Vec<_>>()
                 })

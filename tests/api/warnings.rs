@@ -402,3 +402,44 @@ async fn impossible_values_are_refused_at_their_field_with_the_bound() {
         "{detail}"
     );
 }
+
+/// A sweep's runs carry the warnings of their own inputs in their status, and a sweep
+/// over an odd range on purpose turns them off in its base inputs.
+#[tokio::test]
+async fn sweep_runs_show_their_warnings_unless_the_base_inputs_turn_them_off() {
+    let app = spawn_idle().await;
+    let mut body = example("sweep-calibration.json");
+    body["inputs"]["release"]["tip_displacement"] = json!(0.0);
+    body["axes"] = json!([{"pointer": "/contact/rk", "values": [1.0, 10.0]}]);
+    let id = app.create_sweep(body.clone()).await;
+    let jobs = app.get_json("/jobs").await;
+    let runs: Vec<&Value> = jobs["jobs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|job| job["sweepID"] == id.as_str())
+        .collect();
+    assert_eq!(runs.len(), 2, "{jobs}");
+    for run in runs {
+        assert_eq!(
+            warnings(run),
+            [(
+                "nothing_excites".to_owned(),
+                "/inputs/release/tip_displacement".to_owned()
+            )],
+            "{run}"
+        );
+    }
+
+    body["inputs"]["warnings"] = json!("off");
+    let quiet = app.create_sweep(body).await;
+    let jobs = app.get_json("/jobs").await;
+    let runs: Vec<&Value> = jobs["jobs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|job| job["sweepID"] == quiet.as_str())
+        .collect();
+    assert_eq!(runs.len(), 2, "{jobs}");
+    assert!(runs.iter().all(|run| warnings(run).is_empty()), "{runs:?}");
+}

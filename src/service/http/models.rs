@@ -70,7 +70,7 @@ pub struct StatusInfo {
     pub updated: String,
     /// Plausibility warnings about the inputs, found when the job was submitted: valid
     /// inputs that look like a mistake (a unit slip, nothing exciting the model, ...).
-    /// Empty for sweep runs (see their results) and with `"warnings": "off"`.
+    /// Empty with `"warnings": "off"` among the inputs.
     pub warnings: Vec<crate::processes::Warning>,
     pub links: Vec<Link>,
 }

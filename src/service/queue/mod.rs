@@ -112,8 +112,8 @@ pub struct JobRecord {
     pub attempt: i64,
     /// The sweep this job is a run of, if any.
     pub sweep_id: Option<String>,
-    /// Plausibility warnings about its inputs, found at submission (none for sweep runs
-    /// and jobs submitted before warnings existed).
+    /// Plausibility warnings about its inputs, found at submission (none for jobs
+    /// submitted before warnings existed).
     pub warnings: Vec<crate::processes::Warning>,
 }
 
