@@ -326,7 +326,7 @@ fn check_reference_scan(reference: &CantileverReference, errors: &mut Vec<FieldE
         reference.duration * 16.0 * omega / std::f64::consts::TAU
     };
     let samples = scan_samples(reference.modes);
-    if !(samples <= MAX_SCAN_SAMPLES) {
+    if samples > MAX_SCAN_SAMPLES || samples.is_nan() {
         let (field, advice) = if scan_samples(1) <= MAX_SCAN_SAMPLES {
             ("/inputs/reference/modes", "use fewer modes or a shorter duration")
         } else {
