@@ -4,7 +4,8 @@
 //! with no server: the results document goes to stdout, invalid inputs give the same
 //! problem document as the HTTP API on stderr and exit status 2, a failed run exits 1.
 //! A result whose quality verdict is not `good` still exits 0 (as its job would be
-//! `successful`) but says so on stderr: `warning: quality poor: <reason>; <reason>`.
+//! `successful`) but says so on stderr: `warning: quality poor: <reason>; <reason>`;
+//! each plausibility warning about the inputs is a line `warning: <pointer>: <message>`.
 //! `chocmodal serve` runs the HTTP API and its workers, `chocmodal worker` workers alone
 //! (see [`crate::service`]).
 
@@ -130,6 +131,9 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
         })?;
     if show_progress {
         eprintln!();
+    }
+    for warning in &output.warnings {
+        eprintln!("warning: {}: {}", warning.pointer, warning.message);
     }
     if let Some(dir) = &args.out {
         write_histories(dir, &output).map_err(CliFailure::Failed)?;

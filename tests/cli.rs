@@ -327,3 +327,49 @@ fn run_reads_a_record_file_named_by_a_signal_reference() {
     let detail = problem["errors"][0]["detail"].as_str().unwrap();
     assert!(detail.contains("line 3") && detail.contains("oops"), "{detail}");
 }
+
+/// Plausibility warnings go to stderr, one line each, and the run goes on: a cantilever
+/// released from rest has nothing to move it. The example itself has none.
+#[test]
+fn warnings_are_printed_on_stderr_and_the_run_succeeds() {
+    let mut body: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(example()).unwrap()).unwrap();
+    body["inputs"]["solver"]["duration"] = serde_json::json!(0.01);
+    body["inputs"]["solver"]["check"] = serde_json::json!("none");
+    let run = |body: &serde_json::Value| {
+        let mut child = chocmodal()
+            .args(["run", "cantilever-impact", "-"])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(body.to_string().as_bytes())
+            .unwrap();
+        child.wait_with_output().unwrap()
+    };
+    let quiet = run(&body);
+    assert!(quiet.status.success());
+    assert!(
+        !String::from_utf8_lossy(&quiet.stderr).contains("warning: /inputs"),
+        "{}",
+        String::from_utf8_lossy(&quiet.stderr)
+    );
+
+    body["inputs"]["release"]["tip_displacement"] = serde_json::json!(0.0);
+    let output = run(&body);
+    assert!(output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr
+            .lines()
+            .any(|line| line.starts_with("warning: /inputs/release/tip_displacement: nothing excites")),
+        "{stderr}"
+    );
+    let document: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON on stdout");
+    assert_eq!(document["warnings"][0]["code"], "nothing_excites");
+}

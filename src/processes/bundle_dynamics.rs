@@ -13,6 +13,7 @@ use super::inputs::{self, SolverDefaults, at};
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryOutput, Output, Simulation};
+use super::warnings::Subject;
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::Contact;
 use crate::physics::integrate::{self, Model, Settings, StepSize};
@@ -397,6 +398,20 @@ impl Simulation for BundleDynamics {
 
     fn metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
         bundle_metrics(document)
+    }
+
+    /// The pin of the row, its contacts' gaps where the user wrote them.
+    fn subject(plan: &Plan) -> Subject<'_> {
+        Subject {
+            switch: plan.inputs.warnings,
+            pin: &plan.inputs.pin,
+            pin_pointer: "/inputs/pin",
+            diameter: None,
+            model: plan.model(),
+            duration: plan.settings.duration,
+            gap_pointer: Box::new(|k| plan.inputs.gap_pointer(&plan.contacts[k], k)),
+            excitation_pointer: "/inputs/excitation",
+        }
     }
 
     fn run(plan: Plan, progress: &mut ProgressFn<'_>) -> Result<Output<BundleResults>, RunError> {

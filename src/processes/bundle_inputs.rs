@@ -7,6 +7,7 @@ use utoipa::ToSchema;
 
 use super::impact_report::ImpactsInput;
 use super::inputs::{BeamInput, SolverInput};
+use super::warnings::WarningsInput;
 use crate::physics::bundle::{BundleLayout, GapDistribution, GapState, Levels, LocalClosure};
 use crate::physics::contact::{Body, Contact};
 use crate::physics::loads::{BaseAcceleration, PointForce, Pulse, Table};
@@ -31,6 +32,10 @@ pub struct BundleInputs {
     pub solver: SolverInput,
     #[serde(default)]
     pub output: OutputInput,
+    /// Plausibility warnings (a unit slip, nothing exciting the model, ...): `on`
+    /// (default) or `off`; never a refusal.
+    #[serde(default)]
+    pub warnings: WarningsInput,
 }
 
 /// A potential point contact between `left` and `right` ("wall" or a pin number).
@@ -81,6 +86,23 @@ impl From<Body> for BodyInput {
         match value {
             Body::Pin(p) => BodyInput::Pin(p),
             Body::Wall => BodyInput::Wall(WallKeyword::Wall),
+        }
+    }
+}
+
+impl BundleInputs {
+    /// Where the user wrote the gap of `contact`, number `k` of the explicit list or of
+    /// the generator's expansion.
+    pub fn gap_pointer(&self, contact: &Contact, k: usize) -> String {
+        let Some(generator) = &self.bundle else {
+            return format!("/inputs/contacts/{k}/gap");
+        };
+        let wall = contact.left == Body::Wall || contact.right == Body::Wall;
+        match &generator.gaps {
+            GapsInput::Uniform {} if wall => "/inputs/bundle/wall_gap".to_owned(),
+            GapsInput::Uniform {} => "/inputs/bundle/pin_gap".to_owned(),
+            GapsInput::PerContact { .. } => format!("/inputs/bundle/gaps/values/{k}"),
+            GapsInput::Random { .. } => "/inputs/bundle/gaps".to_owned(),
         }
     }
 }

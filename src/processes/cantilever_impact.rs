@@ -12,6 +12,7 @@ use super::inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, 
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryOutput, Output, Simulation};
+use super::warnings::{Subject, WarningsInput};
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
@@ -44,6 +45,10 @@ pub struct CantileverInputs {
     pub reference: ReferenceInput,
     #[serde(default)]
     pub output: OutputInput,
+    /// Plausibility warnings (a unit slip, nothing exciting the model, ...): `on`
+    /// (default) or `off`; never a refusal.
+    #[serde(default)]
+    pub warnings: WarningsInput,
 }
 
 /// The tip contact: a spring below the tip, acting while w(L) < −gap.
@@ -321,16 +326,31 @@ fn pointer_of(inputs: &CantileverInputs, path: &str, beam_refused: bool) -> Opti
 }
 
 /// The reference's own limit: it scans at 1/16 of its shortest period, and its highest
-/// root is below (n + ½)π.
+/// root is below (n + ½)π. Too many samples are the duration's fault when even one
+/// mode would scan too many, the modes' otherwise.
 fn check_reference_scan(reference: &CantileverReference, errors: &mut Vec<FieldError>) {
-    let lambda = (reference.modes as f64 + 0.5) * std::f64::consts::PI;
-    let omega = lambda * lambda * (reference.bending_stiffness() / reference.mass_per_length()).sqrt()
-        / reference.length.powi(2);
-    let scan_samples = reference.duration * 16.0 * omega / std::f64::consts::TAU;
-    if scan_samples > crate::physics::reference::MAX_SCAN_SAMPLES {
+    use crate::physics::number;
+    use crate::physics::reference::MAX_SCAN_SAMPLES;
+    let scan_samples = |modes: usize| {
+        let lambda = (modes as f64 + 0.5) * std::f64::consts::PI;
+        let omega = lambda * lambda * (reference.bending_stiffness() / reference.mass_per_length()).sqrt()
+            / reference.length.powi(2);
+        reference.duration * 16.0 * omega / std::f64::consts::TAU
+    };
+    let samples = scan_samples(reference.modes);
+    if samples > MAX_SCAN_SAMPLES || samples.is_nan() {
+        let (field, advice) = if scan_samples(1) <= MAX_SCAN_SAMPLES {
+            ("/inputs/reference/modes", "use fewer modes or a shorter duration")
+        } else {
+            ("/inputs/solver/duration", "use a shorter duration")
+        };
         errors.push(FieldError::new(
-            "/inputs/reference/modes",
-            format!("the reference would scan {scan_samples:.3e} samples over the duration: use fewer modes or a shorter duration"),
+            field,
+            format!(
+                "the reference would scan {} samples over the duration, above its limit of {}: {advice}",
+                number(samples),
+                number(MAX_SCAN_SAMPLES)
+            ),
         ));
     }
 }
@@ -472,6 +492,20 @@ impl Simulation for CantileverImpact {
             .to_vec(),
             history_drivers,
             ..stepping
+        }
+    }
+
+    /// The beam, released at the tip toward its one contact.
+    fn subject(plan: &Plan) -> Subject<'_> {
+        Subject {
+            switch: plan.inputs.warnings,
+            pin: &plan.inputs.beam,
+            pin_pointer: "/inputs/beam",
+            diameter: None,
+            model: plan.model(),
+            duration: plan.settings.duration,
+            gap_pointer: Box::new(|_| "/inputs/contact/gap".to_owned()),
+            excitation_pointer: "/inputs/release/tip_displacement",
         }
     }
 

@@ -140,6 +140,10 @@ impl CostLimits {
                 ),
             ));
         }
+        // Too many steps make the run too much work and too many samples too: the other
+        // ceilings are listed as exceeded, but their errors would only restate it at
+        // fields that are not the cause (the modes, the pins).
+        let steps_exceeded = !errors.is_empty();
         let work = estimate.work();
         if work > self.max_work {
             exceeded.push(Excess {
@@ -162,6 +166,7 @@ impl CostLimits {
                 estimate
                     .work_drivers
                     .iter()
+                    .filter(|_| !steps_exceeded)
                     .map(|pointer| FieldError::new(pointer.clone(), detail.clone())),
             );
         }
@@ -182,6 +187,7 @@ impl CostLimits {
                 estimate
                     .history_drivers
                     .iter()
+                    .filter(|_| !steps_exceeded)
                     .map(|pointer| FieldError::new(pointer.clone(), detail.clone())),
             );
         }
@@ -276,5 +282,20 @@ mod tests {
             "{:?}",
             refused.errors
         );
+    }
+
+    /// A duration of 1e308 s is too many steps, hence too much work and too many
+    /// samples: all three are exceeded, but only the duration is at fault.
+    #[test]
+    fn too_many_steps_are_not_restated_at_the_other_ceilings_drivers() {
+        let mut estimate = estimate();
+        estimate.pass_steps = f64::INFINITY;
+        estimate.steps = f64::INFINITY;
+        estimate.history_values = f64::INFINITY;
+        let refused = CostLimits::check_absolute(&estimate).unwrap_err();
+        let quantities: Vec<&str> = refused.exceeded.iter().map(|e| e.quantity.as_str()).collect();
+        assert_eq!(quantities, ["steps", "work", "history_values"]);
+        let pointers: Vec<&str> = refused.errors.iter().map(|e| e.pointer.as_str()).collect();
+        assert_eq!(pointers, ["/inputs/solver/duration"]);
     }
 }

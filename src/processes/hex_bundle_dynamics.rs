@@ -15,6 +15,7 @@ use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::inputs::{self, SolverDefaults, at};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryOutput, Output, Simulation};
+use super::warnings::Subject;
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::{Body as RowBody, Contact};
 use crate::physics::hex::{Aim, Body, HexBundle, HexContact, pair_count};
@@ -404,6 +405,25 @@ impl Simulation for HexBundleDynamics {
             .to_vec(),
             history_drivers,
             ..stepping
+        }
+    }
+
+    /// The pin of the bundle (D may be given apart from its section), its contacts'
+    /// gaps where the user wrote them.
+    fn subject(plan: &Plan) -> Subject<'_> {
+        Subject {
+            switch: plan.inputs.warnings,
+            pin: &plan.inputs.pin,
+            pin_pointer: "/inputs/pin",
+            diameter: plan
+                .inputs
+                .bundle
+                .pin_diameter
+                .map(|d| (d, "/inputs/bundle/pin_diameter")),
+            model: plan.model(),
+            duration: plan.settings.duration,
+            gap_pointer: Box::new(|k| plan.inputs.gap_pointer(&plan.contacts[k], k)),
+            excitation_pointer: "/inputs/excitation",
         }
     }
 

@@ -12,6 +12,7 @@ use utoipa::ToSchema;
 use super::bundle_inputs::{BaseAccelerationInput, DistributionInput};
 use super::impact_report::ImpactsInput;
 use super::inputs::{BeamInput, SectionInput, SolverInput};
+use super::warnings::WarningsInput;
 use crate::physics::bundle::GapDistribution;
 use crate::physics::hex::{FlatOffset, Handedness, HexGapState, HexGaps, HexLayout, PinZone, ZoneClosure};
 
@@ -38,6 +39,10 @@ pub struct HexInputs {
     pub solver: SolverInput,
     #[serde(default)]
     pub output: HexOutputInput,
+    /// Plausibility warnings (a unit slip, nothing exciting the model, ...): `on`
+    /// (default) or `off`; never a refusal.
+    #[serde(default)]
+    pub warnings: WarningsInput,
 }
 
 /// The wire-wrapped hexagonal bundle in its wrapper tube (lengths in m).
@@ -223,6 +228,22 @@ pub enum ContactSelectionInput {
 }
 
 impl HexInputs {
+    /// Where the user wrote (or the geometry set) the gap of `contact`, number `k` in
+    /// contact order.
+    pub fn gap_pointer(&self, contact: &crate::physics::contact::Contact, k: usize) -> String {
+        let wall = contact.right == crate::physics::contact::Body::Wall;
+        match &self.gaps {
+            HexGapsInput::Uniform {
+                pin_wall: Some(_), ..
+            } if wall => "/inputs/gaps/pin_wall".to_owned(),
+            HexGapsInput::Uniform { .. } if wall => "/inputs/bundle/wrapper_flat_to_flat".to_owned(),
+            HexGapsInput::Uniform { pin_pin: Some(_), .. } => "/inputs/gaps/pin_pin".to_owned(),
+            HexGapsInput::Uniform { .. } => "/inputs/bundle/pitch".to_owned(),
+            HexGapsInput::PerContact { .. } => format!("/inputs/gaps/values/{k}"),
+            HexGapsInput::Random { .. } => "/inputs/gaps".to_owned(),
+        }
+    }
+
     /// D: `bundle.pin_diameter`, else the tube's outer diameter; `None` when neither.
     pub fn pin_diameter(&self) -> Option<f64> {
         self.bundle.pin_diameter.or(match self.pin.section {

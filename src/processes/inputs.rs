@@ -261,7 +261,10 @@ impl BeamInput {
         };
         for (field, xi) in ratios {
             if !(xi.is_finite() && (0.0..1.0).contains(&xi)) {
-                issues.push(InputIssue::new(field, format!("must be in [0, 1) (got {xi})")));
+                issues.push(InputIssue::new(
+                    field,
+                    format!("must be in [0, 1) (got {})", crate::physics::number(xi)),
+                ));
             }
         }
         issues
@@ -400,7 +403,7 @@ pub fn scheme(scheme: SchemeInput, phi: Option<f64>, issues: &mut Vec<InputIssue
             if !(phi.is_finite() && (1.0..=2.0).contains(&phi)) {
                 issues.push(InputIssue::new(
                     "phi",
-                    format!("must be between 1 and 2 (got {phi})"),
+                    format!("must be between 1 and 2 (got {})", crate::physics::number(phi)),
                 ));
             }
             Scheme::Tchamwa { phi }
@@ -465,7 +468,7 @@ pub fn solver(input: &SolverInput, defaults: SolverDefaults, errors: &mut Vec<Fi
             "tolerance",
             format!(
                 "must be a relative tolerance between 0 and 1, both excluded (got {})",
-                input.tolerance
+                crate::physics::number(input.tolerance)
             ),
         ));
     }

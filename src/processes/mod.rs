@@ -19,6 +19,8 @@ pub mod metrics;
 pub mod model_check;
 /// The shared parts of results documents (quality, energy) as serialized types.
 pub mod report;
+/// Every missing member at once, with the other problems of the inputs.
+pub mod required;
 /// The `signal` base acceleration: a stored accelerogram by id, or a file for the CLI.
 pub mod signal_input;
 /// A process described by its types, and the one adapter to [`Process`].
@@ -26,6 +28,8 @@ pub mod simulation;
 pub mod strict_json;
 /// The `spectrum_compatible` base acceleration: a synthetic earthquake as an input.
 pub mod synthetic_input;
+/// Plausibility warnings about valid inputs, the same for every process.
+pub mod warnings;
 
 #[cfg(test)]
 mod excitation_tests;
@@ -41,6 +45,7 @@ use std::sync::Arc;
 
 pub use cost::{CostLimits, TooCostly, WorkEstimate};
 pub use simulation::{HistoryOutput, Output, Simulation};
+pub use warnings::Warning;
 
 /// One problem with the inputs: where (JSON pointer into the request body) and why.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -109,10 +114,21 @@ pub fn columns_csv(key: &str, keys: &[f64], series: &[(String, Vec<f64>)]) -> St
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutput {
     /// Results document without its `outputs` links (the caller adds those, since
-    /// only it knows where histories are served from).
+    /// only it knows where histories are served from); its `warnings` are
+    /// [`RunOutput::warnings`].
     pub document: serde_json::Value,
     /// Time histories, served as `/jobs/{id}/results/{name}` or written as CSV.
     pub histories: Vec<History>,
+    /// Plausibility warnings about the inputs.
+    pub warnings: Vec<Warning>,
+}
+
+/// Inputs a process accepts: what running them will cost, and what looks implausible
+/// about them (warnings, not refusals).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Validated {
+    pub estimate: WorkEstimate,
+    pub warnings: Vec<Warning>,
 }
 
 impl RunOutput {
@@ -181,8 +197,9 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     fn outputs_description(&self) -> serde_json::Value;
     /// Parses and checks the `inputs` object of an execution request, and estimates what
     /// running it will cost (a service compares that with its [`CostLimits`]). Pointers in
-    /// the errors start with `/inputs`.
-    fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs>;
+    /// the errors start with `/inputs`. Accepted inputs come with their plausibility
+    /// warnings.
+    fn validate(&self, inputs: &serde_json::Value) -> Result<Validated, InvalidInputs>;
     /// Runs the computation on inputs that passed [`Process::validate`].
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError>;
     /// [`Process::validate`], the stored signals the inputs refer to (`{"type":
@@ -192,7 +209,7 @@ pub trait Process: Send + Sync + std::fmt::Debug {
         &self,
         inputs: &serde_json::Value,
         signals: &signal_input::SignalLibrary,
-    ) -> Result<WorkEstimate, InvalidInputs> {
+    ) -> Result<Validated, InvalidInputs> {
         let _ = signals;
         self.validate(inputs)
     }

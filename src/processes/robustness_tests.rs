@@ -317,7 +317,7 @@ proptest! {
         };
         let body = serde_json::json!({ "inputs": inputs });
         match outcome {
-            Ok(estimate) => {
+            Ok(super::Validated { estimate, .. }) => {
                 prop_assert!(
                     estimate.work().is_finite() && estimate.work() >= 0.0
                         && estimate.history_values.is_finite() && estimate.history_values >= 0.0,

@@ -6,16 +6,21 @@
 //! its JSON pointer), what a plan costs, and how it runs. The adapter does the rest, the
 //! same way for every process: strict parsing with pointer repair
 //! ([`super::inputs::parse`]), the absolute cost ceilings ([`CostLimits::ABSOLUTE`]),
-//! the OGC descriptions of inputs and outputs, the results document and its schema.
+//! the OGC descriptions of inputs and outputs, the plausibility warnings
+//! ([`super::warnings`]), the results document and its schema.
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
+use utoipa::openapi::schema::{AllOfBuilder, ArrayBuilder, ObjectBuilder};
 use utoipa::openapi::{RefOr, Schema};
 use utoipa::{PartialSchema, ToSchema};
 
+use super::required;
 use super::signal_input::{SignalLibrary, SignalSlot};
+use super::warnings::{self, Subject, Warning};
 use super::{
-    CostLimits, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate, inputs,
+    CostLimits, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, Validated, WorkEstimate,
+    inputs,
 };
 
 /// One history a simulation writes: served as `/jobs/{id}/results/{name}` (CSV or JSON).
@@ -67,6 +72,9 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
     fn prepare(inputs: Self::Inputs) -> Result<Self::Plan, InvalidInputs>;
     /// What running the plan will cost (compared with the ceilings before anything runs).
     fn estimate(plan: &Self::Plan) -> WorkEstimate;
+    /// What the plausibility checks read of the plan: its pin, model and duration, and
+    /// where the user wrote them ([`warnings::assess`] judges them).
+    fn subject(plan: &Self::Plan) -> Subject<'_>;
     /// Runs the plan; `progress` gets the fraction done and may cancel.
     fn run(plan: Self::Plan, progress: &mut ProgressFn<'_>) -> Result<Output<Self::Results>, RunError>;
     /// The metric columns of a sweep's results table for one results document: the
@@ -77,24 +85,34 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
     }
 }
 
-/// Parses, attaches the stored signals referenced, prepares and checks against the
-/// absolute ceilings.
+/// Parses, attaches the stored signals referenced, prepares, checks against the
+/// absolute ceilings and assesses plausibility.
 fn plan<S: Simulation>(
     json: &serde_json::Value,
     signals: &SignalLibrary,
-) -> Result<(S::Plan, WorkEstimate), InvalidInputs> {
-    let mut inputs: S::Inputs = inputs::parse(json)?;
-    let unresolved: Vec<_> = S::signals(&mut inputs)
-        .into_iter()
-        .filter_map(|(pointer, signal)| signal.resolve(signals, &pointer).err())
-        .collect();
-    if !unresolved.is_empty() {
-        return Err(InvalidInputs(unresolved));
-    }
-    let plan = S::prepare(inputs)?;
+) -> Result<(S::Plan, Validated), InvalidInputs> {
+    let plan = required::prepare::<S::Inputs, S::Plan>(json, |mut inputs| {
+        let unresolved: Vec<_> = S::signals(&mut inputs)
+            .into_iter()
+            .filter_map(|(pointer, signal)| signal.resolve(signals, &pointer).err())
+            .collect();
+        if !unresolved.is_empty() {
+            return Err(InvalidInputs(unresolved));
+        }
+        S::prepare(inputs)
+    })?;
     let estimate = S::estimate(&plan);
     CostLimits::check_absolute(&estimate).map_err(|refused| InvalidInputs(refused.errors))?;
-    Ok((plan, estimate))
+    let warnings = warnings::assess(&S::subject(&plan), estimate.steps);
+    Ok((plan, Validated { estimate, warnings }))
+}
+
+/// A results document: the simulation's results and the warnings about its inputs.
+#[derive(Serialize)]
+struct Document<'a, R> {
+    #[serde(flatten)]
+    results: &'a R,
+    warnings: &'a [Warning],
 }
 
 impl<S: Simulation> Process for S {
@@ -132,7 +150,7 @@ impl<S: Simulation> Process for S {
             .into()
     }
 
-    fn validate(&self, inputs: &serde_json::Value) -> Result<WorkEstimate, InvalidInputs> {
+    fn validate(&self, inputs: &serde_json::Value) -> Result<Validated, InvalidInputs> {
         self.validate_with(inputs, &SignalLibrary::default())
     }
 
@@ -140,8 +158,8 @@ impl<S: Simulation> Process for S {
         &self,
         inputs: &serde_json::Value,
         signals: &SignalLibrary,
-    ) -> Result<WorkEstimate, InvalidInputs> {
-        plan::<S>(inputs, signals).map(|(_, estimate)| estimate)
+    ) -> Result<Validated, InvalidInputs> {
+        plan::<S>(inputs, signals).map(|(_, validated)| validated)
     }
 
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
@@ -154,10 +172,13 @@ impl<S: Simulation> Process for S {
         signals: &SignalLibrary,
         progress: &mut ProgressFn<'_>,
     ) -> Result<RunOutput, RunError> {
-        let (plan, _) = plan::<S>(inputs, signals)?;
+        let (plan, Validated { warnings, .. }) = plan::<S>(inputs, signals)?;
         let output = S::run(plan, progress)?;
-        let document = serde_json::to_value(&output.results)
-            .map_err(|e| RunError::Failed(format!("results document: {e}")))?;
+        let document = serde_json::to_value(Document {
+            results: &output.results,
+            warnings: &warnings,
+        })
+        .map_err(|e| RunError::Failed(format!("results document: {e}")))?;
         debug_assert_eq!(
             output
                 .histories
@@ -171,6 +192,7 @@ impl<S: Simulation> Process for S {
         Ok(RunOutput {
             document,
             histories: output.histories,
+            warnings,
         })
     }
 
@@ -181,7 +203,30 @@ impl<S: Simulation> Process for S {
     fn schemas(&self, schemas: &mut Vec<(String, RefOr<Schema>)>) {
         schemas.push((S::Inputs::name().into_owned(), S::Inputs::schema()));
         S::Inputs::schemas(schemas);
-        schemas.push((S::Results::name().into_owned(), S::Results::schema()));
+        schemas.push((
+            S::Results::name().into_owned(),
+            with_warnings(S::Results::schema()),
+        ));
         S::Results::schemas(schemas);
+        schemas.push((Warning::name().into_owned(), Warning::schema()));
+        Warning::schemas(schemas);
     }
+}
+
+/// A results schema with the document's `warnings` member (see [`Document`]).
+fn with_warnings(results: RefOr<Schema>) -> RefOr<Schema> {
+    let warnings = ObjectBuilder::new()
+        .property(
+            "warnings",
+            ArrayBuilder::new()
+                .items(RefOr::Ref(
+                    utoipa::openapi::Ref::from_schema_name(Warning::name()),
+                ))
+                .description(Some(
+                    "Plausibility warnings about the inputs (valid, but they look like a mistake); \
+                     empty with `\"warnings\": \"off\"`",
+                )),
+        )
+        .required("warnings");
+    AllOfBuilder::new().item(results).item(warnings).into()
 }

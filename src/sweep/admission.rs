@@ -2,8 +2,9 @@
 //!
 //! A sweep is admitted whole or not at all. Its request is checked ([`spec::parse`]),
 //! its process looked up, each axis pointer checked against the process's inputs schema
-//! ([`input_schema`]: a typo would otherwise fail every run), its axes expanded into
-//! runs, and every run's inputs validated
+//! ([`input_schema`]: a typo would otherwise fail every run; the problems of the base
+//! inputs come in the same 422, from the first run without those axes), its axes
+//! expanded into runs, and every run's inputs validated
 //! by the process as an execution request's would be, its estimated cost compared with
 //! the service's ceilings. A run above a ceiling refuses the sweep; an invalid run
 //! refuses it too, unless the request says `invalid_runs: record` (the run is then
@@ -22,7 +23,7 @@ use super::spec::{self, SweepError, SweepSpec};
 use super::{InvalidRuns, Run};
 use crate::processes::cost::Excess;
 use crate::processes::signal_input::SignalLibrary;
-use crate::processes::{CostLimits, FieldError, InvalidInputs, Process, Registry, TooCostly};
+use crate::processes::{CostLimits, FieldError, InvalidInputs, Process, Registry, TooCostly, Warning};
 
 /// At most this many field errors are reported for the runs of one sweep.
 pub const MAX_RUN_ERRORS: usize = 100;
@@ -50,6 +51,8 @@ pub struct AdmittedRun {
     pub inputs: Value,
     /// Why the process refuses them, for a run recorded as failed (`invalid_runs: record`).
     pub invalid: Option<InvalidInputs>,
+    /// Plausibility warnings about them (none for an invalid run).
+    pub warnings: Vec<Warning>,
 }
 
 /// Why a sweep is not admitted; each variant's doc says its HTTP status and problem type.
@@ -95,8 +98,10 @@ pub fn admit(
     let process = registry
         .get(&spec.process)
         .ok_or_else(|| Refusal::NoSuchProcess(spec.process.clone()))?;
-    check_pointers(&spec, process.as_ref())
-        .map_err(|errors| Refusal::Request(SweepError::Invalid(errors)))?;
+    if let Err(mut errors) = check_pointers(&spec, process.as_ref()) {
+        errors.extend(first_run_errors(&spec, process.as_ref(), &errors, signals));
+        return Err(Refusal::Request(SweepError::Invalid(errors)));
+    }
     let runs = admit_runs(&spec, process.as_ref(), &limits.cost, signals)?;
     Ok(Admitted { spec, runs })
 }
@@ -119,6 +124,36 @@ fn check_pointers(spec: &SweepSpec, process: &dyn Process) -> Result<(), Vec<Fie
     if errors.is_empty() { Ok(()) } else { Err(errors) }
 }
 
+/// The problems of the first run of `spec` without the axes whose pointer is refused
+/// (`refused`, at `/axes/{k}/pointer`): those of the base inputs and the other axes,
+/// reported with the refused pointers rather than once they are fixed.
+fn first_run_errors(
+    spec: &SweepSpec,
+    process: &dyn Process,
+    refused: &[FieldError],
+    signals: &SignalLibrary,
+) -> Vec<FieldError> {
+    let mut kept = spec.clone();
+    kept.axes = spec
+        .axes
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| refused.iter().all(|e| e.pointer != format!("/axes/{k}/pointer")))
+        .map(|(_, axis)| axis.clone())
+        .collect();
+    let Some(first) = kept.expand().into_iter().next() else {
+        return Vec::new();
+    };
+    match process.validate_with(&first.inputs, signals) {
+        Ok(_) => Vec::new(),
+        Err(invalid) => run_errors(
+            &kept,
+            std::slice::from_ref(&first),
+            std::iter::once((0, invalid.0.as_slice())),
+        ),
+    }
+}
+
 /// Why the process does not take a generated run as it is.
 #[derive(Debug)]
 enum RunProblem {
@@ -135,13 +170,17 @@ fn admit_runs(
     signals: &SignalLibrary,
 ) -> Result<Vec<AdmittedRun>, Refusal> {
     let runs = spec.expand();
-    let problems = validate_in_parallel(&runs, process, limits, signals);
+    let outcomes = validate_in_parallel(&runs, process, limits, signals);
     let mut invalid: Vec<(usize, InvalidInputs)> = Vec::new();
     let mut costly: Vec<(usize, TooCostly)> = Vec::new();
-    for (index, problem) in problems {
-        match problem {
-            RunProblem::Invalid(inputs) => invalid.push((index, inputs)),
-            RunProblem::TooCostly(refused) => costly.push((index, refused)),
+    let mut warnings: HashMap<usize, Vec<Warning>> = HashMap::new();
+    for (index, outcome) in outcomes {
+        match outcome {
+            Ok(found) => {
+                warnings.insert(index, found);
+            }
+            Err(RunProblem::Invalid(inputs)) => invalid.push((index, inputs)),
+            Err(RunProblem::TooCostly(refused)) => costly.push((index, refused)),
         }
     }
     if !costly.is_empty() {
@@ -162,6 +201,7 @@ fn admit_runs(
             .into_iter()
             .map(|run| AdmittedRun {
                 invalid: invalid.remove(&run.index),
+                warnings: warnings.remove(&run.index).unwrap_or_default(),
                 inputs: run.inputs,
             })
             .collect());
@@ -176,14 +216,14 @@ fn admit_runs(
     )))
 }
 
-/// The problem of each run the process refuses or that is above a ceiling, by run
-/// number (in no particular order); one chunk of runs per core.
+/// By run number (in no particular order), the warnings about each run the process
+/// accepts within the ceilings, or its problem; one chunk of runs per core.
 fn validate_in_parallel(
     runs: &[Run],
     process: &dyn Process,
     limits: &CostLimits,
     signals: &SignalLibrary,
-) -> Vec<(usize, RunProblem)> {
+) -> Vec<(usize, Result<Vec<Warning>, RunProblem>)> {
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .min(runs.len().max(1));
@@ -194,12 +234,15 @@ fn validate_in_parallel(
             .map(|runs| {
                 scope.spawn(move || {
                     runs.iter()
-                        .filter_map(|run| {
-                            let problem = match process.validate_with(&run.inputs, signals) {
-                                Err(invalid) => RunProblem::Invalid(invalid),
-                                Ok(estimate) => RunProblem::TooCostly(limits.check(&estimate).err()?),
+                        .map(|run| {
+                            let outcome = match process.validate_with(&run.inputs, signals) {
+                                Err(invalid) => Err(RunProblem::Invalid(invalid)),
+                                Ok(validated) => match limits.check(&validated.estimate) {
+                                    Ok(()) => Ok(validated.warnings),
+                                    Err(refused) => Err(RunProblem::TooCostly(refused)),
+                                },
                             };
-                            Some((run.index, problem))
+                            (run.index, outcome)
                         })
                         .collect::<Vec<_>>()
                 })

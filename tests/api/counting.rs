@@ -12,7 +12,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use chocmodal::processes::{
-    FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, WorkEstimate,
+    FieldError, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, Validated, WorkEstimate,
 };
 use serde_json::{Value, json};
 
@@ -146,16 +146,21 @@ impl Process for CountSteps {
     }
 
     /// The estimate: one "modal DOF" per step, histories of three columns.
-    fn validate(&self, inputs: &Value) -> Result<WorkEstimate, InvalidInputs> {
-        parse(inputs).map(|inputs| WorkEstimate {
-            steps: inputs.steps as f64,
-            modal_dofs: 1.0,
-            contacts: 0.0,
-            history_values: 3.0 * inputs.steps as f64,
-            work_drivers: vec!["/inputs/steps".into()],
-            history_drivers: vec!["/inputs/steps".into()],
-            ..WorkEstimate::default()
-        })
+    fn validate(&self, inputs: &Value) -> Result<Validated, InvalidInputs> {
+        parse(inputs)
+            .map(|inputs| WorkEstimate {
+                steps: inputs.steps as f64,
+                modal_dofs: 1.0,
+                contacts: 0.0,
+                history_values: 3.0 * inputs.steps as f64,
+                work_drivers: vec!["/inputs/steps".into()],
+                history_drivers: vec!["/inputs/steps".into()],
+                ..WorkEstimate::default()
+            })
+            .map(|estimate| Validated {
+                estimate,
+                warnings: Vec::new(),
+            })
     }
 
     fn run(&self, inputs: &Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError> {
@@ -198,6 +203,7 @@ impl Process for CountSteps {
                 time,
                 series: vec![("value".into(), value), ("square".into(), square)],
             }],
+            warnings: Vec::new(),
         })
     }
 }

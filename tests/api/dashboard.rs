@@ -224,6 +224,12 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
             / 5.0
     );
     let poor = execute(&app, "cantilever-impact", &poor).await;
+    // A job with a plausibility warning: a cantilever released from rest.
+    let mut still = example("cantilever-impact.json");
+    still["inputs"]["release"]["tip_displacement"] = json!(0.0);
+    still["inputs"]["solver"]["duration"] = json!(0.02);
+    still["inputs"]["solver"]["check"] = json!("none");
+    let still = execute(&app, "cantilever-impact", &still).await;
     assert_eq!(
         app.wait_for(&poor, &["successful"], within).await["status"],
         "successful"
@@ -363,6 +369,34 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
     assert!(list.contains(first), "{first} not in {list}");
     let status = element(&dom, "data-job-status=", "</table>");
     assert!(status.contains("quality poor"), "{status}");
+
+    // Warnings: none for the example's cantilever; the one of a cantilever released from
+    // rest under its status, at its pointer.
+    let dom = load(
+        &browser,
+        &app.url(&format!("/jobs/{cantilever}")),
+        "job-cantilever",
+        900,
+        3000,
+    )
+    .await;
+    assert!(tags(&dom, "data-warnings=").is_empty(), "no warnings list");
+    let status = app.wait_for(&still, &["successful"], within).await;
+    assert_eq!(status["warnings"][0]["code"], "nothing_excites", "{status}");
+    let dom = load(
+        &browser,
+        &app.url(&format!("/jobs/{still}")),
+        "job-still",
+        900,
+        3000,
+    )
+    .await;
+    let list = element(&dom, "data-warnings=\"1\"", "</ul>");
+    assert!(
+        list.contains("data-warning=\"nothing_excites\"")
+            && list.contains("/inputs/release/tip_displacement"),
+        "{list}"
+    );
 
     // The bundle: one grid cell per contact, the strongest contact's history drawn.
     let dom = load(

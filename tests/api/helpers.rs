@@ -152,6 +152,16 @@ pub async fn spawn_app_with_processes_on(
     spawn_app_serving(TestStore::new(backend).await, extra, configure).await
 }
 
+/// Starts a service on `store` (a restart when it already holds jobs) that also offers
+/// the `extra` processes.
+pub async fn spawn_app_in_with_processes(
+    store: TestStore,
+    extra: Vec<Arc<dyn Process>>,
+    configure: impl FnOnce(&mut ServiceConfig),
+) -> TestApp {
+    spawn_app_serving(store, extra, configure).await
+}
+
 async fn spawn_app_serving(
     store: TestStore,
     extra: Vec<Arc<dyn Process>>,

@@ -31,3 +31,4 @@ mod signals;
 mod spectra;
 mod sweeps;
 mod tenants;
+mod warnings;

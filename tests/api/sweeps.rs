@@ -273,6 +273,37 @@ async fn an_axis_pointer_that_names_no_input_is_refused_before_any_run_is_queued
     assert_eq!(app.get_json("/sweeps").await["sweeps"], json!([]));
 }
 
+/// The base inputs' own problems come in the same 422 as a refused axis pointer, not
+/// once it is fixed.
+#[tokio::test]
+async fn a_refused_axis_pointer_and_the_base_inputs_problems_come_in_one_422() {
+    let app = spawn_app_with_processes(vec![Arc::new(CantileverImpact)], |_| {}).await;
+    let mut body: Value =
+        serde_json::from_str(include_str!("../../examples/sweep-calibration.json")).unwrap();
+    body["axes"][0]["pointer"] = json!("/contact/rkk");
+    body["inputs"]["beam"]["density"] = json!(-1.0);
+    body["inputs"]["beam"]
+        .as_object_mut()
+        .unwrap()
+        .remove("young_modulus");
+    let response = app.post_sweep(&body).await;
+    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
+    let pointers: Vec<&str> = problem["errors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["pointer"].as_str().unwrap())
+        .collect();
+    for pointer in [
+        "/axes/0/pointer",
+        "/runs/0/inputs/beam/density",
+        "/runs/0/inputs/beam/young_modulus",
+    ] {
+        assert!(pointers.contains(&pointer), "{pointer}: {problem}");
+    }
+    assert_eq!(app.get_json("/sweeps").await["sweeps"], json!([]));
+}
+
 async fn dismissing_a_sweep_dismisses_its_queued_and_running_runs(backend: Backend) {
     let app = spawn_app_on(backend, |_| {}).await;
     let id = app

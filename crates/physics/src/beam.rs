@@ -6,7 +6,77 @@
 //! `n` are `2n` (w) and `2n + 1` (θ). Matrices are dense, row-major, over all DOFs;
 //! [`BeamModel::free_dofs`] lists the DOFs left free by the supports.
 
-use super::{InputIssue, require_non_negative, require_positive};
+use super::{InputIssue, number, require_non_negative, require_positive};
+
+/// A beam's widest plausible values, each `(field, lowest, highest, unit, why)`: far
+/// outside any structure (a value in the wrong unit, 1000 times off, stays inside them
+/// and gets a plausibility warning), and inside them every combination keeps the
+/// element matrices, the eigen-solver and the time step within the range of doubles.
+/// Outside, the modal analysis fails in ways that name no input (an overflowing mass
+/// matrix "not positive definite", an eigen-solver that does not converge, a run that
+/// diverges), so the value is refused at its own field, with the bound.
+pub const PLAUSIBLE_RANGES: [(&str, f64, f64, &str, &str); 5] = [
+    (
+        "length",
+        1e-6,
+        1e5,
+        "m",
+        "from a micro-cantilever to a hundred kilometres",
+    ),
+    (
+        "young_modulus",
+        1.0,
+        1e15,
+        "Pa",
+        "from a gel to a thousand times diamond's 1.2e12 Pa",
+    ),
+    ("density", 1e-3, 1e9, "kg/m³", "a model's lumped masses included"),
+    (
+        "section/outer_diameter",
+        1e-7,
+        1e3,
+        "m",
+        "from a fibre to a kilometre",
+    ),
+    (
+        "section/area",
+        1e-15,
+        1e6,
+        "m²",
+        "from a fibre's to a square kilometre",
+    ),
+];
+/// Widest second moment of area (m⁴), for explicit sections: those of the diameters of
+/// [`PLAUSIBLE_RANGES`].
+pub const INERTIA_RANGE: (f64, f64) = (1e-30, 1e12);
+/// Most added mass per unit length (kg/m).
+pub const MAX_ADDED_MASS_PER_LENGTH: f64 = 1e9;
+
+/// An issue at `field` when the finite positive `value` is outside `[low, high]`.
+fn require_within(
+    issues: &mut Vec<InputIssue>,
+    field: &str,
+    value: f64,
+    (low, high): (f64, f64),
+    unit: &str,
+    why: &str,
+) {
+    if !(value.is_finite() && value > 0.0) {
+        return; // refused as not a positive number already
+    }
+    if value < low || value > high {
+        issues.push(InputIssue::new(
+            field,
+            format!(
+                "must be between {} and {} {unit} ({why}; got {} {unit}): outside, the modal analysis \
+                 leaves the range of floating-point numbers",
+                number(low),
+                number(high),
+                number(value)
+            ),
+        ));
+    }
+}
 
 /// Cross-section of the beam.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,7 +127,10 @@ impl Section {
                 {
                     issues.push(InputIssue::new(
                         "section/inner_diameter",
-                        format!("must be smaller than the outer diameter ({outer_diameter} m)"),
+                        format!(
+                            "must be smaller than the outer diameter ({} m)",
+                            number(outer_diameter)
+                        ),
                     ));
                 }
             }
@@ -122,6 +195,40 @@ impl BeamSpec {
         require_positive(&mut issues, "density", self.density);
         require_non_negative(&mut issues, "added_mass_per_length", self.added_mass_per_length);
         self.section.validate(&mut issues);
+        let value = |field: &str| match (field, self.section) {
+            ("length", _) => Some(self.length),
+            ("young_modulus", _) => Some(self.young_modulus),
+            ("density", _) => Some(self.density),
+            ("section/outer_diameter", Section::Tube { outer_diameter, .. }) => Some(outer_diameter),
+            ("section/area", Section::Explicit { area, .. }) => Some(area),
+            _ => None,
+        };
+        for (field, low, high, unit, why) in PLAUSIBLE_RANGES {
+            if let Some(v) = value(field) {
+                require_within(&mut issues, field, v, (low, high), unit, why);
+            }
+        }
+        if let Section::Explicit { inertia, .. } = self.section {
+            require_within(
+                &mut issues,
+                "section/inertia",
+                inertia,
+                INERTIA_RANGE,
+                "m⁴",
+                "those of diameters from 1e-7 m to 1e3 m",
+            );
+        }
+        if self.added_mass_per_length.is_finite() && self.added_mass_per_length > MAX_ADDED_MASS_PER_LENGTH {
+            issues.push(InputIssue::new(
+                "added_mass_per_length",
+                format!(
+                    "must be at most {} kg/m (got {} kg/m): beyond, the modal analysis leaves the range of \
+                     floating-point numbers",
+                    number(MAX_ADDED_MASS_PER_LENGTH),
+                    number(self.added_mass_per_length)
+                ),
+            ));
+        }
         if !(1..=MAX_ELEMENTS).contains(&self.elements) {
             issues.push(InputIssue::new(
                 "elements",

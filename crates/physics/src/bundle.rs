@@ -14,7 +14,7 @@
 //! `pin_gap`).
 
 use super::contact::{Body, Contact};
-use super::{InputIssue, require_non_negative, require_positive};
+use super::{InputIssue, number, require_non_negative, require_positive};
 
 pub use super::random::{GapRng, ln, splitmix64};
 
@@ -250,7 +250,7 @@ impl BundleLayout {
         if !length_ok {
             issues.push(InputIssue::new(
                 "levels",
-                format!("cannot place levels on a pin of length {pin_length} m"),
+                format!("cannot place levels on a pin of length {} m", number(pin_length)),
             ));
         }
         let too_many = || format!("more than {MAX_CONTACTS} levels");
@@ -275,15 +275,20 @@ impl BundleLayout {
                 if heights[0] > pin_length {
                     issues.push(InputIssue::new(
                         "levels/first",
-                        format!("{first} m lies above the pin top ({pin_length} m)"),
+                        format!(
+                            "{} m lies above the pin top ({} m)",
+                            number(*first),
+                            number(pin_length)
+                        ),
                     ));
                 } else if heights[count - 1] > pin_length {
                     issues.push(InputIssue::new(
                         "levels/count",
                         format!(
                             "the last level, first + (count − 1)·spacing = {} m, lies above \
-                             the pin top ({pin_length} m)",
-                            heights[count - 1]
+                             the pin top ({} m)",
+                            number(heights[count - 1]),
+                            number(pin_length)
                         ),
                     ));
                 } else if heights.windows(2).any(|pair| pair[1] <= pair[0]) {
@@ -334,7 +339,7 @@ impl BundleLayout {
                     .iter()
                     .enumerate()
                     .filter(|(_, gap)| !gap.is_finite() || **gap < 0.0)
-                    .map(|(k, gap)| (k, format!("must be a finite gap ≥ 0 m (got {gap})")))
+                    .map(|(k, gap)| (k, format!("must be a finite gap ≥ 0 m (got {})", number(*gap))))
                     .collect();
                 push_list_issues(issues, "gaps/values", bad);
             }

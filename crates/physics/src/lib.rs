@@ -74,12 +74,30 @@ pub fn decimal(value: f64) -> f64 {
     format!("{value:.11e}").parse().unwrap_or(value)
 }
 
+/// `value` as text for a message: six significant digits at most (1.4, not
+/// 1.4000000000000001), plain between 1e-3 and 1e6 (0.0097, 1800), in scientific
+/// notation outside (2.1e11, 1e-300, 1e308), never hundreds of digits.
+pub fn number(value: f64) -> String {
+    if value == 0.0 || !value.is_finite() {
+        return format!("{value}");
+    }
+    let rounded: f64 = format!("{value:.5e}").parse().unwrap_or(value);
+    if (1e-3..1e6).contains(&rounded.abs()) {
+        format!("{rounded}")
+    } else {
+        format!("{rounded:e}")
+    }
+}
+
 /// Checks that `value` is finite and strictly positive; records an issue otherwise.
 pub fn require_positive(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
     if !value.is_finite() {
         issues.push(InputIssue::new(field, "must be a finite number"));
     } else if value <= 0.0 {
-        issues.push(InputIssue::new(field, format!("must be positive (got {value})")));
+        issues.push(InputIssue::new(
+            field,
+            format!("must be positive (got {})", number(value)),
+        ));
     }
 }
 
@@ -90,7 +108,35 @@ pub fn require_non_negative(issues: &mut Vec<InputIssue>, field: &str, value: f6
     } else if value < 0.0 {
         issues.push(InputIssue::new(
             field,
-            format!("must not be negative (got {value})"),
+            format!("must not be negative (got {})", number(value)),
         ));
+    }
+}
+
+#[cfg(test)]
+mod number_tests {
+    use super::number;
+
+    /// Messages print what a person would type: the shortest decimal of the value at six
+    /// significant digits, with an exponent only far from 1.
+    #[test]
+    fn numbers_print_at_sensible_precision() {
+        let cases = [
+            (0.1 + 0.2, "0.3"),
+            (1.4000000000000001, "1.4"),
+            (0.0097, "0.0097"),
+            (1800.0, "1800"),
+            (2.1e11, "2.1e11"),
+            (1e308, "1e308"),
+            (1e-300, "1e-300"),
+            (-0.5, "-0.5"),
+            (9.765914, "9.76591"),
+            (0.0, "0"),
+            (123456.7, "123457"),
+            (1234567.0, "1.23457e6"),
+        ];
+        for (value, expected) in cases {
+            assert_eq!(number(value), expected, "number({value:e})");
+        }
     }
 }

@@ -68,6 +68,10 @@ pub struct StatusInfo {
     pub finished: Option<String>,
     /// Last change of status, progress or message (RFC 3339, UTC).
     pub updated: String,
+    /// Plausibility warnings about the inputs, found when the job was submitted: valid
+    /// inputs that look like a mistake (a unit slip, nothing exciting the model, ...).
+    /// Empty with `"warnings": "off"` among the inputs.
+    pub warnings: Vec<crate::processes::Warning>,
     pub links: Vec<Link>,
 }
 
@@ -108,6 +112,7 @@ impl StatusInfo {
             started: job.started_at.map(rfc3339),
             finished: job.finished_at.map(rfc3339),
             updated: rfc3339(job.updated_at),
+            warnings: job.warnings.clone(),
             links,
         }
     }

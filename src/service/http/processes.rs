@@ -114,14 +114,20 @@ pub async fn execute(
             .await
             .map_err(|e| ApiError::Internal(format!("validation panicked: {e}")))?
     };
-    let estimate = validated.map_err(|invalid| Problem::invalid_inputs(&invalid))?;
+    let validated = validated.map_err(|invalid| Problem::invalid_inputs(&invalid))?;
     state
         .limits
-        .check(&estimate)
+        .check(&validated.estimate)
         .map_err(|refused| Problem::too_costly(&refused))?;
     let admission = state
         .queue
-        .enqueue(tenant.as_str(), &process_id, &inputs, state.max_queued_jobs)
+        .enqueue(
+            tenant.as_str(),
+            &process_id,
+            &inputs,
+            &validated.warnings,
+            state.max_queued_jobs,
+        )
         .await?;
     let job = match admission {
         Admission::Admitted(job) => job,

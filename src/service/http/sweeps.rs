@@ -73,6 +73,7 @@ pub async fn create(
         .map(|run| NewRun {
             inputs: run.inputs,
             invalid: run.invalid.as_ref().map(Problem::invalid_inputs),
+            warnings: run.warnings,
         })
         .collect();
     let admission = state

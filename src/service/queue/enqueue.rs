@@ -13,22 +13,25 @@ use crate::service::db::{TenantQueueLock, with_pool};
 
 impl JobQueue {
     /// Inserts an accepted job of `tenant` for `process_id` with its (already validated)
-    /// inputs, unless `tenant` already has `max_queued` accepted jobs.
+    /// inputs and their plausibility warnings, unless `tenant` already has `max_queued`
+    /// accepted jobs.
     pub async fn enqueue(
         &self,
         tenant: &str,
         process_id: &str,
         inputs: &serde_json::Value,
+        warnings: &[crate::processes::Warning],
         max_queued: Option<u64>,
     ) -> Result<Admission<JobRecord>, sqlx::Error> {
+        let warnings = serde_json::to_string(warnings).expect("warnings serialize");
         let id = uuid::Uuid::new_v4().to_string();
         let inserted: Option<JobRecord> = with_pool!(&self.db, pool => {
             let mut tx = pool.begin().await?;
             tx.lock_tenant_queue(tenant).await?;
             let inserted = sqlx::query_as(concat!(
                 "INSERT INTO jobs (id, tenant, process_id, inputs, status, progress, message, created_at, \
-                     updated_at, content_hash) \
-                 SELECT $1, $6, $2, $3, 'accepted', 0, 'queued', $4, $4, $5 \
+                     updated_at, content_hash, warnings) \
+                 SELECT $1, $6, $2, $3, 'accepted', 0, 'queued', $4, $4, $5, $8 \
                  WHERE $7 IS NULL OR (SELECT COUNT(*) FROM jobs WHERE tenant = $6 AND status = 'accepted') < $7 \
                  RETURNING ",
                 record_columns!()
@@ -40,6 +43,7 @@ impl JobQueue {
             .bind(content_hash(process_id, inputs))
             .bind(tenant)
             .bind(max_queued.map(|n| i64::try_from(n).unwrap_or(i64::MAX)))
+            .bind(&warnings)
             .fetch_optional(&mut *tx)
             .await?;
             tx.commit().await?;

@@ -112,6 +112,9 @@ pub struct JobRecord {
     pub attempt: i64,
     /// The sweep this job is a run of, if any.
     pub sweep_id: Option<String>,
+    /// Plausibility warnings about its inputs, found at submission (none for jobs
+    /// submitted before warnings existed).
+    pub warnings: Vec<crate::processes::Warning>,
 }
 
 /// Columns of [`JobRecord`] for `SELECT` and `RETURNING` clauses (a literal, for `concat!`:
@@ -119,7 +122,7 @@ pub struct JobRecord {
 macro_rules! record_columns {
     () => {
         "seq, id, process_id, status, progress, message, created_at, started_at, finished_at, \
-         updated_at, attempt, sweep_id"
+         updated_at, attempt, sweep_id, warnings"
     };
 }
 pub(crate) use record_columns;
@@ -150,6 +153,16 @@ where
             updated_at: row.try_get("updated_at")?,
             attempt: row.try_get("attempt")?,
             sweep_id: row.try_get("sweep_id")?,
+            warnings: {
+                let text: Option<String> = row.try_get("warnings")?;
+                match text {
+                    Some(text) => serde_json::from_str(&text).map_err(|e| sqlx::Error::ColumnDecode {
+                        index: "warnings".into(),
+                        source: Box::new(e),
+                    })?,
+                    None => Vec::new(),
+                }
+            },
         })
     }
 }

@@ -16,27 +16,28 @@ use crate::problem::Problem;
 use crate::service::db::{TenantQueueLock, with_pool};
 
 /// Inserts the runs of sweep $3 of process $1 of tenant $5 at time $2 from $4, a JSON
-/// array of `{id, run, inputs, hash, error, message}` (an `error` makes the run `failed`).
+/// array of `{id, run, inputs, hash, error, message, warnings}` (an `error` makes the run
+/// `failed`).
 const RUNS_SQLITE: &str = "\
     INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
-        finished_at, error, sweep_id, sweep_run, content_hash, tenant) \
+        finished_at, error, sweep_id, sweep_run, content_hash, tenant, warnings) \
     SELECT json_extract(value, '$.id'), $1, json_extract(value, '$.inputs'), \
         CASE WHEN json_extract(value, '$.error') IS NULL THEN 'accepted' ELSE 'failed' END, 0, \
         COALESCE(json_extract(value, '$.message'), \
             'queued (sweep run ' || json_extract(value, '$.run') || ')'), $2, $2, \
         CASE WHEN json_extract(value, '$.error') IS NULL THEN NULL ELSE $2 END, \
         json_extract(value, '$.error'), $3, json_extract(value, '$.run'), json_extract(value, '$.hash'), \
-        $5 \
+        $5, json_extract(value, '$.warnings') \
     FROM json_each($4) ORDER BY key";
 
 const RUNS_POSTGRES: &str = "\
     INSERT INTO jobs (id, process_id, inputs, status, progress, message, created_at, updated_at, \
-        finished_at, error, sweep_id, sweep_run, content_hash, tenant) \
+        finished_at, error, sweep_id, sweep_run, content_hash, tenant, warnings) \
     SELECT run->>'id', $1, run->>'inputs', \
         CASE WHEN run->>'error' IS NULL THEN 'accepted' ELSE 'failed' END, 0, \
         COALESCE(run->>'message', 'queued (sweep run ' || (run->>'run') || ')'), $2, $2, \
         CASE WHEN run->>'error' IS NULL THEN NULL ELSE $2 END, \
-        run->>'error', $3, CAST(run->>'run' AS BIGINT), run->>'hash', $5 \
+        run->>'error', $3, CAST(run->>'run' AS BIGINT), run->>'hash', $5, run->>'warnings' \
     FROM jsonb_array_elements(CAST($4 AS jsonb)) WITH ORDINALITY AS runs (run, position) \
     ORDER BY position";
 
@@ -63,6 +64,8 @@ pub struct NewRun {
     /// Why the process refuses these inputs: the run is recorded as `failed` with this
     /// problem and never queued.
     pub invalid: Option<Problem>,
+    /// Plausibility warnings about its inputs.
+    pub warnings: Vec<crate::processes::Warning>,
 }
 
 impl JobQueue {
@@ -89,6 +92,7 @@ impl JobQueue {
                     "hash": content_hash(sweep.process_id, &new.inputs),
                     "error": new.invalid.as_ref().map(|p| serde_json::to_string(p).unwrap_or_default()),
                     "message": new.invalid.as_ref().map(|p| format!("failed: invalid inputs: {}", p.detail)),
+                    "warnings": serde_json::to_string(&new.warnings).unwrap_or_default(),
                 })
             })
             .collect();

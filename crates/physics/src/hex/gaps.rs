@@ -21,7 +21,7 @@ use super::layout::HexBundle;
 use super::wrapper::Flat;
 use crate::bundle::GapDistribution;
 use crate::random::GapRng;
-use crate::{InputIssue, require_non_negative};
+use crate::{InputIssue, number, require_non_negative};
 
 /// Bad entries reported per list before summarizing the rest (as the row does).
 const MAX_LIST_ISSUES: usize = 10;
@@ -307,7 +307,7 @@ impl HexGaps {
                 for &k in bad.iter().take(MAX_LIST_ISSUES) {
                     issues.push(InputIssue::new(
                         format!("gaps/values/{k}"),
-                        format!("must be a finite gap ≥ 0 m (got {})", values[k]),
+                        format!("must be a finite gap ≥ 0 m (got {})", number(values[k])),
                     ));
                 }
                 if bad.len() > MAX_LIST_ISSUES {

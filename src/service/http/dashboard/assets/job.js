@@ -6,6 +6,8 @@
 // Every job with a quality section shows its verdict as a badge (with the reasons) next
 // to its numbers, and each force or displacement plot draws the history's peak-keeping
 // companion (`<name>_peaks`) with the samples, so the plotted peak is the reported one.
+// Plausibility warnings about the inputs (the status's, or a sweep run's results') are
+// listed under the status, each with the input it points at.
 
 import {FINISHED, ApiProblem, api, badge, card, download, errorBox, fmt, fmtElapsed, fmtTime, h, keyValueTable,
   leaves, poll, progressBar, replace, withUnit} from './util.js';
@@ -60,11 +62,20 @@ function statusTable(id, status) {
       ['Run time', fmtElapsed(status.started, status.finished) || '–'],
       ...(status.sweepID ? [['Sweep', h('a', {href: `/sweeps/${status.sweepID}`, class: 'mono'}, status.sweepID)]] : []),
     ], {'data-job-status': status.status}),
+    warningsList(status.warnings),
     h('p', {class: 'actions'},
       h('a', {href: `/jobs/${id}?f=json`}, 'status as JSON'),
       h('a', {href: `/ui/submit?from=${id}`}, 'edit and resubmit'),
       running ? dismiss : null),
   ];
+}
+
+/** Plausibility warnings (valid inputs that look like a mistake), each at its input; null without any. */
+function warningsList(warnings) {
+  if (!warnings || !warnings.length) return null;
+  return h('ul', {class: 'warnings', 'data-warnings': warnings.length},
+    warnings.map((w) => h('li', {'data-warning': w.code},
+      h('span', {class: 'badge doubtful'}, 'warning'), ' ', h('code', {}, w.pointer), ' ', w.message)));
 }
 
 function inputsCard(id, body) {
@@ -94,7 +105,9 @@ async function showResults(box, id, status) {
     return;
   }
   const sections = h('div');
-  replace(box, qualityCard(results), sections, downloadsCard(id, results));
+  const runWarnings = (status.warnings || []).length ? null : warningsList(results.warnings);
+  replace(box, runWarnings ? card('Warnings', runWarnings) : null, qualityCard(results), sections,
+    downloadsCard(id, results));
   if (status.processID === 'cantilever-impact') {
     await cantilever(sections, id, results);
   } else if (status.processID === 'bundle-dynamics') {

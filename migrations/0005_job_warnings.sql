@@ -1,0 +1,5 @@
+-- Plausibility warnings of a job's inputs (JSON array of {code, pointer, message}),
+-- found when it was submitted (a sweep run: when its sweep was) and shown with its
+-- status. NULL for jobs submitted before warnings existed.
+
+ALTER TABLE jobs ADD COLUMN warnings TEXT;
