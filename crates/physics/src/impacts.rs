@@ -140,17 +140,31 @@ impl ImpactClock {
         }
     }
 
-    /// The block of step n (step 0, the initial state, is in the first): once per step,
-    /// for [`ContactImpacts::record`].
+    /// The block of step n (step 0, the initial state, is in the first), for
+    /// [`ContactImpacts::record`]; [`ImpactClock::last_step`] says when it changes.
     pub fn block(&self, n: u64) -> usize {
         let k = n.saturating_sub(1).min(self.steps - 1);
         ((k as u128 * self.blocks as u128) / self.steps as u128) as usize
     }
 
-    /// Steps of block b: those with ⌊(n − 1)·B / N⌋ = b.
+    /// The last step of block b (u64::MAX for the last block, which takes any step past
+    /// the run's end): a step loop moves to the next block once past it.
+    pub fn last_step(&self, b: usize) -> u64 {
+        if b + 1 >= self.blocks {
+            u64::MAX
+        } else {
+            self.block_start(b + 1)
+        }
+    }
+
+    /// ⌈b·N / B⌉: the steps before block b (step n is in block ⌊(n − 1)·B / N⌋).
+    fn block_start(&self, b: usize) -> u64 {
+        (b as u128 * self.steps as u128).div_ceil(self.blocks as u128) as u64
+    }
+
+    /// Steps of block b.
     fn block_steps(&self, b: usize) -> u64 {
-        let first = |b: usize| (b as u128 * self.steps as u128).div_ceil(self.blocks as u128) as u64;
-        first(b + 1) - first(b)
+        self.block_start(b + 1) - self.block_start(b)
     }
 
     /// Whether a force loads the contact.
@@ -194,12 +208,30 @@ impl Default for Sums {
     }
 }
 
-/// The impact under way.
+/// The impact under way, its sums in forces (× Δt when it ends).
 #[derive(Debug, Clone, Copy)]
 struct Running {
+    first_step: u64,
     last_step: u64,
     block: usize,
-    impact: Impact,
+    peak_step: u64,
+    peak_force: f64,
+    /// Σ F and Σ (F − Kc δ) δ̇ over its weighed steps.
+    force: f64,
+    dissipation: f64,
+    rebounds: u64,
+    approach_velocity: f64,
+    energy: f64,
+}
+
+/// The loaded steps of the current block, in forces (× Δt when the block is left).
+#[derive(Debug, Clone, Copy, Default)]
+struct Loaded {
+    block: usize,
+    steps: u64,
+    force: f64,
+    force_squared: f64,
+    max_force: f64,
 }
 
 /// The per-impact table and the peak forces of a run, shared by its contacts.
@@ -320,6 +352,8 @@ pub struct ContactImpacts {
     contact: usize,
     inverse_mass: f64,
     running: Option<Running>,
+    /// The hot sums of the current block; `blocks` gets them when the block changes.
+    loaded: Loaded,
     blocks: Vec<Sums>,
 }
 
@@ -332,13 +366,15 @@ impl ContactImpacts {
             contact,
             inverse_mass,
             running: None,
+            loaded: Loaded::default(),
             blocks: vec![Sums::default(); blocks.max(1)],
         }
     }
 
     /// Step n (in block `block`, [`ImpactClock::block`]) of a closed contact: its force,
     /// its penetration now and a step before, and the power its dashpot dissipates (W).
-    /// Step 0 is the initial state (it can start an impact but weighs nothing).
+    /// Step 0 is the initial state (it can start an impact but weighs nothing). This runs
+    /// at every step of every closed contact: sums of forces only, Δt applied once.
     #[inline(always)]
     pub fn record(
         &mut self,
@@ -352,65 +388,87 @@ impl ContactImpacts {
         if !clock.loads(force) {
             return;
         }
-        let dt = clock.dt;
-        let (t, weight) = (n as f64 * dt, if n == 0 { 0.0 } else { dt });
-        let sums = &mut self.blocks[block];
-        sums.loaded_time += weight;
-        sums.impulse += force * weight;
-        sums.force_squared += force * force * weight;
-        sums.max_force = sums.max_force.max(force);
+        if block != self.loaded.block {
+            Self::flush(&mut self.blocks, &mut self.loaded, clock.dt);
+            self.loaded.block = block;
+        }
+        let loaded = &mut self.loaded;
+        let weighed = n != 0;
+        if weighed {
+            loaded.steps += 1;
+            loaded.force += force;
+            loaded.force_squared += force * force;
+        }
+        loaded.max_force = loaded.max_force.max(force);
         match &mut self.running {
             Some(running) if n - running.last_step <= clock.rest_steps => {
-                if n > running.last_step + 1 {
-                    running.impact.rebounds += 1;
-                }
+                running.rebounds += u64::from(n > running.last_step + 1);
                 running.last_step = n;
-                let impact = &mut running.impact;
-                impact.impulse += force * weight;
-                impact.dissipated += dissipation * weight;
-                impact.duration = t - impact.start;
-                if force > impact.peak_force {
-                    (impact.peak_force, impact.peak_time) = (force, t);
+                running.force += force;
+                running.dissipation += dissipation;
+                if force > running.peak_force {
+                    (running.peak_force, running.peak_step) = (force, n);
                 }
             }
             running => {
                 if let Some(done) = running.take() {
-                    Self::close(&mut self.blocks, log, done);
+                    Self::close(&mut self.blocks, log, clock.dt, self.contact, done);
                 }
-                let approach_velocity = if n == 0 {
-                    0.0
+                let approach_velocity = if weighed {
+                    (penetration - previous) / clock.dt
                 } else {
-                    (penetration - previous) / dt
+                    0.0
                 };
                 let energy = if self.inverse_mass > 0.0 {
                     0.5 * approach_velocity * approach_velocity / self.inverse_mass
                 } else {
                     0.0
                 };
-                let start = n.saturating_sub(1) as f64 * dt;
                 *running = Some(Running {
+                    first_step: n,
                     last_step: n,
                     block,
-                    impact: Impact {
-                        contact: self.contact,
-                        start,
-                        peak_time: t,
-                        peak_force: force,
-                        impulse: force * weight,
-                        duration: t - start,
-                        approach_velocity,
-                        rebounds: 0,
-                        dissipated: dissipation * weight,
-                        energy,
-                    },
+                    peak_step: n,
+                    peak_force: force,
+                    force: if weighed { force } else { 0.0 },
+                    dissipation: if weighed { dissipation } else { 0.0 },
+                    rebounds: 0,
+                    approach_velocity,
+                    energy,
                 });
             }
         }
     }
 
+    /// The current block's loaded steps into its sums.
+    fn flush(blocks: &mut [Sums], loaded: &mut Loaded, dt: f64) {
+        let sums = &mut blocks[loaded.block];
+        sums.loaded_time += loaded.steps as f64 * dt;
+        sums.impulse += loaded.force * dt;
+        sums.force_squared += loaded.force_squared * dt;
+        sums.max_force = sums.max_force.max(loaded.max_force);
+        *loaded = Loaded {
+            block: loaded.block,
+            ..Loaded::default()
+        };
+    }
+
     /// An impact that ended, into its start's block and the log.
-    fn close(blocks: &mut [Sums], log: &mut ImpactLog, done: Running) {
-        let (sums, impact) = (&mut blocks[done.block], done.impact);
+    fn close(blocks: &mut [Sums], log: &mut ImpactLog, dt: f64, contact: usize, done: Running) {
+        let start = done.first_step.saturating_sub(1) as f64 * dt;
+        let impact = Impact {
+            contact,
+            start,
+            peak_time: done.peak_step as f64 * dt,
+            peak_force: done.peak_force,
+            impulse: done.force * dt,
+            duration: done.last_step as f64 * dt - start,
+            approach_velocity: done.approach_velocity,
+            rebounds: done.rebounds,
+            dissipated: done.dissipation * dt,
+            energy: done.energy,
+        };
+        let sums = &mut blocks[done.block];
         sums.impacts += 1;
         sums.rebounds += impact.rebounds;
         sums.duration += impact.duration;
@@ -428,8 +486,9 @@ impl ContactImpacts {
 
     /// Ends the impact under way and summarises the contact over the run and its blocks.
     pub fn finish(mut self, clock: &ImpactClock, log: &mut ImpactLog) -> ImpactStatistics {
+        Self::flush(&mut self.blocks, &mut self.loaded, clock.dt);
         if let Some(done) = self.running.take() {
-            Self::close(&mut self.blocks, log, done);
+            Self::close(&mut self.blocks, log, clock.dt, self.contact, done);
         }
         let duration = clock.steps as f64 * clock.dt;
         let mut total = Sums::default();

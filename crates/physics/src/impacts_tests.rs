@@ -186,6 +186,27 @@ fn block_statistics_of_a_stationary_pulse_train_have_no_spread() {
 }
 
 #[test]
+fn blocks_change_after_their_last_step() {
+    for (steps, blocks) in [(400, 4), (10, 3), (7, 7), (1000, 1), (5, 100)] {
+        let counting = ImpactCounting {
+            blocks,
+            ..ImpactCounting::default()
+        };
+        let clock = ImpactClock::new(&counting, DT, steps);
+        let mut block = clock.block(1);
+        let mut last = clock.last_step(block);
+        assert_eq!(block, 0);
+        for n in 1..=steps + 3 {
+            if n > last {
+                block = clock.block(n);
+                last = clock.last_step(block);
+            }
+            assert_eq!(block, clock.block(n), "step {n} of {steps} in {blocks} blocks");
+        }
+    }
+}
+
+#[test]
 fn histograms_share_their_classes_and_count_every_impact() {
     // Peaks 10, 20, …, 100 N: 10 classes of 10 N, the largest in the last class.
     let mut forces = Vec::new();

@@ -37,7 +37,9 @@ pub(super) struct Recorder {
     pub impacts: Vec<ContactImpacts>,
     pub impact_clock: ImpactClock,
     pub impact_log: ImpactLog,
+    /// The block of the current step, and its last step.
     pub impact_block: usize,
+    impact_block_end: u64,
     /// The lanes of the recorded contacts, in the order of their histories.
     recorded: Vec<usize>,
     /// Per output height and line, the highest and lowest deflection since the last
@@ -82,6 +84,7 @@ impl Recorder {
             impact_clock: ImpactClock::new(counting, layout.dt, steps),
             impact_log: ImpactLog::new(layout.model.contacts.len(), counting),
             impact_block: 0,
+            impact_block_end: 0,
             max_penetration: vec![f64::NEG_INFINITY; lanes],
             force_peak: vec![0.0; lanes],
             wear: match layout.contact_model {
@@ -121,6 +124,15 @@ impl Recorder {
                 stats.max_force = state.contact_force[lane];
                 stats.max_force_time = 0.0;
             }
+        }
+    }
+
+    /// Step n's block for the impacts (a comparison, and a division when it changes).
+    #[inline(always)]
+    pub fn enter_step(&mut self, n: u64) {
+        if n > self.impact_block_end {
+            self.impact_block = self.impact_clock.block(n);
+            self.impact_block_end = self.impact_clock.last_step(self.impact_block);
         }
     }
 

@@ -353,7 +353,7 @@ impl<'m> Integrator<'m> {
     fn step_body<S: Simd, const PLANE: bool>(&mut self, simd: S, n: u64, vectors: usize) {
         let dt = self.layout.dt;
         let t = n as f64 * dt;
-        self.recorder.impact_block = self.recorder.impact_clock.block(n);
+        self.recorder.enter_step(n);
         let half = 0.5 * dt;
         // q ← qₙ₊₁ and v ← v½ (central difference), or vₙ₊₁ (Tchamwa).
         let first_half = match self.layout.scheme {
