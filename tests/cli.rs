@@ -64,21 +64,10 @@ fn a_bundle_run_writes_its_contact_statistics_as_csv() {
     )
     .unwrap();
     body["inputs"]["solver"]["duration"] = serde_json::json!(0.02);
-    let mut child = chocmodal()
-        .args(["run", "bundle-dynamics", "-", "--out"])
-        .arg(&out)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(body.to_string().as_bytes())
-        .unwrap();
-    let output = child.wait_with_output().unwrap();
+    let output = run_piped(
+        &["run", "bundle-dynamics", "-", "--out", out.to_str().unwrap()],
+        &body,
+    );
     assert!(
         output.status.success(),
         "{}",
@@ -183,8 +172,13 @@ fn a_database_password_in_the_environment_stays_out_of_the_help() {
 
 /// Runs `chocmodal run <process> -` with `body` on stdin.
 fn run_with_stdin(process: &str, body: &serde_json::Value) -> std::process::Output {
+    run_piped(&["run", process, "-"], body)
+}
+
+/// Runs `chocmodal <args>` with `body` on stdin.
+fn run_piped(args: &[&str], body: &serde_json::Value) -> std::process::Output {
     let mut child = chocmodal()
-        .args(["run", process, "-"])
+        .args(args)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -336,22 +330,7 @@ fn warnings_are_printed_on_stderr_and_the_run_succeeds() {
         serde_json::from_str(&std::fs::read_to_string(example()).unwrap()).unwrap();
     body["inputs"]["solver"]["duration"] = serde_json::json!(0.01);
     body["inputs"]["solver"]["check"] = serde_json::json!("none");
-    let run = |body: &serde_json::Value| {
-        let mut child = chocmodal()
-            .args(["run", "cantilever-impact", "-"])
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        child
-            .stdin
-            .take()
-            .unwrap()
-            .write_all(body.to_string().as_bytes())
-            .unwrap();
-        child.wait_with_output().unwrap()
-    };
+    let run = |body: &serde_json::Value| run_with_stdin("cantilever-impact", body);
     let quiet = run(&body);
     assert!(quiet.status.success());
     assert!(
