@@ -2,8 +2,8 @@
 //! `IMPACT`): counted with a force threshold and a rest time, tabulated one by one, and
 //! summarised per contact over the whole run and over equal blocks of it.
 //!
-//! The integrator feeds [`ContactImpacts::record`] at every step where a contact is
-//! closed (δ > 0); nothing is read back from thinned histories. Step n covers
+//! The integrator feeds [`ContactImpacts::record`] at every loaded step of a closed
+//! contact (δ > 0); nothing is read back from thinned histories. Step n covers
 //! ((n − 1)Δt, nΔt]. A step is *loaded* when the force is at least the threshold (with
 //! the default threshold 0, every closed step). An impact starts at a loaded step that
 //! follows at least `rest_time` of unloaded steps (or none at all); loaded steps that
@@ -133,7 +133,7 @@ impl ImpactClock {
         let rest = (counting.rest_time / dt * (1.0 - 1e-12)).ceil();
         Self {
             threshold: counting.force_threshold,
-            rest_steps: if rest >= 1.0 { rest as u64 } else { 1 },
+            rest_steps: rest.clamp(1.0, (1u64 << 62) as f64) as u64,
             dt,
             steps: steps.max(1),
             blocks: counting.blocks.max(1),
@@ -165,6 +165,12 @@ impl ImpactClock {
     /// Steps of block b.
     fn block_steps(&self, b: usize) -> u64 {
         self.block_start(b + 1) - self.block_start(b)
+    }
+
+    /// Whether every closed step is loaded (a threshold of 0: contact forces are never
+    /// negative), so that the impacts' sums are the contact's.
+    pub fn loads_every_closed_step(&self) -> bool {
+        self.threshold <= 0.0
     }
 
     /// Whether a force loads the contact.
@@ -208,30 +214,42 @@ impl Default for Sums {
     }
 }
 
-/// The impact under way, its sums in forces (× Δt when it ends).
-#[derive(Debug, Clone, Copy)]
-struct Running {
-    first_step: u64,
-    last_step: u64,
-    block: usize,
-    peak_step: u64,
-    peak_force: f64,
-    /// Σ F and Σ (F − Kc δ) δ̇ over its weighed steps.
-    force: f64,
-    dissipation: f64,
-    rebounds: u64,
-    approach_velocity: f64,
-    energy: f64,
-}
-
-/// The loaded steps of the current block, in forces (× Δt when the block is left).
+/// Sums over a contact's loaded steps since the start of the run (steps n ≥ 1), in
+/// forces and powers (× Δt when read).
 #[derive(Debug, Clone, Copy, Default)]
-struct Loaded {
-    block: usize,
+struct Cumulative {
     steps: u64,
     force: f64,
     force_squared: f64,
-    max_force: f64,
+    dissipation: f64,
+}
+
+/// What [`ContactImpacts::record`] touches at every loaded step, in one cache line.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+struct Hot {
+    /// The last loaded step ([`NEVER`] before the first).
+    last_step: u64,
+    sums: Cumulative,
+    /// The peak of the impact under way, and its step.
+    peak_force: f64,
+    peak_step: u64,
+}
+
+/// [`Hot::last_step`] of a contact never loaded: n − NEVER (wrapping) is about 2⁶³ for
+/// any step n, more than any rest ([`ImpactClock::new`] caps it below).
+const NEVER: u64 = 1 << 63;
+
+/// The impact under way (its peak is in [`Hot`]).
+#[derive(Debug, Clone, Copy)]
+struct Running {
+    first_step: u64,
+    block: usize,
+    rebounds: u64,
+    approach_velocity: f64,
+    energy: f64,
+    /// The cumulative sums before its first step.
+    before: Cumulative,
 }
 
 /// The per-impact table and the peak forces of a run, shared by its contacts.
@@ -349,12 +367,17 @@ pub struct ImpactHistogram {
 /// One contact's impacts as the run goes.
 #[derive(Debug, Clone)]
 pub struct ContactImpacts {
+    hot: Hot,
     contact: usize,
     inverse_mass: f64,
     running: Option<Running>,
-    /// The hot sums of the current block; `blocks` gets them when the block changes.
-    loaded: Loaded,
+    /// The current block, and the cumulative sums when it began.
+    block: usize,
+    block_start: Cumulative,
     blocks: Vec<Sums>,
+    /// The largest peak of the impacts that ended, and its step.
+    max_force: f64,
+    max_force_step: u64,
 }
 
 impl ContactImpacts {
@@ -363,18 +386,45 @@ impl ContactImpacts {
     /// modal masses), with `blocks` blocks.
     pub fn new(contact: usize, inverse_mass: f64, blocks: usize) -> Self {
         Self {
+            hot: Hot {
+                last_step: NEVER,
+                sums: Cumulative::default(),
+                peak_force: 0.0,
+                peak_step: 0,
+            },
             contact,
             inverse_mass,
             running: None,
-            loaded: Loaded::default(),
+            block: 0,
+            block_start: Cumulative::default(),
             blocks: vec![Sums::default(); blocks.max(1)],
+            max_force: 0.0,
+            max_force_step: 0,
         }
     }
 
-    /// Step n (in block `block`, [`ImpactClock::block`]) of a closed contact: its force,
-    /// its penetration now and a step before, and the power its dashpot dissipates (W).
-    /// Step 0 is the initial state (it can start an impact but weighs nothing). This runs
-    /// at every step of every closed contact: sums of forces only, Δt applied once.
+    /// The initial state of a contact closed at t = 0, with its force then: an impact
+    /// starts at t = 0 (no approach, no weight: step 1 is the first to count).
+    pub fn record_initial(&mut self, clock: &ImpactClock, force: f64) {
+        if !clock.loads(force) {
+            return;
+        }
+        self.running = Some(Running {
+            first_step: 0,
+            block: 0,
+            rebounds: 0,
+            approach_velocity: 0.0,
+            energy: 0.0,
+            before: self.hot.sums,
+        });
+        (self.hot.last_step, self.hot.peak_force, self.hot.peak_step) = (0, force, 0);
+    }
+
+    /// Loaded step n ≥ 1 (in block `block`, [`ImpactClock::block`]; the caller calls
+    /// [`ContactImpacts::enter_block`] as blocks change): its force, its penetration now
+    /// and a step before, and the power its dashpot dissipates (W). This runs at every
+    /// loaded step of every contact: four sums, a store and a comparison, and a branch
+    /// taken only when an impact or a rebound starts.
     #[inline(always)]
     pub fn record(
         &mut self,
@@ -385,92 +435,99 @@ impl ContactImpacts {
         (penetration, previous): (f64, f64),
         dissipation: f64,
     ) {
-        if !clock.loads(force) {
+        if n.wrapping_sub(self.hot.last_step) != 1 {
+            self.returns(clock, log, (n, block), force, penetration - previous);
+        }
+        let hot = &mut self.hot;
+        hot.last_step = n;
+        hot.sums.steps += 1;
+        hot.sums.force += force;
+        hot.sums.force_squared += force * force;
+        hot.sums.dissipation += dissipation;
+        if force > hot.peak_force {
+            (hot.peak_force, hot.peak_step) = (force, n);
+        }
+    }
+
+    /// Step n loads the contact after unloaded steps (or for the first time): a
+    /// rebound of the impact under way if they lasted less than the rest time, else a
+    /// new impact, approaching by `rise` over the step.
+    #[cold]
+    #[inline(never)]
+    fn returns(
+        &mut self,
+        clock: &ImpactClock,
+        log: &mut ImpactLog,
+        (n, block): (u64, usize),
+        force: f64,
+        rise: f64,
+    ) {
+        if let Some(running) = &mut self.running
+            && n.wrapping_sub(self.hot.last_step) <= clock.rest_steps
+        {
+            running.rebounds += 1;
             return;
         }
-        if block != self.loaded.block {
-            Self::flush(&mut self.blocks, &mut self.loaded, clock.dt);
-            self.loaded.block = block;
-        }
-        let loaded = &mut self.loaded;
-        let weighed = n != 0;
-        if weighed {
-            loaded.steps += 1;
-            loaded.force += force;
-            loaded.force_squared += force * force;
-        }
-        loaded.max_force = loaded.max_force.max(force);
-        match &mut self.running {
-            Some(running) if n - running.last_step <= clock.rest_steps => {
-                running.rebounds += u64::from(n > running.last_step + 1);
-                running.last_step = n;
-                running.force += force;
-                running.dissipation += dissipation;
-                if force > running.peak_force {
-                    (running.peak_force, running.peak_step) = (force, n);
-                }
-            }
-            running => {
-                if let Some(done) = running.take() {
-                    Self::close(&mut self.blocks, log, clock.dt, self.contact, done);
-                }
-                let approach_velocity = if weighed {
-                    (penetration - previous) / clock.dt
-                } else {
-                    0.0
-                };
-                let energy = if self.inverse_mass > 0.0 {
-                    0.5 * approach_velocity * approach_velocity / self.inverse_mass
-                } else {
-                    0.0
-                };
-                *running = Some(Running {
-                    first_step: n,
-                    last_step: n,
-                    block,
-                    peak_step: n,
-                    peak_force: force,
-                    force: if weighed { force } else { 0.0 },
-                    dissipation: if weighed { dissipation } else { 0.0 },
-                    rebounds: 0,
-                    approach_velocity,
-                    energy,
-                });
-            }
-        }
+        self.close(log, clock.dt);
+        let approach_velocity = rise / clock.dt;
+        let energy = if self.inverse_mass > 0.0 {
+            0.5 * approach_velocity * approach_velocity / self.inverse_mass
+        } else {
+            0.0
+        };
+        self.running = Some(Running {
+            first_step: n,
+            block,
+            rebounds: 0,
+            approach_velocity,
+            energy,
+            before: self.hot.sums,
+        });
+        (self.hot.peak_force, self.hot.peak_step) = (force, n);
+    }
+
+    /// Block `block` begins (before its first step is recorded).
+    pub fn enter_block(&mut self, block: usize, clock: &ImpactClock) {
+        self.flush(clock.dt);
+        self.block = block.min(self.blocks.len() - 1);
     }
 
     /// The current block's loaded steps into its sums.
-    fn flush(blocks: &mut [Sums], loaded: &mut Loaded, dt: f64) {
-        let sums = &mut blocks[loaded.block];
-        sums.loaded_time += loaded.steps as f64 * dt;
-        sums.impulse += loaded.force * dt;
-        sums.force_squared += loaded.force_squared * dt;
-        sums.max_force = sums.max_force.max(loaded.max_force);
-        *loaded = Loaded {
-            block: loaded.block,
-            ..Loaded::default()
-        };
+    fn flush(&mut self, dt: f64) {
+        let (now, start) = (self.hot.sums, self.block_start);
+        let sums = &mut self.blocks[self.block];
+        sums.loaded_time += (now.steps - start.steps) as f64 * dt;
+        sums.impulse += (now.force - start.force) * dt;
+        sums.force_squared += (now.force_squared - start.force_squared) * dt;
+        self.block_start = now;
     }
 
-    /// An impact that ended, into its start's block and the log.
-    fn close(blocks: &mut [Sums], log: &mut ImpactLog, dt: f64, contact: usize, done: Running) {
+    /// The impact under way, if any, ends: into its start's block and the log.
+    fn close(&mut self, log: &mut ImpactLog, dt: f64) {
+        let Some(done) = self.running.take() else {
+            return;
+        };
+        let (now, before) = (self.hot.sums, done.before);
         let start = done.first_step.saturating_sub(1) as f64 * dt;
         let impact = Impact {
-            contact,
+            contact: self.contact,
             start,
-            peak_time: done.peak_step as f64 * dt,
-            peak_force: done.peak_force,
-            impulse: done.force * dt,
-            duration: done.last_step as f64 * dt - start,
+            peak_time: self.hot.peak_step as f64 * dt,
+            peak_force: self.hot.peak_force,
+            impulse: (now.force - before.force) * dt,
+            duration: self.hot.last_step as f64 * dt - start,
             approach_velocity: done.approach_velocity,
             rebounds: done.rebounds,
-            dissipated: done.dissipation * dt,
+            dissipated: (now.dissipation - before.dissipation) * dt,
             energy: done.energy,
         };
-        let sums = &mut blocks[done.block];
+        if impact.peak_force > self.max_force {
+            (self.max_force, self.max_force_step) = (impact.peak_force, self.hot.peak_step);
+        }
+        let sums = &mut self.blocks[done.block];
         sums.impacts += 1;
         sums.rebounds += impact.rebounds;
+        sums.max_force = sums.max_force.max(impact.peak_force);
         sums.duration += impact.duration;
         sums.min_duration = sums.min_duration.min(impact.duration);
         sums.max_duration = sums.max_duration.max(impact.duration);
@@ -484,12 +541,28 @@ impl ContactImpacts {
         self.blocks.iter().map(|s| s.impacts).sum::<u64>() + u64::from(self.running.is_some())
     }
 
+    /// What [`ContactStatistics`](crate::ContactStatistics) sums over the closed steps,
+    /// when every closed step is loaded (a threshold of 0, [`ImpactClock::loads_every_closed_step`]):
+    /// contact time, impulse, and the largest force with its time (initial state
+    /// included).
+    pub fn closed_steps(&self, dt: f64) -> ClosedSteps {
+        let sums = self.hot.sums;
+        let (mut max_force, mut step) = (self.max_force, self.max_force_step);
+        if self.running.is_some() && self.hot.peak_force > max_force {
+            (max_force, step) = (self.hot.peak_force, self.hot.peak_step);
+        }
+        ClosedSteps {
+            contact_time: sums.steps as f64 * dt,
+            impulse: sums.force * dt,
+            max_force,
+            max_force_time: step as f64 * dt,
+        }
+    }
+
     /// Ends the impact under way and summarises the contact over the run and its blocks.
     pub fn finish(mut self, clock: &ImpactClock, log: &mut ImpactLog) -> ImpactStatistics {
-        Self::flush(&mut self.blocks, &mut self.loaded, clock.dt);
-        if let Some(done) = self.running.take() {
-            Self::close(&mut self.blocks, log, clock.dt, self.contact, done);
-        }
+        self.flush(clock.dt);
+        self.close(log, clock.dt);
         let duration = clock.steps as f64 * clock.dt;
         let mut total = Sums::default();
         for sums in &self.blocks {
@@ -534,6 +607,18 @@ impl ContactImpacts {
     }
 }
 
+/// A contact's closed steps over the run ([`ContactImpacts::closed_steps`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClosedSteps {
+    /// s.
+    pub contact_time: f64,
+    /// ∫ F dt (N·s).
+    pub impulse: f64,
+    /// N, and when (s).
+    pub max_force: f64,
+    pub max_force_time: f64,
+}
+
 /// a / b, 0 when b is 0.
 fn ratio(a: f64, b: f64) -> f64 {
     if b > 0.0 { a / b } else { 0.0 }
@@ -553,7 +638,8 @@ pub struct Summary {
     pub mean_force: f64,
     /// RMS force over the whole time, √(∫F² dt / T) (N).
     pub rms_force: f64,
-    /// Largest force (N).
+    /// Largest force (N): over a block, the largest peak of the impacts that started in
+    /// it (as they are counted there).
     pub max_force: f64,
     /// ∫ F dt over the loaded steps (N·s).
     pub impulse: f64,

@@ -13,13 +13,16 @@ fn feed(counting: &ImpactCounting, forces: &[f64]) -> (ImpactStatistics, ImpactT
     let clock = ImpactClock::new(counting, DT, forces.len() as u64);
     let mut log = ImpactLog::new(1, counting);
     let mut contact = ContactImpacts::new(0, 4.0, counting.blocks);
-    let mut previous = 0.0;
+    let (mut previous, mut block) = (0.0, 0);
     for (k, &force) in forces.iter().enumerate() {
         let penetration = force / STIFFNESS;
-        if force > 0.0 {
-            let n = k as u64 + 1;
-            let at = (n, clock.block(n));
-            contact.record(&clock, &mut log, at, force, (penetration, previous), 0.0);
+        let n = k as u64 + 1;
+        if clock.block(n) != block {
+            block = clock.block(n);
+            contact.enter_block(block, &clock);
+        }
+        if clock.loads(force) && force > 0.0 {
+            contact.record(&clock, &mut log, (n, block), force, (penetration, previous), 0.0);
         }
         previous = penetration;
     }
@@ -244,7 +247,8 @@ fn a_contact_closed_at_the_start_counts_one_impact_from_zero() {
     let clock = ImpactClock::new(&counting, DT, 10);
     let mut log = ImpactLog::new(1, &counting);
     let mut contact = ContactImpacts::new(0, 1.0, 1);
-    for n in 0..=3 {
+    contact.record_initial(&clock, 7.0);
+    for n in 1..=3 {
         contact.record(&clock, &mut log, (n, 0), 7.0, (1e-6, 1e-6), 0.5);
     }
     let statistics = contact.finish(&clock, &mut log);

@@ -186,3 +186,62 @@ fn with_no_threshold_or_rest_the_count_is_the_closures() {
     }
     assert!(total > 5, "the case must exercise contacts: {total}");
 }
+
+/// The contact statistics (contact time, impulse, largest force and its time) follow
+/// the force at every step whatever the counting: with a threshold of 0 they come from
+/// the impacts' sums, with a threshold from sums of their own, and both equal the force
+/// history sampled at every step (without dashpots a contact is closed exactly when its
+/// force is positive).
+#[test]
+fn the_contact_statistics_are_the_step_forces_with_or_without_a_threshold() {
+    let basis = basis(20, 8);
+    let mut model = shaken_two_pin_row(&basis);
+    for contact in &mut model.contacts {
+        contact.damping = 0.0;
+    }
+    let dt = 2e-6;
+    for threshold in [0.0, 5.0] {
+        let result = run(
+            &model,
+            &Settings {
+                output_interval: Some(dt),
+                impacts: ImpactCounting {
+                    force_threshold: threshold,
+                    ..ImpactCounting::default()
+                },
+                ..settings(Scheme::CentralDifference, dt, 0.03)
+            },
+        );
+        assert_eq!(result.time.len() as u64, result.steps + 1);
+        let mut closed = 0;
+        for (c, (forces, stats)) in result
+            .contact_forces
+            .iter()
+            .zip(&result.contact_statistics)
+            .enumerate()
+        {
+            let steps = forces[1..].iter().filter(|&&f| f > 0.0).count();
+            closed += steps;
+            let impulse: f64 = forces[1..].iter().map(|f| f * dt).sum();
+            let (k, max) = forces
+                .iter()
+                .enumerate()
+                .fold((0, 0.0), |(k, m), (i, &f)| if f > m { (i, f) } else { (k, m) });
+            let what = format!("threshold {threshold}, contact {c}");
+            assert!(
+                (stats.contact_time - steps as f64 * dt).abs() < 1e-9 * dt,
+                "{what}"
+            );
+            assert!(
+                (stats.impulse - impulse).abs() <= 1e-12 * impulse.max(1e-30),
+                "{what}"
+            );
+            assert_eq!(stats.max_force, max, "{what}");
+            assert_eq!(stats.max_force_time, result.time[k], "{what}");
+        }
+        assert!(
+            closed > 100,
+            "the case must exercise contacts: {closed} closed steps"
+        );
+    }
+}

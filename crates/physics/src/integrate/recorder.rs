@@ -116,8 +116,7 @@ impl Recorder {
             let penetration = state.penetration[lane];
             if penetration > 0.0 && (contact.stiffness > 0.0 || contact.damping > 0.0) {
                 let force = state.contact_force[lane];
-                let (clock, log) = (&self.impact_clock, &mut self.impact_log);
-                self.impacts[lane].record(clock, log, (0, 0), force, (penetration, penetration), 0.0);
+                self.impacts[lane].record_initial(&self.impact_clock, force);
                 let stats = &mut self.statistics[lane];
                 stats.first_impact_time = Some(0.0);
                 // The force at t = 0 counts for the peak, as it does in the samples.
@@ -131,8 +130,14 @@ impl Recorder {
     #[inline(always)]
     pub fn enter_step(&mut self, n: u64) {
         if n > self.impact_block_end {
-            self.impact_block = self.impact_clock.block(n);
-            self.impact_block_end = self.impact_clock.last_step(self.impact_block);
+            let block = self.impact_clock.block(n);
+            if block != self.impact_block {
+                for contact in &mut self.impacts {
+                    contact.enter_block(block, &self.impact_clock);
+                }
+            }
+            self.impact_block = block;
+            self.impact_block_end = self.impact_clock.last_step(block);
         }
     }
 
@@ -255,8 +260,16 @@ impl Recorder {
             .iter()
             .map(|&lane| {
                 let contact = impacts[lane as usize].take().expect("one contact per lane");
+                let stats = &mut self.statistics[lane as usize];
+                if clock.loads_every_closed_step() {
+                    let closed = contact.closed_steps(layout.dt);
+                    stats.contact_time = closed.contact_time;
+                    stats.impulse = closed.impulse;
+                    stats.max_force = closed.max_force;
+                    stats.max_force_time = closed.max_force_time;
+                }
                 let statistics = contact.finish(&clock, &mut log);
-                self.statistics[lane as usize].impacts = statistics.summary.impacts;
+                stats.impacts = statistics.summary.impacts;
                 statistics
             })
             .collect();
@@ -290,25 +303,36 @@ impl Recorder {
     }
 }
 
-/// A closed contact's step in its statistics: the first closure (`previous` ≤ 0, timed
-/// by linear interpolation of the penetration), contact time, impulse and the largest
-/// force.
+/// A closed contact's step n (of `dt`, in impact block `block`) in its statistics and
+/// impacts: the first closure (`previous` ≤ 0, timed by linear interpolation of the
+/// penetration), contact time, impulse, the largest force, and the impact counting.
+/// With a threshold of 0 every closed step is loaded, and the impacts' sums are the
+/// contact's: they are summed once, and [`Recorder::finish`] reads them.
 #[inline(always)]
 pub(super) fn record_closed_contact(
-    stats: &mut ContactStatistics,
-    (t, dt): (f64, f64),
+    (stats, impacts): (&mut ContactStatistics, &mut ContactImpacts),
+    (clock, log): (&ImpactClock, &mut ImpactLog),
+    (n, block, dt): (u64, usize, f64),
     (penetration, previous): (f64, f64),
-    force: f64,
+    (force, dissipation): (f64, f64),
 ) {
-    // (Impacts are counted by `ContactImpacts`, as `Settings::impacts` says.)
     if previous <= 0.0 && stats.first_impact_time.is_none() {
+        let t = n as f64 * dt;
         stats.first_impact_time = Some(t - dt * penetration / (penetration - previous));
+    }
+    let at = (n, block);
+    if clock.loads_every_closed_step() {
+        impacts.record(clock, log, at, force, (penetration, previous), dissipation);
+        return;
     }
     stats.contact_time += dt;
     stats.impulse += force * dt;
     if force > stats.max_force {
         stats.max_force = force;
-        stats.max_force_time = t;
+        stats.max_force_time = n as f64 * dt;
+    }
+    if clock.loads(force) {
+        impacts.record(clock, log, at, force, (penetration, previous), dissipation);
     }
 }
 

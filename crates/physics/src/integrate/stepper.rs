@@ -253,7 +253,7 @@ impl<'m> Integrator<'m> {
         let count = penetrations(simd, &layout.contacts, deflections, &layout.gaps, contact_state);
 
         let mut dissipation_power = 0.0;
-        let at = (n, recorder.impact_block);
+        let at = (n, recorder.impact_block, dt);
         let (lookahead, wall, n) = (layout.dashpot_lookahead, layout.wall_row, vectors);
         let shapes = S::as_simd_f64s(&layout.level_shapes).0;
         let (v, a) = (S::as_simd_f64s(&state.v).0, S::as_simd_f64s(&state.a).0);
@@ -293,8 +293,13 @@ impl<'m> Integrator<'m> {
                 peaks[j] = force;
             }
             if record && contact.active {
-                record_closed_contact(&mut statistics[j], (t, dt), (penetration, previous), force);
-                impacts[j].record(clock, log, at, force, (penetration, previous), dissipation);
+                record_closed_contact(
+                    (&mut statistics[j], &mut impacts[j]),
+                    (clock, &mut *log),
+                    at,
+                    (penetration, previous),
+                    (force, dissipation),
+                );
             }
         }
         for &j in closed {
@@ -497,7 +502,6 @@ fn plane_contact_forces<S: Simd>(
 ) -> f64 {
     let mut dissipation_power = 0.0;
     let (lookahead, wall, n, dt) = (layout.dashpot_lookahead, layout.wall_row, vectors, layout.dt);
-    let t = step as f64 * dt;
     let shapes = S::as_simd_f64s(&layout.level_shapes).0;
     let (v, a) = (S::as_simd_f64s(&state.v).0, S::as_simd_f64s(&state.a).0);
     let loads = S::as_mut_simd_f64s(&mut state.force).0;
@@ -512,7 +516,7 @@ fn plane_contact_forces<S: Simd>(
     let (peaks, wear) = (&mut recorder.force_peak[..lanes], &mut recorder.wear[..lanes]);
     let impacts = &mut recorder.impacts[..lanes];
     let (clock, log) = (&recorder.impact_clock, &mut recorder.impact_log);
-    let at = (step, recorder.impact_block);
+    let at = (step, recorder.impact_block, dt);
     let closed = &state.closed[..count];
     for &j in closed {
         let j = j as usize;
@@ -534,8 +538,13 @@ fn plane_contact_forces<S: Simd>(
                 peaks[j] = force;
             }
             if contact.active {
-                record_closed_contact(&mut statistics[j], (t, dt), (penetration, previous), force);
-                impacts[j].record(clock, log, at, force, (penetration, previous), dissipation);
+                record_closed_contact(
+                    (&mut statistics[j], &mut impacts[j]),
+                    (clock, &mut *log),
+                    at,
+                    (penetration, previous),
+                    (force, dissipation),
+                );
             }
             wear[j] += force * sliding.abs() * dt;
         }
