@@ -55,6 +55,7 @@ fn row_model<'a>(
         contacts: contacts.to_vec(),
         initial_tip_displacements: inputs.initial.tip_displacements.clone(),
         base_acceleration: inputs.excitation.base_acceleration.as_ref().map(|b| b.physics()),
+        walls: None,
         plane: None,
         point_forces: inputs
             .excitation

@@ -155,6 +155,7 @@ fn tip_model<'a>(inputs: &CantileverInputs, basis: &'a ModalBasis, contact_stiff
         }],
         initial_tip_displacements: vec![inputs.release.tip_displacement],
         base_acceleration: None,
+        walls: None,
         plane: None,
         point_forces: vec![],
     }

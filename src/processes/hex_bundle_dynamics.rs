@@ -70,6 +70,7 @@ fn plane_model<'a>(
         initial_tip_displacements: Vec::new(),
         base_acceleration: x.clone(),
         point_forces: Vec::new(),
+        walls: None,
         plane: Some(Plane {
             normals: normals.to_vec(),
             base_acceleration_y: y.clone(),

@@ -59,6 +59,21 @@ pub struct ModalBasis {
     /// Modal coordinates of the static tip-load shape scaled to a unit tip deflection;
     /// `None` when the top is fixed.
     unit_tip_release: Option<Vec<f64>>,
+    /// The static shape of a unit displacement of the top support relative to the foot;
+    /// `None` when the top is free.
+    transport: Option<SupportTransport>,
+}
+
+/// The quasi-static transport of a beam held at both ends when its top support moves
+/// by d relative to its foot: w = Ψ d + Σ φᵢ qᵢ, Ψ the static deflection under a unit
+/// top displacement (K Ψ = 0 away from the supports), and mode i loaded by −Γᴾᵢ d̈
+/// (code_aster's `MULT_APPUI`). Ψ vanishes at the foot and is 1 at the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SupportTransport {
+    /// Ψ over all DOFs (deflection and rotation at each node).
+    pub shape: Vec<f64>,
+    /// Γᴾᵢ = φᵢᵀ M Ψ per basis vector (kg^½).
+    pub participation: Vec<f64>,
 }
 
 impl ModalBasis {
@@ -171,8 +186,15 @@ impl ModalBasis {
             shapes,
             participation,
             unit_tip_release: None,
+            transport: None,
         };
         basis.unit_tip_release = basis.static_top_load_shape(&stiffness).map(|u| basis.project(&u));
+        basis.transport = basis.top_support_shape(&stiffness).map(|shape| SupportTransport {
+            participation: (0..total)
+                .map(|i| dot(basis.shape(i), &mat_vec(&basis.model.mass, dofs, &shape)))
+                .collect(),
+            shape,
+        });
         Ok(basis)
     }
 
@@ -203,6 +225,10 @@ impl ModalBasis {
             shapes: self.shapes[..m * dofs].to_vec(),
             participation: self.participation[..m].to_vec(),
             unit_tip_release: None,
+            transport: self.transport.as_ref().map(|t| SupportTransport {
+                shape: t.shape.clone(),
+                participation: t.participation[..m].to_vec(),
+            }),
         };
         basis.unit_tip_release = self.unit_tip_release.as_ref().map(|q| q[..m].to_vec());
         basis
@@ -267,6 +293,39 @@ impl ModalBasis {
     /// unit top deflection; `None` when the top deflection is fixed by its support.
     pub fn unit_tip_release(&self) -> Option<&[f64]> {
         self.unit_tip_release.as_deref()
+    }
+
+    /// The quasi-static transport by the top support, `None` when the top is free (or
+    /// the beam held by its top alone has no static shape: a mechanism).
+    pub fn support_transport(&self) -> Option<&SupportTransport> {
+        self.transport.as_ref()
+    }
+
+    /// Ψ(x): the transport's deflection at height `x` (m), 0 without one.
+    pub fn transport_at(&self, x: f64) -> f64 {
+        self.transport.as_ref().map_or(0.0, |t| {
+            let (first_dof, weights) = self.model.interpolation(x);
+            (0..4).map(|k| weights[k] * t.shape[first_dof + k]).sum()
+        })
+    }
+
+    /// Ψ: K_ff Ψ_f = −K_f,top for a unit top deflection (the foot's fixed DOFs and the
+    /// top's rotation, when clamped, held at 0); `None` when the top is free.
+    fn top_support_shape(&self, free_stiffness: &Mat<f64>) -> Option<Vec<f64>> {
+        let model = &self.model;
+        let (free, dofs, top_dof) = (&model.free_dofs, model.dof_count(), 2 * model.elements);
+        if free.contains(&top_dof) {
+            return None;
+        }
+        let llt = free_stiffness.llt(Side::Lower).ok()?;
+        let rhs = Mat::from_fn(free.len(), 1, |k, _| -model.stiffness[free[k] * dofs + top_dof]);
+        let solution = faer::linalg::solvers::Solve::solve(&llt, &rhs);
+        let mut full = vec![0.0; dofs];
+        full[top_dof] = 1.0;
+        for (k, &d) in free.iter().enumerate() {
+            full[d] = solution[(k, 0)];
+        }
+        full.iter().all(|v| v.is_finite()).then_some(full)
     }
 
     /// Solves K_ff u = e_top and scales u to a unit top deflection.
@@ -337,6 +396,49 @@ mod tests {
         }
         let f1 = basis.frequencies_hz()[0];
         assert!((f1 - 9.76591).abs() < 1e-4, "f1 = {f1} Hz vs public 9.76591 Hz");
+    }
+
+    /// The transport by the top support is the cubic static shape of a uniform beam
+    /// under a unit top displacement (w⁗ = 0 with the end conditions), which cubic
+    /// Hermite elements hold exactly: ξ pinned–pinned, (3ξ² − ξ³)/2 clamped–pinned,
+    /// (3ξ − ξ³)/2 pinned–clamped, 3ξ² − 2ξ³ clamped–clamped (ξ = x/L); none with a free
+    /// top.
+    #[test]
+    fn the_top_support_transport_is_the_static_cubic() {
+        type Cubic = fn(f64) -> f64;
+        let cases: [(Support, Support, Cubic); 4] = [
+            (Support::Pinned, Support::Pinned, |x| x),
+            (Support::Clamped, Support::Pinned, |x| {
+                (3.0 * x * x - x * x * x) / 2.0
+            }),
+            (Support::Pinned, Support::Clamped, |x| (3.0 * x - x * x * x) / 2.0),
+            (Support::Clamped, Support::Clamped, |x| {
+                3.0 * x * x - 2.0 * x * x * x
+            }),
+        ];
+        for (foot, top, expected) in cases {
+            let spec = BeamSpec {
+                foot,
+                top,
+                ..default_tube(12)
+            };
+            let basis = ModalBasis::compute(&spec, 4).unwrap();
+            for k in 0..=24 {
+                let x = spec.length * k as f64 / 24.0;
+                let psi = basis.transport_at(x);
+                assert!(
+                    (psi - expected(x / spec.length)).abs() < 1e-9,
+                    "{foot:?}–{top:?} at x = {x}: Ψ = {psi}"
+                );
+            }
+            assert_eq!(basis.support_transport().unwrap().participation.len(), 4);
+        }
+        assert!(
+            ModalBasis::compute(&default_tube(12), 4)
+                .unwrap()
+                .support_transport()
+                .is_none()
+        );
     }
 
     /// Hermite cubic elements converge in frequency as h⁴ (frequency error of the

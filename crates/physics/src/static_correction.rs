@@ -422,6 +422,7 @@ mod tests {
             contacts: vec![tip_wall(1e5)],
             initial_tip_displacements: vec![0.0],
             base_acceleration: None,
+            walls: None,
             plane: None,
             point_forces: vec![PointForce {
                 pin: 0,
@@ -494,6 +495,7 @@ mod tests {
                 amplitude: 20.0,
                 duration: 0.01,
             }),
+            walls: None,
             plane: None,
             point_forces: vec![],
         }

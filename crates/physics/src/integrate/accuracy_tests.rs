@@ -94,6 +94,7 @@ impl Row {
             contacts,
             initial_tip_displacements: vec![],
             base_acceleration: Some(self.excitation.clone()),
+            walls: None,
             plane: None,
             point_forces: vec![],
         }

@@ -19,6 +19,7 @@
 //! four slots and a normal per lane.
 
 use super::kernels::{ContactLanes, Lanes, LevelShapes, PlaneGroups};
+use super::walls::WallLayout;
 use super::{Model, Settings, StepSize};
 use crate::contact::{Body, Contact};
 use crate::stability::Scheme;
@@ -72,6 +73,8 @@ pub(super) struct Layout<'m> {
     /// Created energy allowed per joule involved before declaring divergence
     /// (see [`super::stepper`]'s divergence check).
     pub divergence_allowance: f64,
+    /// The walls' own motion; `None` when they move with the feet.
+    pub walls: Option<WallLayout>,
 }
 
 /// A contact as its lane needs it; offsets are in SIMD vectors.
@@ -273,6 +276,20 @@ impl<'m> Layout<'m> {
             lanes,
         );
         let r2 = (dt / critical).powi(2);
+        let gaps = contact_lanes.by_lane(&contacts.iter().map(|c| c.gap).collect::<Vec<_>>(), f64::INFINITY);
+        let walls = model.walls.as_ref().map(|_| {
+            let normals = model
+                .plane
+                .as_ref()
+                .map(|p| contact_lanes.by_lane(&p.normals, [0.0, 0.0]));
+            WallLayout::new(
+                model,
+                &contact_lanes,
+                normals.as_deref(),
+                &gaps,
+                (row, &settings.output_heights),
+            )
+        });
         Self {
             model,
             scheme: settings.scheme,
@@ -319,7 +336,7 @@ impl<'m> Layout<'m> {
             ),
             contact_model,
             wall_row: state_row(Body::Wall),
-            gaps: contact_lanes.by_lane(&contacts.iter().map(|c| c.gap).collect::<Vec<_>>(), f64::INFINITY),
+            gaps,
             contacts: contact_lanes,
             point_force_shapes: model.point_forces.iter().map(|f| shape_at(f.height)).collect(),
             output_offsets: output_levels
@@ -328,6 +345,7 @@ impl<'m> Layout<'m> {
                 .collect(),
             node_shapes,
             divergence_allowance: if r2 < 1.0 { 2.0 / (1.0 - r2) } else { 1.0 },
+            walls,
         }
     }
 

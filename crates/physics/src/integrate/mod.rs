@@ -43,7 +43,7 @@
 pub use super::statistics::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme};
 use crate::InputIssue;
 pub use crate::impacts::{ImpactCounting, ImpactHistogram, ImpactStatistics, ImpactTable};
-pub use model::{Model, NORMAL_LENGTH_TOLERANCE, Plane, Settings, TimeStep};
+pub use model::{Model, NORMAL_LENGTH_TOLERANCE, Plane, Settings, TimeStep, WallMotion};
 pub use plan::Plan;
 pub use quality::{Check, Quality, StepHalving, Verdict};
 pub use step_size::{DEFAULT_TOLERANCE, StepLimit, StepSize, critical_time_step};
@@ -161,6 +161,7 @@ mod recorder;
 mod state;
 pub mod step_size;
 mod stepper;
+mod walls;
 
 #[cfg(test)]
 mod tests;
@@ -173,3 +174,6 @@ mod plane_tests;
 
 #[cfg(test)]
 mod impact_tests;
+
+#[cfg(test)]
+mod wall_tests;

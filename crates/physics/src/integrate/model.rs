@@ -35,6 +35,53 @@ pub struct Model<'a> {
     /// `None`: the row (every pin bends along x only, every contact normal is +x).
     /// `Some`: every pin bends along x and y with the same modal basis.
     pub plane: Option<Plane>,
+    /// `None`: the walls (the wrapper in the plane) and the pins' top supports move with
+    /// the feet. `Some`: they have their own motion ([`WallMotion`]).
+    pub walls: Option<WallMotion>,
+}
+
+/// The walls' own motion (and the wrapper's in the plane), distinct from the feet's.
+///
+/// Every result stays in the frame of the feet: a deflection is relative to the feet,
+/// and a wall sits at d(t) = ∬ (a_wall − a_base) dt in it (starting at rest). Pins held
+/// at both ends have their top support on the walls: they are carried by the
+/// quasi-static transport Ψ(z) d(t) ([`crate::modal::SupportTransport`]), the modes
+/// loaded by −Γᴾ d̈ besides the base's −Γ a_base. Walls given the feet's acceleration
+/// give the results of walls moving with the feet, exactly. An acceleration left out is
+/// zero: that wall stands still in space along it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WallMotion {
+    /// Absolute acceleration along x (m/s²) of the walls on the left of their contacts
+    /// (the row's left wall), and of those on the right. The plane's wrapper is one
+    /// body: the two are the same there.
+    pub left_x: Option<BaseAcceleration>,
+    pub right_x: Option<BaseAcceleration>,
+    /// Along y, in the plane only.
+    pub y: Option<BaseAcceleration>,
+}
+
+impl WallMotion {
+    /// One motion for every wall, along x and y.
+    pub fn rigid(x: Option<BaseAcceleration>, y: Option<BaseAcceleration>) -> Self {
+        Self {
+            left_x: x.clone(),
+            right_x: x,
+            y,
+        }
+    }
+
+    /// The walls' accelerations relative to the feet at `t` (m/s²): left walls and
+    /// right walls along x, all walls along y.
+    pub fn relative(&self, model: &Model<'_>, t: f64) -> [f64; 3] {
+        let at = |a: Option<&BaseAcceleration>| a.map_or(0.0, |a| a.at(t));
+        let base_x = at(model.base_acceleration.as_ref());
+        let base_y = at(model.plane.as_ref().and_then(|p| p.base_acceleration_y.as_ref()));
+        [
+            at(self.left_x.as_ref()) - base_x,
+            at(self.right_x.as_ref()) - base_x,
+            at(self.y.as_ref()) - base_y,
+        ]
+    }
 }
 
 /// Pins bending in the transverse plane (x, y), each direction on the same basis.
@@ -161,7 +208,55 @@ impl Model<'_> {
                     .map(|i| i.within("plane")),
             );
         }
+        if let Some(walls) = &self.walls {
+            self.validate_walls(walls, &mut issues);
+        }
         issues
+    }
+
+    fn validate_walls(&self, walls: &WallMotion, issues: &mut Vec<InputIssue>) {
+        for (field, acceleration) in [
+            ("left_x", &walls.left_x),
+            ("right_x", &walls.right_x),
+            ("y", &walls.y),
+        ] {
+            if let Some(a) = acceleration {
+                issues.extend(
+                    a.validate()
+                        .into_iter()
+                        .map(|i| i.within(&format!("walls/{field}"))),
+                );
+            }
+        }
+        if self.plane.is_none() && walls.y.is_some() {
+            issues.push(InputIssue::new(
+                "walls/y",
+                "a row moves along x only: its walls have no y motion",
+            ));
+        }
+        if self.plane.is_some() && walls.left_x != walls.right_x {
+            issues.push(InputIssue::new(
+                "walls/right_x",
+                "the wrapper is one body: its walls share one motion",
+            ));
+        }
+        let model = self.basis.model();
+        let top_dof = 2 * model.elements;
+        if !model.free_dofs.contains(&top_dof) {
+            if self.basis.support_transport().is_none() {
+                issues.push(InputIssue::new(
+                    "walls",
+                    "the pins' top support cannot follow the walls: held by the top alone, \
+                     they have no static shape for it",
+                ));
+            } else if walls.left_x != walls.right_x {
+                issues.push(InputIssue::new(
+                    "walls/right_x",
+                    "pins held at both ends have their top support on the walls: the walls \
+                     need one motion",
+                ));
+            }
+        }
     }
 
     /// Deflection lines of the model: one per pin in the row, two (x then y) in the
@@ -337,6 +432,7 @@ mod tests {
                     values: vec![0.0, 1.0],
                 },
             }],
+            walls: None,
             plane: None,
         }
     }

@@ -58,6 +58,7 @@ fn shaken_row(basis: &ModalBasis, amplitude: f64) -> Model<'_> {
             duration: 0.01,
         }),
         point_forces: vec![],
+        walls: None,
         plane: None,
     }
 }
@@ -299,6 +300,7 @@ fn triangle(basis: &ModalBasis) -> Model<'_> {
             duration: 0.01,
         }),
         point_forces: vec![],
+        walls: None,
         plane: Some(Plane {
             normals,
             base_acceleration_y: Some(BaseAcceleration::Sine {
@@ -377,6 +379,7 @@ fn a_contact_between_two_pins_exchanges_equal_and_opposite_impulses() {
         initial_tip_displacements: vec![-3e-4, 3e-4],
         base_acceleration: None,
         point_forces: vec![],
+        walls: None,
         plane: Some(Plane {
             normals: vec![normal, [normal[1], normal[0]]],
             base_acceleration_y: None,
@@ -617,6 +620,7 @@ fn the_planes_critical_step_matches_brute_force_divergence() {
                 values: vec![-1.0, -1.0],
             },
         }],
+        walls: None,
         plane: Some(Plane {
             normals: vec![[0.6, 0.8]],
             base_acceleration_y: None,
@@ -624,6 +628,7 @@ fn the_planes_critical_step_matches_brute_force_divergence() {
     };
     let critical = critical_time_step(&model, Scheme::CentralDifference);
     let row = Model {
+        walls: None,
         plane: None,
         ..model.clone()
     };
@@ -708,6 +713,7 @@ fn large_plane_speed() {
             duration: 0.005,
         }),
         point_forces: vec![],
+        walls: None,
         plane: Some(Plane {
             normals,
             base_acceleration_y: Some(BaseAcceleration::HalfSine {
@@ -777,6 +783,7 @@ fn one_pin_in_the_wrapper_shaken_sixty_degrees_further_gives_the_turned_response
             duration: 0.01,
         }),
         point_forces: vec![],
+        walls: None,
         plane: Some(Plane {
             normals: geometry.iter().map(|c| [c.normal.x, c.normal.y]).collect(),
             base_acceleration_y: Some(BaseAcceleration::HalfSine {

@@ -219,11 +219,18 @@ impl Recorder {
             out: &mut self.node_deflections,
         });
         let element_length = layout.model.basis.model().element_length;
-        let (lanes, stride) = (layout.lanes, layout.stride);
+        let (lanes, stride, pins) = (layout.lanes, layout.stride, layout.model.pins);
+        // The transport by the top support, with walls that move (0 without).
+        let transport = |node: usize, line: usize| match (&layout.walls, &state.wall) {
+            (Some(walls), Some(wall)) if !walls.node_transport.is_empty() => {
+                walls.node_transport[node] * wall.transport()[usize::from(line >= pins)]
+            }
+            _ => 0.0,
+        };
         for node in 0..=layout.model.basis.model().elements {
             let (block, lane) = (node / lanes, node % lanes);
             for (p, extreme) in self.pin_extremes.iter_mut().enumerate() {
-                let w = self.node_deflections[(block * stride + 1 + p) * lanes + lane];
+                let w = self.node_deflections[(block * stride + 1 + p) * lanes + lane] + transport(node, p);
                 if w.abs() > extreme.max_abs_deflection {
                     *extreme = PinExtreme {
                         max_abs_deflection: w.abs(),

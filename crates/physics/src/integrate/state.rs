@@ -6,6 +6,7 @@ use pulp::Simd;
 
 use super::kernels;
 use super::layout::Layout;
+use super::walls::WallState;
 
 /// What a step advances.
 pub(super) struct State {
@@ -29,6 +30,8 @@ pub(super) struct State {
     /// and the groups holding them.
     pub closed: Vec<u32>,
     pub closed_groups: Vec<u64>,
+    /// The walls, when they have their own motion.
+    pub wall: Option<WallState>,
 }
 
 impl State {
@@ -58,6 +61,7 @@ impl State {
             level_deflections: vec![0.0; layout.level_deflections_len()],
             closed: vec![0; lanes],
             closed_groups: vec![0; groups.div_ceil(64)],
+            wall: layout.walls.as_ref().map(|walls| WallState::new(walls, model)),
         }
     }
 

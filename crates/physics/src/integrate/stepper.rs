@@ -46,6 +46,7 @@ use super::kernels::{
 use super::layout::{ContactModel, Layout, PlaneContacts};
 use super::recorder::{Powers, Recorder, record_closed_contact};
 use super::state::State;
+use super::walls::{WallLayout, WallState};
 use super::{Model, Settings, Simulation, SimulationError, StepSize, step_counts};
 use crate::stability::Scheme;
 
@@ -170,6 +171,9 @@ impl<'m> Integrator<'m> {
         recorder.record_initial_contacts(layout, state);
         let (base_x, base_y) = base_accelerations(model, 0.0);
         let (row, pins) = (layout.row, model.pins);
+        if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
+            wall.add_transport_loads(walls, &mut state.force, (row, pins));
+        }
         for (line, ((a, f), q)) in state
             .a
             .chunks_exact_mut(row)
@@ -225,6 +229,7 @@ impl<'m> Integrator<'m> {
         // Every contact, in vectors: penetration, its running maximum, a zero force
         // where open, and the list of closed contacts (about one in seven).
         std::mem::swap(&mut state.penetration, &mut state.previous_penetration);
+        let gaps = state.wall.as_ref().map_or(&layout.gaps, |wall| &wall.gaps);
         let contact_state = ContactState {
             now: &mut state.penetration,
             max: &mut recorder.max_penetration,
@@ -237,7 +242,7 @@ impl<'m> Integrator<'m> {
                 &layout.contacts,
                 &plane.groups,
                 deflections,
-                &layout.gaps,
+                gaps,
                 contact_state,
             );
             return plane_contact_forces(
@@ -250,9 +255,10 @@ impl<'m> Integrator<'m> {
                 vectors,
             );
         }
-        let count = penetrations(simd, &layout.contacts, deflections, &layout.gaps, contact_state);
+        let count = penetrations(simd, &layout.contacts, deflections, gaps, contact_state);
 
-        let mut dissipation_power = 0.0;
+        let (mut dissipation_power, mut wall_power) = (0.0, 0.0);
+        let walls = layout.walls.as_ref().zip(state.wall.as_ref());
         let at = (n, recorder.impact_block, dt);
         let (lookahead, wall, n) = (layout.dashpot_lookahead, layout.wall_row, vectors);
         let shapes = S::as_simd_f64s(&layout.level_shapes).0;
@@ -277,18 +283,26 @@ impl<'m> Integrator<'m> {
             let j = j as usize;
             let contact = lane_contacts[j];
             let (penetration, previous) = (now[j], before[j]);
-            let rate = if contact.dashpot > 0.0 {
+            let mut rate = if contact.dashpot > 0.0 {
                 let rows = |offset: usize| (&v[offset..], &a[offset..]);
                 let shape = &shapes[contact.shape..][..n];
                 penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead)
             } else {
                 0.0
             };
+            let wall_rate = match walls {
+                Some((layout, wall)) => wall.rate(layout, j),
+                None => 0.0,
+            };
+            if walls.is_some() {
+                rate += wall_rate;
+            }
             // The penetration is positive: F = max(0, Kc δ + cc δ̇) (`Contact::force`).
             let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
             forces[j] = force;
             let dissipation = (force - contact.stiffness * penetration) * rate;
             dissipation_power += dissipation;
+            wall_power += force * wall_rate;
             if record && force > peaks[j] {
                 peaks[j] = force;
             }
@@ -314,6 +328,9 @@ impl<'m> Integrator<'m> {
                     row_axpy(simd, force, shape, &mut loads[contact.right..]);
                 }
             }
+        }
+        if let Some(wall) = &mut state.wall {
+            wall.power = wall_power;
         }
         dissipation_power
     }
@@ -375,6 +392,9 @@ impl<'m> Integrator<'m> {
             S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
             S::as_simd_f64s(&state.a[..pins_state]).0,
         );
+        if let (Some(walls), Some(wall)) = (&self.layout.walls, &mut self.state.wall) {
+            wall.advance(walls, self.layout.model, (t, dt));
+        }
         let contact_damping = self.contact_forces_and_statistics::<S, PLANE>(simd, n, true, vectors);
         let Self {
             layout,
@@ -382,12 +402,19 @@ impl<'m> Integrator<'m> {
             recorder,
             ..
         } = self;
+        if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
+            transport_outputs(layout, walls, wall, &mut state.level_deflections);
+        }
         recorder.track_deflection_peaks(layout, &state.level_deflections);
         let second_half = match layout.scheme {
             Scheme::CentralDifference => half,
             Scheme::Tchamwa { .. } => 0.0,
         };
         let n = vectors;
+        // The transport's inertial load −Γᴾ r joins the contact and point loads.
+        if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
+            wall.add_transport_loads(walls, &mut state.force, (layout.row, layout.model.pins));
+        }
         let coefficients = ModalCoefficients::<S> {
             stiffness: &S::as_simd_f64s(&layout.omega_squared).0[..n],
             damping: &S::as_simd_f64s(&layout.damping).0[..n],
@@ -425,6 +452,9 @@ impl<'m> Integrator<'m> {
         for (point, shape) in layout.model.point_forces.iter().zip(&layout.point_force_shapes) {
             let velocity = kernels::dot(simd, shape, &state.v[point.pin * layout.row..][..layout.row]);
             external += point.force.at(t) * velocity;
+        }
+        if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
+            external += wall.power + wall.transport_power(walls, &state.v, (layout.row, layout.model.pins));
         }
         recorder.add_powers(
             half,
@@ -477,6 +507,19 @@ impl<'m> Integrator<'m> {
     }
 }
 
+/// Adds the transport Ψ(z) d to every line's deflection at the output heights (after
+/// the contacts read the level deflections: they see the modal part and the walls'
+/// relative position through their gaps).
+fn transport_outputs(layout: &Layout<'_>, walls: &WallLayout, wall: &WallState, deflections: &mut [f64]) {
+    let (pins, lanes) = (layout.model.pins, layout.lanes);
+    for (&offset, &psi) in layout.output_offsets.iter().zip(&walls.output_transport) {
+        for line in 0..layout.lines {
+            let d = wall.transport()[usize::from(line >= pins)];
+            deflections[offset + line * lanes] += psi * d;
+        }
+    }
+}
+
 /// The base acceleration (m/s²) at `t` along x and along y (0 for the row).
 fn base_accelerations(model: &Model<'_>, t: f64) -> (f64, f64) {
     let at = |base: Option<&crate::loads::BaseAcceleration>| base.map_or(0.0, |b| b.at(t));
@@ -500,7 +543,8 @@ fn plane_contact_forces<S: Simd>(
     (step, record): (u64, bool),
     vectors: usize,
 ) -> f64 {
-    let mut dissipation_power = 0.0;
+    let (mut dissipation_power, mut wall_power) = (0.0, 0.0);
+    let walls = layout.walls.as_ref().zip(state.wall.as_ref());
     let (lookahead, wall, n, dt) = (layout.dashpot_lookahead, layout.wall_row, vectors, layout.dt);
     let shapes = S::as_simd_f64s(&layout.level_shapes).0;
     let (v, a) = (S::as_simd_f64s(&state.v).0, S::as_simd_f64s(&state.a).0);
@@ -524,15 +568,22 @@ fn plane_contact_forces<S: Simd>(
         let (penetration, previous) = (now[j], before[j]);
         let rows = |offset: usize| (&v[offset..], &a[offset..]);
         let shape = &shapes[contact.shape..][..n];
-        let rate_x = penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead);
-        let rate_y = penetration_rate(simd, shape, rows(lane.left_y), rows(lane.right_y), lookahead);
+        let mut rate_x = penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead);
+        let mut rate_y = penetration_rate(simd, shape, rows(lane.left_y), rows(lane.right_y), lookahead);
         let [normal_x, normal_y] = lane.normal;
+        let mut wall_rate = 0.0;
+        if let Some((layout, wall)) = walls {
+            let [x, y] = wall.velocity_of(layout, j);
+            (rate_x, rate_y) = (rate_x + x, rate_y + y);
+            wall_rate = normal_x * x + normal_y * y;
+        }
         let rate = normal_x * rate_x + normal_y * rate_y;
         let sliding = normal_x * rate_y - normal_y * rate_x;
         let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
         forces[j] = force;
         let dissipation = (force - contact.stiffness * penetration) * rate;
         dissipation_power += dissipation;
+        wall_power += force * wall_rate;
         if record {
             if force > peaks[j] {
                 peaks[j] = force;
@@ -564,6 +615,9 @@ fn plane_contact_forces<S: Simd>(
                 row_axpy(simd, force * normal_y, shape, &mut loads[lane.right_y..]);
             }
         }
+    }
+    if let Some(wall) = &mut state.wall {
+        wall.power = wall_power;
     }
     dissipation_power
 }

@@ -23,6 +23,7 @@ pub(super) fn free_model(basis: &ModalBasis, xi: f64, tip: f64) -> Model<'_> {
         contacts: vec![],
         initial_tip_displacements: vec![tip],
         base_acceleration: None,
+        walls: None,
         plane: None,
         point_forces: vec![],
     }
@@ -263,6 +264,7 @@ pub(super) fn shaken_two_pin_row(basis: &ModalBasis) -> Model<'_> {
             amplitude: 20.0,
             duration: 0.01,
         }),
+        walls: None,
         plane: None,
         point_forces: vec![],
     }
