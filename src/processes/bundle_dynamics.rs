@@ -55,7 +55,7 @@ fn row_model<'a>(
         contacts: contacts.to_vec(),
         initial_tip_displacements: inputs.initial.tip_displacements.clone(),
         base_acceleration: inputs.excitation.base_acceleration.as_ref().map(|b| b.physics()),
-        walls: None,
+        walls: inputs.excitation.walls(),
         plane: None,
         point_forces: inputs
             .excitation
@@ -92,6 +92,29 @@ fn pointer_of(inputs: &BundleInputs, path: &str, pins_refused: bool) -> Option<S
             return None;
         }
         ("base_acceleration", _, _) => model_check::join("/inputs/excitation", path),
+        ("walls", None, "") => match inputs
+            .excitation
+            .wall_member(false)
+            .or(inputs.excitation.wall_member(true))
+        {
+            Some((member, _)) => format!("/inputs/excitation/{member}"),
+            None => "/inputs/excitation".to_owned(),
+        },
+        ("walls", None, rest) => {
+            let (channel, rest) = rest.split_once('/').unwrap_or((rest, ""));
+            let excitation = &inputs.excitation;
+            match excitation.wall_member(channel == "right_x") {
+                Some((_, signal)) if !rest.is_empty() && signal.is_checked_apart() => return None,
+                Some((member, _)) => model_check::join(&format!("/inputs/excitation/{member}"), rest),
+                // A wall following the feet: a problem of its signal is the base's,
+                // reported there; one of its motion, the other wall's.
+                None if !rest.is_empty() => return None,
+                None => match excitation.wall_member(channel != "right_x") {
+                    Some((member, _)) => format!("/inputs/excitation/{member}"),
+                    None => "/inputs/excitation".to_owned(),
+                },
+            }
+        }
         ("point_forces", Some(k), rest) => {
             model_check::join(&format!("/inputs/excitation/point_forces/{k}"), rest)
         }
@@ -324,10 +347,31 @@ impl Simulation for BundleDynamics {
         // A synthetic record is checked (and generated) as its inputs, a stored signal was
         // checked when uploaded; the model then sees their tables, whose problems would
         // only restate these.
-        if let Some(base) = &inputs.excitation.base_acceleration
-            && base.is_checked_apart()
-        {
-            errors.extend(at("/inputs/excitation/base_acceleration", base.validate()));
+        let excitation = &inputs.excitation;
+        for (member, signal) in [
+            ("base_acceleration", &excitation.base_acceleration),
+            ("wall_acceleration", &excitation.wall_acceleration),
+            ("left_wall_acceleration", &excitation.left_wall_acceleration),
+            ("right_wall_acceleration", &excitation.right_wall_acceleration),
+        ] {
+            if let Some(signal) = signal
+                && signal.is_checked_apart()
+            {
+                errors.extend(at(&format!("/inputs/excitation/{member}"), signal.validate()));
+            }
+        }
+        if excitation.wall_acceleration.is_some() {
+            for (member, signal) in [
+                ("left_wall_acceleration", &excitation.left_wall_acceleration),
+                ("right_wall_acceleration", &excitation.right_wall_acceleration),
+            ] {
+                if signal.is_some() {
+                    errors.push(FieldError::new(
+                        format!("/inputs/excitation/{member}"),
+                        "give either wall_acceleration (both walls) or each wall's own, not both",
+                    ));
+                }
+            }
         }
         let stand_in = StandIn::of(&inputs.pin);
         let pins_refused = errors.iter().any(|e| e.pointer.ends_with("/pins"));

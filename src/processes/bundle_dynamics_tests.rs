@@ -331,3 +331,83 @@ fn row17_envelopes_reach_the_reported_maxima_that_samples_miss() {
     }
     assert_eq!(force_peaks.time, forces.time);
 }
+
+/// Walls given the feet's acceleration move with the feet: the same results.
+#[test]
+fn walls_given_the_feet_motion_move_with_them() {
+    let base = json!({"type": "half_sine", "amplitude": 40.0, "duration": 0.01});
+    let row = |excitation: Value| {
+        json!({"pin": pin(), "bundle": {"pins": 3, "levels": [0.5, 1.0], "wall_gap": 1e-4, "pin_gap": 1e-4, "stiffness": 2e4, "damping": 2.0},
+               "excitation": excitation, "solver": {"duration": 0.05, "check": "none"}})
+    };
+    let still = run(&row(json!({"base_acceleration": base})));
+    let moving = run(&row(
+        json!({"base_acceleration": base, "wall_acceleration": base}),
+    ));
+    let one = run(&row(
+        json!({"base_acceleration": base, "left_wall_acceleration": base}),
+    ));
+    assert_eq!(still.document["contacts"], moving.document["contacts"]);
+    assert_eq!(still.histories, moving.histories);
+    assert_eq!(still.histories, one.histories);
+}
+
+/// Opposite motions of the two walls, the feet still: the row answers as its own
+/// mirror image (the first pin's deflection is minus the last's, the two wall contacts
+/// at a level carry the same force).
+#[test]
+fn opposite_wall_motions_give_a_mirror_symmetric_row() {
+    let inputs = json!({"pin": pin(), "bundle": {"pins": 2, "levels": [1.0], "wall_gap": 5e-5, "pin_gap": 5e-5, "stiffness": 2e4, "damping": 2.0},
+        "excitation": {
+            "left_wall_acceleration": {"type": "sine", "amplitude": 30.0, "frequency": 25.0, "cycles": 2.0},
+            "right_wall_acceleration": {"type": "sine", "amplitude": -30.0, "frequency": 25.0, "cycles": 2.0}},
+        "solver": {"duration": 0.1, "check": "none"}});
+    let result = run(&inputs);
+    let contacts = result.document["contacts"].as_array().unwrap();
+    let wall = |side: &str| {
+        contacts
+            .iter()
+            .position(|c| c[side] == "wall")
+            .unwrap_or_else(|| panic!("a contact with the {side} wall"))
+    };
+    let (left, right) = (wall("left"), wall("right"));
+    let forces = result
+        .histories
+        .iter()
+        .find(|h| h.name == "contact_forces")
+        .expect("forces");
+    let (l, r) = (
+        series(forces, &format!("c{left}")),
+        series(forces, &format!("c{right}")),
+    );
+    let top = l.iter().fold(0.0_f64, |m, f| m.max(*f));
+    assert!(top > 0.0, "the walls must hit the pins");
+    for (a, b) in l.iter().zip(r) {
+        assert!((a - b).abs() <= 1e-9 * top, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn wall_motions_are_exclusive_and_checked() {
+    let signal = json!({"type": "half_sine", "amplitude": 1.0, "duration": 0.01});
+    let row = |excitation: Value| {
+        json!({"pin": pin(), "bundle": {"pins": 2, "levels": [1.0], "wall_gap": 1e-4, "pin_gap": 1e-4, "stiffness": 2e4},
+               "excitation": excitation, "solver": {"duration": 0.02}})
+    };
+    assert_eq!(
+        pointers(&row(
+            json!({"wall_acceleration": signal, "right_wall_acceleration": signal})
+        )),
+        ["/inputs/excitation/right_wall_acceleration"]
+    );
+    assert_eq!(
+        pointers(&row(
+            json!({"wall_acceleration": {"type": "half_sine", "amplitude": 1.0, "duration": -1.0}})
+        )),
+        ["/inputs/excitation/wall_acceleration/duration"]
+    );
+    // Pins held at both ends have their top support on the walls: one motion for both.
+    let mut held = row(json!({"left_wall_acceleration": signal}));
+    held["pin"]["supports"] = json!({"foot": "clamped", "top": "pinned"});
+    assert_eq!(pointers(&held), ["/inputs/excitation/left_wall_acceleration"]);
+}

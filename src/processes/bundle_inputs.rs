@@ -304,8 +304,20 @@ pub struct InitialInput {
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ExcitationInput {
-    /// Acceleration of the wrapper (walls and pin feet), toward the right wall (m/s²).
+    /// Absolute acceleration of the pin feet, toward the right wall (m/s²); the walls
+    /// (and the top supports of pins held at both ends) move with the feet unless given
+    /// their own. Results are relative to the feet.
     pub base_acceleration: Option<BaseAccelerationInput>,
+    /// Absolute acceleration of both walls, toward the right wall (m/s²), when they do
+    /// not move with the feet (a wrapper hitting its neighbour). Pins held at both ends
+    /// have their top support on the walls and follow them quasi-statically. A signal of
+    /// amplitude 0 holds the walls still while the feet shake.
+    pub wall_acceleration: Option<BaseAccelerationInput>,
+    /// The left wall's own absolute acceleration (m/s²), instead of `wall_acceleration`;
+    /// the other wall follows the feet unless given too.
+    pub left_wall_acceleration: Option<BaseAccelerationInput>,
+    /// The right wall's own absolute acceleration (m/s²), instead of `wall_acceleration`.
+    pub right_wall_acceleration: Option<BaseAccelerationInput>,
     /// Force histories at a height of a pin, toward the right wall (N).
     #[serde(default)]
     pub point_forces: Vec<PointForceInput>,
@@ -314,12 +326,52 @@ pub struct ExcitationInput {
 impl ExcitationInput {
     /// The stored signals referenced, with their pointers.
     pub fn signal_references(&mut self) -> Vec<super::signal_input::SignalSlot<'_>> {
-        self.base_acceleration
-            .as_mut()
-            .and_then(BaseAccelerationInput::signal_mut)
-            .map(|signal| ("/inputs/excitation/base_acceleration".to_owned(), signal))
-            .into_iter()
-            .collect()
+        [
+            ("base_acceleration", &mut self.base_acceleration),
+            ("wall_acceleration", &mut self.wall_acceleration),
+            ("left_wall_acceleration", &mut self.left_wall_acceleration),
+            ("right_wall_acceleration", &mut self.right_wall_acceleration),
+        ]
+        .into_iter()
+        .filter_map(|(member, signal)| {
+            let signal = signal.as_mut()?.signal_mut()?;
+            Some((format!("/inputs/excitation/{member}"), signal))
+        })
+        .collect()
+    }
+
+    /// The member that gives the left (`right` false) or right wall's motion, if any.
+    pub fn wall_member(&self, right: bool) -> Option<(&'static str, &BaseAccelerationInput)> {
+        let own = if right {
+            ("right_wall_acceleration", &self.right_wall_acceleration)
+        } else {
+            ("left_wall_acceleration", &self.left_wall_acceleration)
+        };
+        match (own, &self.wall_acceleration) {
+            ((member, Some(signal)), _) => Some((member, signal)),
+            (_, Some(signal)) => Some(("wall_acceleration", signal)),
+            _ => None,
+        }
+    }
+
+    /// The walls' motion for the integrator: `None` when both follow the feet; a wall
+    /// not given follows the feet.
+    pub fn walls(&self) -> Option<crate::physics::integrate::WallMotion> {
+        let base = self
+            .base_acceleration
+            .as_ref()
+            .map(BaseAccelerationInput::physics);
+        let wall = |right| match self.wall_member(right) {
+            Some((_, signal)) => Some(signal.physics()),
+            None => base.clone(),
+        };
+        (self.wall_member(false).is_some() || self.wall_member(true).is_some()).then(|| {
+            crate::physics::integrate::WallMotion {
+                left_x: wall(false),
+                right_x: wall(true),
+                y: None,
+            }
+        })
     }
 }
 

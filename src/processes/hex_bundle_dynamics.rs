@@ -19,7 +19,7 @@ use super::warnings::Subject;
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::{Body as RowBody, Contact};
 use crate::physics::hex::{Aim, Body, HexBundle, HexContact, pair_count};
-use crate::physics::integrate::{self, Model, Plane, Settings, StepSize};
+use crate::physics::integrate::{self, Model, Plane, Settings, StepSize, WallMotion};
 use crate::physics::loads::BaseAcceleration;
 use crate::physics::modal::ModalBasis;
 use crate::physics::{InputIssue, require_non_negative};
@@ -36,6 +36,7 @@ pub struct Plan {
     contacts: Vec<Contact>,
     normals: Vec<[f64; 2]>,
     excitation: (Option<BaseAcceleration>, Option<BaseAcceleration>),
+    walls: Option<WallMotion>,
     basis: ModalBasis,
     settings: Settings,
     step: StepSize,
@@ -47,7 +48,7 @@ impl Plan {
             &self.inputs,
             self.bundle.pin_count(),
             (&self.contacts, &self.normals),
-            &self.excitation,
+            (&self.excitation, &self.walls),
             &self.basis,
         )
     }
@@ -59,7 +60,10 @@ fn plane_model<'a>(
     inputs: &HexInputs,
     pins: usize,
     (contacts, normals): (&[Contact], &[[f64; 2]]),
-    (x, y): &(Option<BaseAcceleration>, Option<BaseAcceleration>),
+    ((x, y), walls): (
+        &(Option<BaseAcceleration>, Option<BaseAcceleration>),
+        &Option<WallMotion>,
+    ),
     basis: &'a ModalBasis,
 ) -> Model<'a> {
     Model {
@@ -70,7 +74,7 @@ fn plane_model<'a>(
         initial_tip_displacements: Vec::new(),
         base_acceleration: x.clone(),
         point_forces: Vec::new(),
-        walls: None,
+        walls: walls.clone(),
         plane: Some(Plane {
             normals: normals.to_vec(),
             base_acceleration_y: y.clone(),
@@ -292,6 +296,7 @@ impl Simulation for HexBundleDynamics {
                 .map(|(pointer, reason)| FieldError::new(pointer, reason)),
         );
         let excitation = excitation(&inputs.excitation, &mut errors);
+        let walls = wrapper_motion(&inputs.excitation, &excitation, &mut errors);
         let solver = inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
         inputs::check_output_interval(inputs.output.interval, &mut errors);
         let counting = impact_report::counting(inputs.output.impacts.as_ref(), inputs.output.blocks);
@@ -354,9 +359,22 @@ impl Simulation for HexBundleDynamics {
             &inputs,
             bundle.pin_count(),
             (&contacts, &normals),
-            &excitation,
+            (&excitation, &walls),
             &basis,
         );
+        // The pins' supports the wrapper's motion cannot carry (a pin held by its top
+        // alone): the wrapper's, said at its member.
+        if walls.is_some() {
+            let refused: Vec<FieldError> = model
+                .validate()
+                .into_iter()
+                .filter(|issue| issue.field.starts_with("walls"))
+                .map(|issue| FieldError::new("/inputs/excitation/wrapper_acceleration", issue.reason))
+                .collect();
+            if !refused.is_empty() {
+                return Err(InvalidInputs(refused).into());
+            }
+        }
         let step = inputs::resolve_step(&model, &settings)?;
         Ok(Plan {
             inputs,
@@ -365,6 +383,7 @@ impl Simulation for HexBundleDynamics {
             contacts,
             normals,
             excitation,
+            walls,
             basis,
             settings,
             step,
@@ -568,61 +587,128 @@ fn excitation(
     input: &HexExcitationInput,
     errors: &mut Vec<FieldError>,
 ) -> (Option<BaseAcceleration>, Option<BaseAcceleration>) {
-    let component = |signal: &Option<super::bundle_inputs::BaseAccelerationInput>,
-                     pointer: &str,
+    plane_signal(
+        PlaneSignal {
+            single: ("base_acceleration", &input.base_acceleration),
+            direction: ("direction", input.direction, input.direction.is_some()),
+            x: ("base_acceleration_x", &input.base_acceleration_x),
+            y: ("base_acceleration_y", &input.base_acceleration_y),
+        },
+        errors,
+    )
+}
+
+/// The wrapper's own motion, when given: its (x, y) components as for the base (the
+/// direction defaults to the base's), a component not given following the feet.
+fn wrapper_motion(
+    input: &HexExcitationInput,
+    base: &(Option<BaseAcceleration>, Option<BaseAcceleration>),
+    errors: &mut Vec<FieldError>,
+) -> Option<WallMotion> {
+    let given = input.wrapper_acceleration.is_some()
+        || input.wrapper_acceleration_x.is_some()
+        || input.wrapper_acceleration_y.is_some();
+    if !given {
+        if input.wrapper_direction.is_some() {
+            errors.push(FieldError::new(
+                "/inputs/excitation/wrapper_direction",
+                "is the direction of wrapper_acceleration, which is not given",
+            ));
+        }
+        return None;
+    }
+    let (x, y) = plane_signal(
+        PlaneSignal {
+            single: ("wrapper_acceleration", &input.wrapper_acceleration),
+            direction: (
+                "wrapper_direction",
+                input.wrapper_direction.or(input.direction),
+                input.wrapper_direction.is_some(),
+            ),
+            x: ("wrapper_acceleration_x", &input.wrapper_acceleration_x),
+            y: ("wrapper_acceleration_y", &input.wrapper_acceleration_y),
+        },
+        errors,
+    );
+    let single = input.wrapper_acceleration.is_some();
+    let follow = |own: Option<BaseAcceleration>, given: bool, base: &Option<BaseAcceleration>| {
+        if given || single { own } else { base.clone() }
+    };
+    Some(WallMotion::rigid(
+        follow(x, input.wrapper_acceleration_x.is_some(), &base.0),
+        follow(y, input.wrapper_acceleration_y.is_some(), &base.1),
+    ))
+}
+
+/// A signal in the plane as the request gives it: one signal along a direction, or two
+/// components (member names and values).
+struct PlaneSignal<'a> {
+    single: (
+        &'static str,
+        &'a Option<super::bundle_inputs::BaseAccelerationInput>,
+    ),
+    /// The direction member, its value (given or defaulted), and whether it was given.
+    direction: (&'static str, Option<f64>, bool),
+    x: (
+        &'static str,
+        &'a Option<super::bundle_inputs::BaseAccelerationInput>,
+    ),
+    y: (
+        &'static str,
+        &'a Option<super::bundle_inputs::BaseAccelerationInput>,
+    ),
+}
+
+/// The (x, y) components of a [`PlaneSignal`], or the errors: one signal with an
+/// optional direction, or two components, not both.
+fn plane_signal(
+    signal: PlaneSignal<'_>,
+    errors: &mut Vec<FieldError>,
+) -> (Option<BaseAcceleration>, Option<BaseAcceleration>) {
+    let pointer = "/inputs/excitation";
+    let component = |(member, signal): (&str, &Option<super::bundle_inputs::BaseAccelerationInput>),
                      errors: &mut Vec<FieldError>| {
         signal.as_ref().map(|s| {
-            errors.extend(at(pointer, s.validate()));
+            errors.extend(at(&format!("{pointer}/{member}"), s.validate()));
             s.physics()
         })
     };
-    let pointer = "/inputs/excitation";
-    let single = component(
-        &input.base_acceleration,
-        &format!("{pointer}/base_acceleration"),
-        errors,
-    );
-    let x = component(
-        &input.base_acceleration_x,
-        &format!("{pointer}/base_acceleration_x"),
-        errors,
-    );
-    let y = component(
-        &input.base_acceleration_y,
-        &format!("{pointer}/base_acceleration_y"),
-        errors,
-    );
-    if let Some(direction) = input.direction
+    let single = component(signal.single, errors);
+    let x = component(signal.x, errors);
+    let y = component(signal.y, errors);
+    let (direction_member, direction, direction_given) = signal.direction;
+    if let Some(direction) = direction
         && !direction.is_finite()
     {
         errors.push(FieldError::new(
-            format!("{pointer}/direction"),
+            format!("{pointer}/{direction_member}"),
             "must be a finite angle in degrees",
         ));
     }
+    let (single_member, x_member, y_member) = (signal.single.0, signal.x.0, signal.y.0);
     match single {
-        Some(signal) => {
+        Some(one) => {
             if x.is_some() || y.is_some() {
-                let field = if x.is_some() {
-                    "base_acceleration_x"
-                } else {
-                    "base_acceleration_y"
-                };
+                let field = if x.is_some() { x_member } else { y_member };
                 errors.push(FieldError::new(
                     format!("{pointer}/{field}"),
-                    "give either base_acceleration (with direction) or the components base_acceleration_x \
-                     and base_acceleration_y, not both",
+                    format!(
+                        "give either {single_member} (with {direction_member}) or the components \
+                         {x_member} and {y_member}, not both"
+                    ),
                 ));
             }
-            let angle = input.direction.unwrap_or(0.0).to_radians();
-            (Some(signal.scaled(angle.cos())), Some(signal.scaled(angle.sin())))
+            let angle = direction.unwrap_or(0.0).to_radians();
+            (Some(one.scaled(angle.cos())), Some(one.scaled(angle.sin())))
         }
         None => {
-            if input.direction.is_some() {
+            if direction_given {
                 errors.push(FieldError::new(
-                    format!("{pointer}/direction"),
-                    "is the direction of base_acceleration, which is not given (the components \
-                     base_acceleration_x and base_acceleration_y need none)",
+                    format!("{pointer}/{direction_member}"),
+                    format!(
+                        "is the direction of {single_member}, which is not given (the components \
+                         {x_member} and {y_member} need none)"
+                    ),
                 ));
             }
             (x, y)

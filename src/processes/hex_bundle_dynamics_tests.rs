@@ -361,3 +361,67 @@ fn bad_counting_settings_are_refused_at_their_pointers() {
         assert!(pointers.contains(&pointer), "{pointer} in {errors:?}");
     }
 }
+
+/// A wrapper given the feet's acceleration (one signal along the same direction, or its
+/// two components) moves with the feet: the same results, contact by contact.
+#[test]
+fn a_wrapper_given_the_feet_motion_moves_with_them() {
+    let still = run(&inputs());
+    let excitation = &inputs()["excitation"];
+    let along = with(
+        inputs(),
+        "/excitation/wrapper_acceleration",
+        excitation["base_acceleration"].clone(),
+    );
+    let moving = run(&along);
+    assert_eq!(still.document["contacts"], moving.document["contacts"]);
+    assert_eq!(still.histories, moving.histories);
+}
+
+/// A wrapper on its own motion changes the contacts (here the wrapper shaken across
+/// while the feet stay still), the energy balance still closing with its work.
+#[test]
+fn a_wrapper_on_its_own_motion_drives_the_bundle_through_the_walls() {
+    let mut shaken = with(
+        inputs(),
+        "/excitation",
+        json!({"wrapper_acceleration": {"type": "half_sine", "amplitude": 50.0, "duration": 0.01},
+               "wrapper_direction": 10.0}),
+    );
+    shaken["solver"]["duration"] = json!(0.03);
+    let result = run(&shaken);
+    let walls: f64 = contacts(&result.document)
+        .iter()
+        .filter(|c| c["touched_flat"].is_number())
+        .map(|c| c["impulse"].as_f64().unwrap())
+        .sum();
+    assert!(walls > 0.0, "the wrapper must hit the pins");
+    let energy = &result.document["energy"];
+    let relative = energy["relative_residual"].as_f64().unwrap();
+    assert!(relative < 1e-2, "energy residual {relative}: {energy}");
+}
+
+#[test]
+fn wrapper_motion_forms_are_exclusive_and_checked() {
+    let both = with(
+        with(
+            inputs(),
+            "/excitation/wrapper_acceleration",
+            json!({"type": "half_sine", "amplitude": 1.0, "duration": 0.01}),
+        ),
+        "/excitation/wrapper_acceleration_x",
+        json!({"type": "half_sine", "amplitude": 1.0, "duration": 0.01}),
+    );
+    let pointers: Vec<String> = errors(&both).into_iter().map(|(p, _)| p).collect();
+    assert_eq!(pointers, ["/inputs/excitation/wrapper_acceleration_x"]);
+    let orphan = with(inputs(), "/excitation/wrapper_direction", json!(30.0));
+    let pointers: Vec<String> = errors(&orphan).into_iter().map(|(p, _)| p).collect();
+    assert_eq!(pointers, ["/inputs/excitation/wrapper_direction"]);
+    let bad = with(
+        inputs(),
+        "/excitation/wrapper_acceleration",
+        json!({"type": "half_sine", "amplitude": 1.0, "duration": -0.01}),
+    );
+    let pointers: Vec<String> = errors(&bad).into_iter().map(|(p, _)| p).collect();
+    assert_eq!(pointers, ["/inputs/excitation/wrapper_acceleration/duration"]);
+}

@@ -157,8 +157,9 @@ pub struct OffsetInput {
     pub distance: f64,
 }
 
-/// Acceleration of the wrapper and of every pin foot in the transverse plane: one
-/// signal along `direction`, or two components.
+/// Acceleration of every pin foot in the transverse plane (one signal along `direction`,
+/// or two components), and of the wrapper, which moves with the feet unless given its
+/// own (`wrapper_acceleration…`). Results are relative to the feet.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HexExcitationInput {
@@ -171,6 +172,19 @@ pub struct HexExcitationInput {
     pub base_acceleration_x: Option<BaseAccelerationInput>,
     /// Component along y (m/s²), instead of `base_acceleration`.
     pub base_acceleration_y: Option<BaseAccelerationInput>,
+    /// The wrapper's own absolute acceleration (m/s²) along `wrapper_direction`, when it
+    /// does not move with the pin feet (hitting its neighbour). Pins held at both ends
+    /// have their top support on it and follow it quasi-statically. Results are relative
+    /// to the feet.
+    pub wrapper_acceleration: Option<BaseAccelerationInput>,
+    /// Direction of `wrapper_acceleration` (degrees, counter-clockwise from +x); default
+    /// `direction`.
+    pub wrapper_direction: Option<f64>,
+    /// The wrapper's own acceleration along x (m/s²), instead of `wrapper_acceleration`;
+    /// a component not given follows the feet.
+    pub wrapper_acceleration_x: Option<BaseAccelerationInput>,
+    /// Along y (m/s²), instead of `wrapper_acceleration`.
+    pub wrapper_acceleration_y: Option<BaseAccelerationInput>,
 }
 
 impl HexExcitationInput {
@@ -180,6 +194,9 @@ impl HexExcitationInput {
             ("base_acceleration", &mut self.base_acceleration),
             ("base_acceleration_x", &mut self.base_acceleration_x),
             ("base_acceleration_y", &mut self.base_acceleration_y),
+            ("wrapper_acceleration", &mut self.wrapper_acceleration),
+            ("wrapper_acceleration_x", &mut self.wrapper_acceleration_x),
+            ("wrapper_acceleration_y", &mut self.wrapper_acceleration_y),
         ]
         .into_iter()
         .filter_map(|(member, signal)| {
