@@ -372,7 +372,7 @@ impl Simulation for HexBundleDynamics {
                 .map(|issue| FieldError::new("/inputs/excitation/wrapper_acceleration", issue.reason))
                 .collect();
             if !refused.is_empty() {
-                return Err(InvalidInputs(refused).into());
+                return Err(InvalidInputs(refused));
             }
         }
         let step = inputs::resolve_step(&model, &settings)?;
