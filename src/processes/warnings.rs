@@ -48,6 +48,9 @@ const LARGE_DIAMETER: f64 = 0.1;
 /// Length above which a slenderness above [`MAX_SLENDERNESS`] is blamed on the length
 /// rather than on the diameter (m).
 const LONG_PIN: f64 = 10.0;
+/// Largest ratio of the critical steps without and with the static correction before
+/// [`WarningCode::CostlyStaticCorrection`].
+const MAX_CORRECTION_COST: f64 = 4.0;
 /// Most gap warnings of one run (one per input field).
 const MAX_GAP_WARNINGS: usize = 5;
 
@@ -71,6 +74,9 @@ pub enum WarningCode {
     NothingExcites,
     /// More than 1e8 time steps in the run.
     ManySteps,
+    /// The static correction's pseudo-modes make the critical step over 4 times smaller
+    /// than the eigenmodes' alone (contacts at many heights).
+    CostlyStaticCorrection,
 }
 
 /// A plausibility note about valid inputs: where (JSON pointer into the request body)
@@ -159,6 +165,7 @@ impl Subject<'_> {
                 .is_some_and(|plane| plane.base_acceleration_y.is_some())
             || !model.point_forces.is_empty()
             || model.initial_tip_displacements.iter().any(|u| *u != 0.0)
+            || model.walls.is_some()
     }
 }
 
@@ -290,6 +297,10 @@ pub fn assess(subject: &Subject<'_>, steps: f64) -> Vec<Warning> {
         ));
     }
 
+    if let Some(warning) = static_correction_cost(subject) {
+        warnings.push(warning);
+    }
+
     if steps > MAX_STEPS {
         warnings.push(Warning::new(
             WarningCode::ManySteps,
@@ -302,6 +313,37 @@ pub fn assess(subject: &Subject<'_>, steps: f64) -> Vec<Warning> {
         ));
     }
     warnings
+}
+
+/// The critical step of the model with its pseudo-modes against its eigenmodes alone:
+/// a warning when they make it over [`MAX_CORRECTION_COST`] times smaller.
+fn static_correction_cost(subject: &Subject<'_>) -> Option<Warning> {
+    use crate::physics::integrate::critical_time_step;
+    use crate::physics::stability::Scheme;
+    let correction = subject.basis().static_correction()?;
+    let modes_only = subject.basis().without_static_correction();
+    let lean = Model {
+        basis: &modes_only,
+        damping_ratios: subject.model.damping_ratios[..modes_only.modes()].to_vec(),
+        ..subject.model.clone()
+    };
+    let scheme = Scheme::CentralDifference;
+    let ratio = critical_time_step(&lean, scheme) / critical_time_step(&subject.model, scheme);
+    (ratio > MAX_CORRECTION_COST).then(|| {
+        let top = subject.basis().frequencies_hz().last().copied().unwrap_or(0.0);
+        Warning::new(
+            WarningCode::CostlyStaticCorrection,
+            format!("{}/static_correction", subject.pin_pointer),
+            format!(
+                "the static correction adds {} pseudo-modes (one per contact height, up to {} Hz): \
+                 the critical time step is {} times smaller than with the modes alone, and the run as \
+                 much longer; with contacts at this many heights, \"none\" may be the better trade",
+                correction.heights.len(),
+                number(top),
+                number(ratio)
+            ),
+        )
+    })
 }
 
 /// One warning per input field that holds gaps larger than the pin diameter (at most

@@ -443,3 +443,47 @@ async fn sweep_runs_show_their_warnings_unless_the_base_inputs_turn_them_off() {
     assert_eq!(runs.len(), 2, "{jobs}");
     assert!(runs.iter().all(|run| warnings(run).is_empty()), "{runs:?}");
 }
+
+/// The hexagonal bundle with its default static correction: a pseudo-mode per contact
+/// level (24 here, a level every H/12, two per element) stiffer than every eigenmode makes the critical
+/// step many times smaller: a warning at `pin/static_correction` saying by how much;
+/// none with the correction off (the shipped hex217 example checks that side).
+#[tokio::test]
+async fn a_static_correction_that_shrinks_the_step_is_flagged_with_its_cost() {
+    let app = spawn_idle().await;
+    let mut inputs = example("hex217.json")["inputs"].clone();
+    inputs["bundle"]["rings"] = json!(1);
+    inputs["bundle"]["wrapper_flat_to_flat"] = json!(0.0305);
+    inputs["pin"]["length"] = json!(0.6);
+    inputs["bundle"]["wire_lead"] = json!(0.3);
+    inputs["pin"]["elements"] = json!(24);
+    inputs["pin"]["static_correction"] = json!("contacts");
+    let body = accepted(&app, "hex-bundle-dynamics", &inputs).await;
+    let found = warnings(&body);
+    assert!(
+        has(
+            &found,
+            "costly_static_correction",
+            "/inputs/pin/static_correction"
+        ),
+        "{body}"
+    );
+    let message = body["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|w| w["code"] == "costly_static_correction")
+        .unwrap()["message"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    let ratio = number_before(&message, "times smaller");
+    assert!(ratio > 4.0, "{message}");
+    inputs["pin"]["static_correction"] = json!("none");
+    let body = accepted(&app, "hex-bundle-dynamics", &inputs).await;
+    assert!(!has(
+        &warnings(&body),
+        "costly_static_correction",
+        "/inputs/pin/static_correction"
+    ));
+}

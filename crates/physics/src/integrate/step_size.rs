@@ -169,7 +169,12 @@ pub fn critical_time_step(model: &Model<'_>, scheme: Scheme) -> f64 {
 fn excitation_bound(model: &Model<'_>, steps_per_period: f64) -> Option<f64> {
     let mut bound = f64::INFINITY;
     let base_y = model.plane.as_ref().and_then(|p| p.base_acceleration_y.as_ref());
-    for base in model.base_acceleration.iter().chain(base_y) {
+    let walls = model
+        .walls
+        .iter()
+        .flat_map(|w| [&w.left_x, &w.right_x, &w.y])
+        .flatten();
+    for base in model.base_acceleration.iter().chain(base_y).chain(walls) {
         bound = bound.min(match base {
             BaseAcceleration::HalfSine { duration, .. } => 2.0 * duration / steps_per_period,
             BaseAcceleration::Sine { frequency, .. } => 1.0 / (frequency * steps_per_period),
