@@ -217,6 +217,25 @@ pub struct PeakDeflectionResult {
     pub time: f64,
 }
 
+impl PeakDeflectionResult {
+    /// Line `line`'s peak at each output height of a run.
+    pub fn of_line(
+        heights: &[f64],
+        peaks: &[Vec<crate::physics::integrate::PeakDeflection>],
+        line: usize,
+    ) -> Vec<Self> {
+        heights
+            .iter()
+            .zip(peaks)
+            .map(|(height, per_line)| Self {
+                height: *height,
+                deflection: per_line[line].deflection,
+                time: per_line[line].time,
+            })
+            .collect()
+    }
+}
+
 /// The explicit model the generator form expands to.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 pub struct Expansion {
@@ -501,15 +520,7 @@ impl Simulation for BundleDynamics {
                 max_abs_deflection: e.max_abs_deflection,
                 height: e.height,
                 time: e.time,
-                peak_deflections: heights
-                    .iter()
-                    .zip(&simulation.peak_deflections)
-                    .map(|(height, per_pin)| PeakDeflectionResult {
-                        height: *height,
-                        deflection: per_pin[p].deflection,
-                        time: per_pin[p].time,
-                    })
-                    .collect(),
+                peak_deflections: PeakDeflectionResult::of_line(heights, &simulation.peak_deflections, p),
             })
             .collect();
         let results = BundleResults {

@@ -500,15 +500,7 @@ impl Simulation for HexBundleDynamics {
                 max_abs_deflection: extreme.max_abs_deflection,
                 height: extreme.height,
                 time: extreme.time,
-                peak_deflections: heights
-                    .iter()
-                    .zip(&simulation.peak_deflections)
-                    .map(|(height, per_line)| PeakDeflectionResult {
-                        height: *height,
-                        deflection: per_line[line].deflection,
-                        time: per_line[line].time,
-                    })
-                    .collect(),
+                peak_deflections: PeakDeflectionResult::of_line(heights, &simulation.peak_deflections, line),
             }
         };
         let pins: Vec<HexPinResult> = (0..pin_count)
