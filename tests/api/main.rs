@@ -31,4 +31,5 @@ mod signals;
 mod spectra;
 mod sweeps;
 mod tenants;
+mod units;
 mod warnings;
