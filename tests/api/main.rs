@@ -23,6 +23,7 @@ mod negotiation;
 mod physics;
 mod quality;
 mod recovery;
+mod response_spectra;
 mod responsiveness;
 mod results;
 mod robustness;
