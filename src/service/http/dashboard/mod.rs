@@ -3,7 +3,8 @@
 //! A browser asking for `/`, `/jobs`, `/jobs/{jobId}`, `/sweeps` or `/sweeps/{sweepId}`
 //! gets a small HTML page ([`negotiation`] decides); every other client gets the JSON
 //! exactly as before. The page's scripts then read the JSON API like any client and draw
-//! the plots as SVG in the browser. `/ui/submit` is the submit form, `/ui/assets/{file}`
+//! the plots in the browser (line plots with the vendored uPlot, maps, histograms and
+//! bars as SVG). `/ui/submit` is the submit form, `/ui/assets/{file}`
 //! the scripts and style sheet, `/ui/examples.json` the shipped examples: all embedded in
 //! the binary ([`assets`]), nothing fetched from elsewhere.
 
@@ -77,6 +78,7 @@ pub fn shell(page: Page) -> String {
 <meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
 <title>{title}</title>
+<link rel="stylesheet" href="/ui/assets/uPlot.min.css">
 <link rel="stylesheet" href="/ui/assets/style.css">
 <script type="module" src="/ui/assets/app.js"></script>
 </head>

@@ -269,6 +269,16 @@ export function errorBox(error) {
     h('strong', {}, problem.title || 'Error'), ' ', problem.detail || String(error.message || error));
 }
 
+/** Saves `blob` as a file called `filename` (the browser's download). */
+export function saveBlob(blob, filename) {
+  const url = URL.createObjectURL(blob);
+  const link = h('a', {href: url, download: filename});
+  document.body.append(link);
+  link.click();
+  link.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 10000);
+}
+
 /** A download link, saved as `filename`. */
 export function download(href, filename) {
   // With a token, a plain link would go without it: fetch, then save the bytes.
@@ -280,14 +290,7 @@ export function download(href, filename) {
         if (!response.ok) throw new ApiProblem(response.status, null);
         return response.blob();
       })
-      .then((blob) => {
-        const url = URL.createObjectURL(blob);
-        const link = h('a', {href: url, download: filename});
-        document.body.append(link);
-        link.click();
-        link.remove();
-        setTimeout(() => URL.revokeObjectURL(url), 10000);
-      })
+      .then((blob) => saveBlob(blob, filename))
       .catch((error) => window.alert(`Download failed: ${error.message}`));
   };
   return h('a', {class: 'download', href, download: filename, onclick: save}, filename);
