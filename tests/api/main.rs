@@ -3,6 +3,7 @@
 //! and talks to it over HTTP, with a small test process (`counting`).
 
 mod counting;
+mod devtools;
 mod helpers;
 mod postgres;
 mod skip;
@@ -10,6 +11,7 @@ mod skip;
 mod capabilities;
 mod cors;
 mod dashboard;
+mod dashboard_plots;
 mod database;
 mod dismissal;
 mod earthquakes;

@@ -44,6 +44,8 @@ pub const ASSETS: &[Asset] = &[
     asset!("job.js", JS),
     asset!("hex.js", JS),
     asset!("impacts.js", JS),
+    asset!("spectra.js", JS),
+    asset!("signals.js", JS),
     asset!("sweep.js", JS),
     asset!("submit.js", JS),
     asset!("style.css", CSS),

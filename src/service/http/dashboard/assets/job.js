@@ -7,13 +7,15 @@
 // to its numbers, and each force or displacement plot draws the history's peak-keeping
 // companion (`<name>_peaks`) with the samples, so the plotted peak is the reported one.
 // Plausibility warnings about the inputs (the status's, or a sweep run's results') are
-// listed under the status, each with the input it points at.
+// listed under the status, each with the input it points at. Every process with a
+// displacement history gets its response spectra (spectra.js).
 
 import {FINISHED, ApiProblem, api, badge, card, download, errorBox, fmt, fmtElapsed, fmtTime, h, keyValueTable,
   leaves, poll, progressBar, replace, withUnit} from './util.js';
 import {barChart, heatMap} from './plot.js';
 import {linePlot} from './lines.js';
 import {hexBundle} from './hex.js';
+import {responseSpectrumCard} from './spectra.js';
 import {STATISTICS, contactImpacts, impactsCard, statisticPicker} from './impacts.js';
 
 /** Points asked of a history for a plot (min/max thinning keeps every peak). */
@@ -106,8 +108,9 @@ async function showResults(box, id, status) {
     return;
   }
   const sections = h('div');
+  const spectrumBox = h('div');
   const runWarnings = (status.warnings || []).length ? null : warningsList(results.warnings);
-  replace(box, runWarnings ? card('Warnings', runWarnings) : null, qualityCard(results), sections,
+  replace(box, runWarnings ? card('Warnings', runWarnings) : null, qualityCard(results), sections, spectrumBox,
     downloadsCard(id, results));
   if (status.processID === 'cantilever-impact') {
     await cantilever(sections, id, results);
@@ -118,6 +121,7 @@ async function showResults(box, id, status) {
   } else {
     await generic(sections, id, results);
   }
+  replace(spectrumBox, await responseSpectrumCard(id, status.processID));
 }
 
 function downloadsCard(id, results) {
