@@ -7,15 +7,20 @@
 //! - Response spectra are drawn on log–log axes with the API's values: a job's
 //!   displacement history (column and damping picked on the page) and a stored signal's,
 //!   with the record's peak acceleration as a line; the signal list links to it.
+//! - The job list at 1280 px: a failed job's bar stops where the run stopped, sweep runs
+//!   can be hidden, and the table needs no horizontal scroll. The submit form gives
+//!   every number its unit and every enumeration a select.
 //!
 //! Screenshots go to `target/dashboard-screenshots/` (see `dashboard.rs`).
 
 use std::sync::Arc;
 use std::time::Duration;
 
+use chocmodal::processes::bundle_dynamics::BundleDynamics;
 use chocmodal::processes::cantilever_impact::CantileverImpact;
 use serde_json::{Value, json};
 
+use crate::counting;
 use crate::dashboard::{chromium, example, execute, same, screenshot_dir};
 use crate::devtools::Browser;
 use crate::helpers::spawn_app_with_processes;
@@ -357,4 +362,156 @@ async fn check_spectrum(browser: &mut Browser, figure: &str, api: &Value, peak: 
         "line at {line}, {peak} {}",
         api[peak]
     );
+}
+
+#[tokio::test]
+#[cfg_attr(
+    chocmodal_skip_browser_tests,
+    ignore = "needs headless Chromium: none found at build time, or CHOCMODAL_SKIP_BROWSER_TESTS=1 (build.rs)"
+)]
+async fn the_job_list_fits_1280_px_shows_where_a_failed_run_stopped_and_hides_sweep_runs() {
+    let chromium = chromium(concat!(
+        module_path!(),
+        "::the_job_list_fits_1280_px_shows_where_a_failed_run_stopped_and_hides_sweep_runs"
+    ));
+    let app =
+        spawn_app_with_processes(vec![Arc::new(CantileverImpact), Arc::new(BundleDynamics)], |_| {}).await;
+    let failed = app.submit(json!({"steps": 100, "fail_at": 61})).await;
+    assert_eq!(app.wait_until_finished(&failed).await["progress"], 60);
+    let sweep = app
+        .create_sweep(json!({"process": counting::ID, "inputs": {"steps": 1},
+                             "axes": [{"pointer": "/steps", "values": [1, 2]}]}))
+        .await;
+    app.wait_for_sweep(&sweep, &["successful"], WITHIN).await;
+    let mut cantilever = example("cantilever-impact.json");
+    cantilever["inputs"]["solver"]["duration"] = json!(0.02);
+    let first = execute(&app, "cantilever-impact", &cantilever).await;
+    app.wait_for(&first, &["successful"], WITHIN).await;
+    // A poor run, whose long status message sits in the table too: 5 steps per contact
+    // period (see dashboard.rs).
+    let results = app.get_json(&format!("/jobs/{first}/results")).await;
+    cantilever["inputs"]["solver"]["check"] = json!("none");
+    cantilever["inputs"]["solver"]["time_step"] = json!(
+        results["numerical"]["time_step"].as_f64().unwrap()
+            * results["quality"]["steps_per_contact_period"].as_f64().unwrap()
+            / 5.0
+    );
+    let alone = execute(&app, "cantilever-impact", &cantilever).await;
+    let status = app.wait_for(&alone, &["successful"], WITHIN).await;
+    assert!(status["message"].as_str().unwrap().len() > 100, "{status}");
+
+    let mut browser = Browser::launch(&chromium, 1280, 800).await;
+    browser.goto(&app.url("/jobs?limit=30")).await;
+    browser
+        .wait_for(
+            &format!("document.querySelector('tr[data-job=\"{alone}\"]') !== null"),
+            WITHIN,
+        )
+        .await;
+    // Nothing wider than its card.
+    let overflow = browser
+        .eval(
+            "(() => { const table = document.querySelector('table[data-list=\"jobs\"]'); \
+             return [table.scrollWidth, table.parentElement.clientWidth, document.documentElement.scrollWidth, \
+             document.documentElement.clientWidth]; })()",
+        )
+        .await;
+    assert!(
+        overflow[0].as_f64() <= overflow[1].as_f64() && overflow[2].as_f64() <= overflow[3].as_f64(),
+        "the table is [width, room, page width, window] = {overflow} px"
+    );
+    browser.screenshot(&screenshot_dir().join("jobs-1280.png")).await;
+    // The failed run's bar stops at 60 %.
+    let bar = browser
+        .eval(&format!(
+            "(() => {{ const row = document.querySelector('tr[data-job=\"{failed}\"]'); \
+             const bar = row.querySelector('[role=progressbar]'); \
+             return [bar.getAttribute('data-value'), row.querySelector('.percent').textContent]; }})()"
+        ))
+        .await;
+    assert_eq!(parsed(&bar[0]), 0.6, "{bar}");
+    assert_eq!(bar[1], "stopped at 60 %");
+    // Without sweep runs: the three jobs submitted on their own.
+    browser.click("[data-in-sweep=\"false\"]").await;
+    browser
+        .wait_for(
+            "location.search.includes('inSweep=false') && document.querySelector('tr[data-job]') !== null",
+            WITHIN,
+        )
+        .await;
+    let listed = browser
+        .eval("[...document.querySelectorAll('tr[data-job]')].map((row) => row.getAttribute('data-job'))")
+        .await;
+    assert_eq!(listed, json!([alone, first, failed]));
+    // The failed job's own page says the same.
+    browser.goto(&app.url(&format!("/jobs/{failed}"))).await;
+    let progress = browser
+        .wait_for(
+            "document.querySelector('[data-job-status] .percent')?.textContent",
+            WITHIN,
+        )
+        .await;
+    assert_eq!(progress, "stopped at 60 %");
+
+    // The submit form: every number with its unit, enumerations as selects.
+    browser
+        .goto(&app.url("/ui/submit?example=bundle-random-gaps.json"))
+        .await;
+    browser
+        .wait_for(
+            "document.querySelector('[data-pointer=\"/inputs/pin/length\"]') !== null",
+            WITHIN,
+        )
+        .await;
+    let form = browser
+        .eval(
+            "(() => { const unitOf = (p) => document.querySelector(`[data-pointer=\"${p}\"]`)\
+               .closest('label').querySelector('[data-unit]')?.getAttribute('data-unit'); \
+             const numbers = [...document.querySelectorAll('input[data-pointer]')].filter((input) => \
+               /^-?[0-9.]/.test(input.value) || /^\\[\\s*-?[0-9.]/.test(input.value)); \
+             return {numbers: numbers.length, \
+               unitless: numbers.filter((input) => !input.closest('label').querySelector('[data-unit]')) \
+                 .map((input) => input.dataset.pointer), \
+               length: unitOf('/inputs/pin/length'), density: unitOf('/inputs/pin/density'), \
+               stiffness: unitOf('/inputs/bundle/stiffness'), damping_ratio: unitOf('/inputs/pin/damping_ratio'), \
+               scheme: document.querySelector('[data-pointer=\"/inputs/solver/scheme\"]').tagName, \
+               schemes: [...document.querySelectorAll('[data-pointer=\"/inputs/solver/scheme\"] option')].map((o) => o.value), \
+               section: document.querySelector('[data-pointer=\"/inputs/pin/section/type\"]').tagName}; })()",
+        )
+        .await;
+    assert!(form["numbers"].as_u64().unwrap() > 10, "{form}");
+    assert_eq!(
+        form["unitless"],
+        json!([]),
+        "number fields without a unit: {form}"
+    );
+    assert_eq!(form["length"], "m");
+    assert_eq!(form["density"], "kg/m³");
+    assert_eq!(form["stiffness"], "N/m");
+    assert_eq!(form["damping_ratio"], "dimensionless");
+    assert_eq!(form["scheme"], "SELECT");
+    assert_eq!(form["schemes"], json!(["central_difference", "tchamwa"]));
+    assert_eq!(form["section"], "SELECT");
+    // Another section type offers its own members, empty, and keeps the form's JSON valid.
+    browser
+        .eval(
+            "(() => { const select = document.querySelector('[data-pointer=\"/inputs/pin/section/type\"]'); \
+             select.value = 'explicit'; select.dispatchEvent(new Event('change', {bubbles: true})); })()",
+        )
+        .await;
+    let explicit = browser
+        .wait_for(
+            "document.querySelector('[data-pointer=\"/inputs/pin/section/area\"]') && \
+             [document.querySelector('[data-pointer=\"/inputs/pin/section/area\"]').closest('label') \
+               .querySelector('[data-unit]').getAttribute('data-unit'), \
+              document.querySelector('[data-pointer=\"/inputs/pin/section/outer_diameter\"]') === null, \
+              JSON.parse(document.querySelector('textarea.json').value).inputs.pin.section.type]",
+            WITHIN,
+        )
+        .await;
+    assert_eq!(explicit, json!(["m²", true, "explicit"]));
+    browser
+        .screenshot(&screenshot_dir().join("submit-units.png"))
+        .await;
+    browser.assert_no_exceptions();
 }

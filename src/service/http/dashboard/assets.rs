@@ -48,6 +48,7 @@ pub const ASSETS: &[Asset] = &[
     asset!("signals.js", JS),
     asset!("sweep.js", JS),
     asset!("submit.js", JS),
+    asset!("schema.js", JS),
     asset!("style.css", CSS),
     asset!(vendor "uPlot.esm.js", JS),
     asset!(vendor "uPlot.min.css", CSS),

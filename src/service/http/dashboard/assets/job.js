@@ -11,7 +11,7 @@
 // displacement history gets its response spectra (spectra.js).
 
 import {FINISHED, ApiProblem, api, badge, card, download, errorBox, fmt, fmtElapsed, fmtTime, h, keyValueTable,
-  leaves, poll, progressBar, replace, withUnit} from './util.js';
+  leaves, poll, progressCell, replace, withUnit} from './util.js';
 import {barChart, heatMap} from './plot.js';
 import {linePlot} from './lines.js';
 import {hexBundle} from './hex.js';
@@ -58,7 +58,7 @@ function statusTable(id, status) {
       ['Process', status.processID],
       ['Status', [badge(status.status), status.message && !['queued', 'running', 'finished', 'dismissed'].includes(status.message)
         ? h('span', {class: 'message'}, ` ${status.message}`) : null]],
-      ['Progress', running ? progressBar(status.progress, status.status) : `${status.progress} %`],
+      ['Progress', progressCell(status)],
       ['Created', fmtTime(status.created)],
       ['Started', fmtTime(status.started)],
       ['Finished', fmtTime(status.finished)],
