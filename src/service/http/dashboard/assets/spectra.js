@@ -88,7 +88,7 @@ export async function responseSpectrumCard(id, processID) {
           ? [{x: resolved, label: `1/(10 Δt) = ${fmt(resolved, 3)} Hz`}] : [],
         caption: h('span', {class: 'muted', 'data-peak-acceleration': doc.peak_acceleration},
           ` acceleration by second differences of ${doc.samples + 2} samples every ${fmt(doc.sample_interval, 3)} s, ` +
-          'relative to the wrapper')}));
+          'relative to the base (the frame of the histories)')}));
     } catch (error) {
       replace(drawn, errorBox(error));
     }
