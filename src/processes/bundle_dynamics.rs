@@ -12,7 +12,7 @@ use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::inputs::{self, SolverDefaults, at};
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
-use super::simulation::{HistoryOutput, Output, Simulation};
+use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::Contact;
@@ -270,22 +270,26 @@ impl Simulation for BundleDynamics {
     const HISTORIES: &'static [HistoryOutput] = &[
         HistoryOutput {
             name: "contact_forces",
+            kind: HistoryKind::Force,
             title: "Contact forces (N)",
             description: "CSV columns time (s), c0, c1, ... in contact order",
         },
         HistoryOutput {
             name: "displacements",
+            kind: HistoryKind::Displacement,
             title: "Pin deflections (m)",
             description: "CSV columns time (s), p0, p1, ... (pin tips; `p<pin>@<height>` for other heights)",
         },
         HistoryOutput {
             name: "contact_forces_peaks",
+            kind: HistoryKind::Peaks,
             title: "Contact force peaks (N)",
             description: "As contact_forces, each value the largest force reached at any step of its output \
                           interval: the maximum of column c<k> is contact k's max_force",
         },
         HistoryOutput {
             name: "displacements_peaks",
+            kind: HistoryKind::Peaks,
             title: "Pin deflection peaks (m)",
             description: "As displacements, each value the deflection of largest magnitude (signed) reached at \
                           any step of its output interval",

@@ -186,8 +186,11 @@ impl<'de> Deserialize<'de> for LevelsInput {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RegularLevels {
+    /// Height of the lowest level (m).
     pub first: f64,
+    /// Distance between two levels (m).
     pub spacing: f64,
+    /// Number of levels.
     pub count: usize,
 }
 
@@ -199,7 +202,10 @@ pub enum GapsInput {
     /// on the unit variants of internally tagged enums, and a typo must not pass.)
     Uniform {},
     /// One gap per contact (m), in expansion order (level by level: wall–0, 0–1, …, n−1–wall).
-    PerContact { values: Vec<f64> },
+    PerContact {
+        /// The gaps (m), one per contact.
+        values: Vec<f64>,
+    },
     /// Independent draws in expansion order, reproducible from the seed on every machine.
     Random {
         distribution: DistributionInput,
@@ -220,13 +226,18 @@ impl Default for GapsInput {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum DistributionInput {
+    /// Uniform law between `low` and `high`.
     Uniform {
+        /// Smallest draw (m; dimensionless for `relative` gaps).
         low: f64,
+        /// Largest draw (m; dimensionless for `relative` gaps).
         high: f64,
     },
     /// Normal law truncated at 0 (resampled, a true truncated normal).
     Normal {
+        /// Mean of the law before truncation (m; dimensionless for `relative` gaps).
         mean: f64,
+        /// Standard deviation (m; dimensionless for `relative` gaps).
         std: f64,
     },
 }
@@ -236,10 +247,15 @@ pub enum DistributionInput {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ClosureInput {
+    /// First level of the zone (0 = the lowest).
     pub first_level: usize,
+    /// Last level of the zone (included).
     pub last_level: usize,
+    /// First pin of the zone (0 = next to the left wall).
     pub first_pin: usize,
+    /// Last pin of the zone (included).
     pub last_pin: usize,
+    /// Multiplier of the gaps (dimensionless, ≥ 0; 0 closes them).
     pub factor: f64,
 }
 
@@ -380,28 +396,55 @@ impl ExcitationInput {
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum BaseAccelerationInput {
     /// amplitude (m/s²) · sin(π t / duration (s)) during `duration`, then 0.
-    HalfSine { amplitude: f64, duration: f64 },
+    HalfSine {
+        /// Peak acceleration (m/s²).
+        amplitude: f64,
+        /// Length of the pulse (s).
+        duration: f64,
+    },
     /// amplitude (m/s²) · sin(2π frequency (Hz) t) for `cycles` periods, then 0.
     Sine {
+        /// Peak acceleration (m/s²).
         amplitude: f64,
+        /// Frequency (Hz).
         frequency: f64,
+        /// Number of periods (dimensionless, may be fractional).
         cycles: f64,
     },
     /// Samples: time (s), acceleration (m/s²); linear between them, 0 outside.
-    Table { time: Vec<f64>, acceleration: Vec<f64> },
+    Table {
+        /// Sample times (s), increasing.
+        time: Vec<f64>,
+        /// Acceleration at each time (m/s²).
+        acceleration: Vec<f64>,
+    },
     /// amplitude (m/s²) · sin²(π t / duration (s)) during `duration`, then 0
     /// (velocity change amplitude · duration / 2).
-    Haversine { amplitude: f64, duration: f64 },
+    Haversine {
+        /// Peak acceleration (m/s²).
+        amplitude: f64,
+        /// Length of the pulse (s).
+        duration: f64,
+    },
     /// amplitude (m/s²) · t / duration (s) during `duration`, then 0 at once
     /// (velocity change amplitude · duration / 2).
-    TerminalPeakSawtooth { amplitude: f64, duration: f64 },
+    TerminalPeakSawtooth {
+        /// Peak acceleration, at the end (m/s²).
+        amplitude: f64,
+        /// Length of the pulse (s).
+        duration: f64,
+    },
     /// Linear rise to amplitude (m/s²) in `rise` (s), `plateau` (s) at it, linear fall
     /// to 0 in `fall` (s); a ramp or the plateau may be 0, not all three (velocity change
     /// amplitude · (rise/2 + plateau + fall/2)).
     Trapezoid {
+        /// Plateau acceleration (m/s²).
         amplitude: f64,
+        /// Time of the rising ramp (s).
         rise: f64,
+        /// Time at the amplitude (s).
         plateau: f64,
+        /// Time of the falling ramp (s).
         fall: f64,
     },
     /// A synthetic earthquake matching a target response spectrum, drawn from a seed.

@@ -11,7 +11,7 @@ use super::impact_report::{self, ContactImpacts, ImpactSummary, ImpactsInput};
 use super::inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
-use super::simulation::{HistoryOutput, Output, Simulation};
+use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::{Subject, WarningsInput};
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::InputIssue;
@@ -375,21 +375,25 @@ impl Simulation for CantileverImpact {
     const HISTORIES: &'static [HistoryOutput] = &[
         HistoryOutput {
             name: "tip_displacement",
+            kind: HistoryKind::Displacement,
             title: "Tip deflection (m)",
             description: HISTORY,
         },
         HistoryOutput {
             name: "contact_force",
+            kind: HistoryKind::Force,
             title: "Contact force (N)",
             description: HISTORY,
         },
         HistoryOutput {
             name: "tip_displacement_peaks",
+            kind: HistoryKind::Peaks,
             title: "Tip deflection (m), peaks",
             description: PEAKS,
         },
         HistoryOutput {
             name: "contact_force_peaks",
+            kind: HistoryKind::Peaks,
             title: "Contact force (N), peaks",
             description: PEAKS,
         },

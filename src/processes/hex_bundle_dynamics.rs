@@ -14,7 +14,7 @@ use super::hex_inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::inputs::{self, SolverDefaults, at};
 use super::report::{EnergyReport, QualityReport};
-use super::simulation::{HistoryOutput, Output, Simulation};
+use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::{Body as RowBody, Contact};
@@ -238,21 +238,25 @@ impl Simulation for HexBundleDynamics {
     const HISTORIES: &'static [HistoryOutput] = &[
         HistoryOutput {
             name: "contact_forces",
+            kind: HistoryKind::Force,
             title: "Contact forces (N)",
             description: "CSV columns time (s), c<k> for each recorded contact k (results recorded_contacts)",
         },
         HistoryOutput {
             name: "displacements",
+            kind: HistoryKind::Displacement,
             title: "Pin deflections (m)",
             description: "CSV columns time (s), p<pin>x, p<pin>y, ... (pin tips; `p<pin>x@<height>` for other heights)",
         },
         HistoryOutput {
             name: "contact_forces_peaks",
+            kind: HistoryKind::Peaks,
             title: "Contact force peaks (N)",
             description: "As contact_forces, each value the largest force reached at any step of its output interval",
         },
         HistoryOutput {
             name: "displacements_peaks",
+            kind: HistoryKind::Peaks,
             title: "Pin deflection peaks (m)",
             description: "As displacements, each value the deflection of largest magnitude (signed) reached at \
                           any step of its output interval",

@@ -105,11 +105,16 @@ pub enum HexGapsInput {
     /// value keeps the nominal clearance (P − D − d_w between pins, from the
     /// flat-to-flat for the wall).
     Uniform {
+        /// Gap of every pin–pin contact (m).
         pin_pin: Option<f64>,
+        /// Gap of every pin–wall contact (m).
         pin_wall: Option<f64>,
     },
     /// One gap per contact (m), in contact order (results `contacts`).
-    PerContact { values: Vec<f64> },
+    PerContact {
+        /// The gaps (m), one per contact.
+        values: Vec<f64>,
+    },
     /// Independent draws in contact order, reproducible from the seed on every machine.
     Random {
         distribution: DistributionInput,
@@ -144,7 +149,7 @@ pub struct HexClosureInput {
     /// Level indices (0 = the lowest; results `geometry.levels`).
     pub first_level: usize,
     pub last_level: usize,
-    /// Multiplier of the gaps (≥ 0).
+    /// Multiplier of the gaps (dimensionless, ≥ 0; 0 closes them).
     pub factor: f64,
 }
 
@@ -153,7 +158,9 @@ pub struct HexClosureInput {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OffsetInput {
+    /// The flat moved toward (0..6).
     pub flat: usize,
+    /// How far every pin moves (m).
     pub distance: f64,
 }
 

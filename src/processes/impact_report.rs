@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::History;
-use super::simulation::HistoryOutput;
+use super::simulation::{HistoryKind, HistoryOutput};
 use crate::physics::impacts::{
     DEFAULT_CLASSES, DEFAULT_MAX_ROWS, Impact, ImpactCounting, ImpactStatistics, ImpactTable, TABLE_COLUMNS,
 };
@@ -23,6 +23,7 @@ pub const TABLE: &str = "impacts";
 /// The per-impact table, as every process declares it.
 pub const TABLE_OUTPUT: HistoryOutput = HistoryOutput {
     name: TABLE,
+    kind: HistoryKind::Table,
     title: "Impacts, one row each",
     description: "CSV columns contact, start (s), peak_time (s), peak_force (N), impulse (N·s), duration (s), \
                   approach_velocity (m/s), rebounds, dissipated (J), energy (J), sorted by start; \

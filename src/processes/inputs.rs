@@ -82,14 +82,21 @@ fn default_damping() -> DampingInput {
 pub enum SectionInput {
     /// Circular tube (m).
     Tube {
+        /// Outer diameter (m).
         outer_diameter: f64,
+        /// Inner diameter (m); 0 for a solid rod.
         inner_diameter: f64,
     },
     /// Area (m²) and second moment of area (m⁴).
-    Explicit { area: f64, inertia: f64 },
+    Explicit {
+        /// Cross-section area A (m²).
+        area: f64,
+        /// Second moment of area I about the bending axis (m⁴).
+        inertia: f64,
+    },
 }
 
-/// Modal damping ratio: a number for every mode, or a list, one per mode.
+/// Modal damping ratio (dimensionless): a number for every mode, or a list, one per mode.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(untagged, expecting = "a damping ratio or a list of damping ratios")]
 pub enum DampingInput {
@@ -282,8 +289,8 @@ pub enum SchemeInput {
     Tchamwa,
 }
 
-/// A time step in seconds, or `"auto"`: chosen for accuracy (the tolerance) within
-/// stability, dividing the output interval.
+/// A time step (s), or `"auto"`: chosen for accuracy (the tolerance) within stability,
+/// dividing the output interval.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(untagged, expecting = "a time step in seconds or \"auto\"")]
 pub enum TimeStepInput {
@@ -330,7 +337,7 @@ pub fn default_tolerance() -> f64 {
 pub struct SolverInput {
     #[serde(default)]
     pub scheme: SchemeInput,
-    /// Tchamwa–Wielgosz parameter φ in [1, 2] (default 1.1).
+    /// Tchamwa–Wielgosz parameter φ (dimensionless, in [1, 2]; default 1.1).
     pub phi: Option<f64>,
     /// Time step (s) or "auto": chosen for accuracy at `tolerance` within stability, a
     /// whole number of steps per output interval. Default: "auto", except for
@@ -342,7 +349,7 @@ pub struct SolverInput {
     #[serde(default, deserialize_with = "present")]
     #[schema(value_type = f64)]
     pub duration: Option<f64>,
-    /// Relative accuracy target in (0, 1), default 1e-3: `auto` picks its step so that
+    /// Relative accuracy target (dimensionless, in (0, 1); default 1e-3): `auto` picks its step so that
     /// the energy balance closes within it and peaks are within 10 × it, and
     /// `quality.verdict` judges against it. Larger values trade accuracy for speed (sweeps).
     #[serde(default = "default_tolerance")]

@@ -44,7 +44,7 @@ use std::ops::ControlFlow;
 use std::sync::Arc;
 
 pub use cost::{CostLimits, TooCostly, WorkEstimate};
-pub use simulation::{HistoryOutput, Output, Simulation};
+pub use simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 pub use warnings::Warning;
 
 /// One problem with the inputs: where (JSON pointer into the request body) and why.
@@ -193,8 +193,16 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     fn inputs_schema(&self) -> Option<serde_json::Value> {
         None
     }
-    /// OGC process description `outputs` object: `{name: {title, description, schema}}`.
+    /// OGC process description `outputs` object: `{name: {title, description, schema}}`
+    /// (and `kind`, [`HistoryKind::as_str`], when the process declares it).
     fn outputs_description(&self) -> serde_json::Value;
+    /// What the values of history `output` are; `None` for an output the process does
+    /// not declare a kind for (then no view that needs one, like a response spectrum,
+    /// is offered).
+    fn history_kind(&self, output: &str) -> Option<HistoryKind> {
+        let _ = output;
+        None
+    }
     /// Parses and checks the `inputs` object of an execution request, and estimates what
     /// running it will cost (a service compares that with its [`CostLimits`]). Pointers in
     /// the errors start with `/inputs`. Accepted inputs come with their plausibility

@@ -28,9 +28,37 @@ use super::{
 pub struct HistoryOutput {
     /// Output name (`tip_displacement`).
     pub name: &'static str,
+    /// What its values are.
+    pub kind: HistoryKind,
     pub title: &'static str,
     /// Its columns and units.
     pub description: &'static str,
+}
+
+/// What the values of a history are: which views of it make sense (a response spectrum
+/// is the spectrum of a motion; the per-impact table is no time series at all).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HistoryKind {
+    /// Displacements (m), sampled at each output time.
+    Displacement,
+    /// Forces (N), sampled at each output time.
+    Force,
+    /// The extreme of each output interval over all steps (a `_peaks` companion).
+    Peaks,
+    /// Not a time series: one row per event.
+    Table,
+}
+
+impl HistoryKind {
+    /// Its name in the process description's outputs (`kind`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Displacement => "displacement",
+            Self::Force => "force",
+            Self::Peaks => "peaks",
+            Self::Table => "table",
+        }
+    }
 }
 
 /// What a run of a simulation produces: its typed results and its histories.
@@ -136,13 +164,17 @@ impl<S: Simulation> Process for S {
         Some(inputs::schema_of::<S::Inputs>())
     }
 
+    fn history_kind(&self, output: &str) -> Option<HistoryKind> {
+        S::HISTORIES.iter().find(|h| h.name == output).map(|h| h.kind)
+    }
+
     fn outputs_description(&self) -> serde_json::Value {
         S::HISTORIES
             .iter()
             .map(|h| {
                 (
                     h.name.to_owned(),
-                    serde_json::json!({"title": h.title, "description": h.description,
+                    serde_json::json!({"title": h.title, "description": h.description, "kind": h.kind.as_str(),
                                        "schema": {"type": "string", "contentMediaType": "text/csv"}}),
                 )
             })

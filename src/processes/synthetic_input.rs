@@ -43,7 +43,7 @@ pub struct SpectrumCompatibleInput {
     #[schema(value_type = f64)]
     pub time_step: Option<f64>,
     /// Largest relative deviation of the record's spectrum from the target over the
-    /// target's band (default 0.1); a record that cannot reach it is refused.
+    /// target's band (dimensionless, default 0.1); a record that cannot reach it is refused.
     #[serde(default = "default_tolerance")]
     #[schema(default = 0.1, exclusive_minimum = 0.0, exclusive_maximum = 1.0)]
     pub tolerance: f64,

@@ -4,13 +4,15 @@ use std::collections::HashSet;
 
 use serde_json::{Value, json};
 
+use crate::counting;
 use crate::helpers::{Backend, TestApp, on_both_backends, spawn_app_on};
 
 on_both_backends!(
     jobs_are_listed_newest_first,
     jobs_can_be_filtered_by_status_and_process,
     paging_follows_next_links_through_every_job_once_even_while_jobs_arrive,
-    next_links_keep_the_filters
+    next_links_keep_the_filters,
+    sweep_runs_can_be_left_out_or_listed_alone
 );
 
 fn ids(page: &Value) -> Vec<String> {
@@ -120,4 +122,38 @@ async fn next_links_keep_the_filters(backend: Backend) {
     seen.extend(ids(&second));
     assert!(next_link(&second).is_none());
     assert_eq!(seen, dismissed);
+}
+
+/// `inSweep=false` hides the runs of sweeps (what a person looking for their own jobs
+/// wants), `inSweep=true` shows them alone; the `next` link keeps the filter.
+async fn sweep_runs_can_be_left_out_or_listed_alone(backend: Backend) {
+    let app = queue_only(backend).await;
+    let before = app.submit(json!({"steps": 1})).await;
+    let sweep = app
+        .create_sweep(json!({"process": counting::ID, "inputs": {"steps": 1},
+                             "axes": [{"pointer": "/steps", "values": [1, 2, 3]}]}))
+        .await;
+    let after = app.submit(json!({"steps": 1})).await;
+    assert_eq!(ids(&app.get_json("/jobs").await).len(), 5);
+    assert_eq!(
+        ids(&app.get_json("/jobs?inSweep=false").await),
+        vec![after.clone(), before.clone()]
+    );
+    let runs = app.get_json("/jobs?inSweep=true").await;
+    assert_eq!(ids(&runs).len(), 3);
+    assert!(
+        runs["jobs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|j| j["sweepID"] == sweep.as_str()),
+        "{runs}"
+    );
+    let page = app.get_json("/jobs?inSweep=false&limit=1").await;
+    assert_eq!(ids(&page), vec![after]);
+    let next = next_link(&page).expect("a second page");
+    assert!(next.contains("inSweep=false"), "{next}");
+    assert_eq!(ids(&app.get_json(&next).await), vec![before]);
+    let refused = app.get("/jobs?inSweep=maybe").await;
+    assert_eq!(refused.status(), reqwest::StatusCode::BAD_REQUEST);
 }

@@ -3,6 +3,7 @@
 //! and talks to it over HTTP, with a small test process (`counting`).
 
 mod counting;
+mod devtools;
 mod helpers;
 mod postgres;
 mod skip;
@@ -10,6 +11,7 @@ mod skip;
 mod capabilities;
 mod cors;
 mod dashboard;
+mod dashboard_plots;
 mod database;
 mod dismissal;
 mod earthquakes;
@@ -23,6 +25,7 @@ mod negotiation;
 mod physics;
 mod quality;
 mod recovery;
+mod response_spectra;
 mod responsiveness;
 mod results;
 mod robustness;
@@ -31,4 +34,5 @@ mod signals;
 mod spectra;
 mod sweeps;
 mod tenants;
+mod units;
 mod warnings;

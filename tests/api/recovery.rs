@@ -156,7 +156,7 @@ async fn a_worker_that_lost_its_lease_can_neither_heartbeat_nor_write_results(ba
     assert!(!app.queue.heartbeat(&stale, Some(50), lease).await.unwrap());
     assert!(!app.queue.is_held(&stale).await.unwrap());
     let problem = chocmodal::problem::Problem::job_failed("stale");
-    assert!(!app.queue.fail(&stale, &problem).await.unwrap());
+    assert!(!app.queue.fail(&stale, &problem, None).await.unwrap());
     assert!(
         !app.queue
             .complete(&stale, &json!({"stale": true}), &[])

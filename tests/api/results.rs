@@ -11,6 +11,7 @@ use crate::helpers::{Backend, assert_problem, on_both_backends, spawn_app, spawn
 on_both_backends!(
     a_job_runs_to_success_and_serves_its_results_and_histories,
     a_deterministic_failure_fails_at_once_without_retry,
+    a_failed_job_keeps_the_progress_it_had_reached,
     a_panicking_process_fails_only_its_own_job
 );
 
@@ -128,6 +129,19 @@ async fn an_unknown_output_is_a_404_problem() {
     app.wait_until_finished(&job).await;
     let response = app.get(&format!("/jobs/{job}/results/nothing")).await;
     assert_problem(response, StatusCode::NOT_FOUND, "/no-such-output").await;
+}
+
+/// A run that fails (a divergence) says where it stopped: its progress stays at the
+/// percent it had reached, even when it fails between two heartbeats (no pause here:
+/// the 60 steps before the failure take microseconds, far less than the 50 ms period).
+async fn a_failed_job_keeps_the_progress_it_had_reached(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
+    let job = app.submit(json!({"steps": 100, "fail_at": 61})).await;
+    let status = app.wait_until_finished(&job).await;
+    assert_eq!(status["status"], "failed", "{status}");
+    assert_eq!(status["progress"], 60, "60 of 100 steps were done: {status}");
+    let listed = app.get_json("/jobs?status=failed").await;
+    assert_eq!(listed["jobs"][0]["progress"], 60, "{listed}");
 }
 
 async fn a_deterministic_failure_fails_at_once_without_retry(backend: Backend) {

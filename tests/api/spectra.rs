@@ -34,7 +34,7 @@ fn series<'a>(document: &'a Value, name: &str) -> &'a Value {
 }
 
 /// A finished `cantilever-impact` job of the public case over 0.1 s; its id and results.
-async fn cantilever_job(app: &TestApp) -> (String, Value) {
+pub(crate) async fn cantilever_job(app: &TestApp) -> (String, Value) {
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/examples/cantilever-impact.json"
@@ -53,7 +53,7 @@ async fn cantilever_job(app: &TestApp) -> (String, Value) {
     (id, results)
 }
 
-async fn spawn_with_cantilever() -> TestApp {
+pub(crate) async fn spawn_with_cantilever() -> TestApp {
     spawn_app_with_processes(vec![Arc::new(CantileverImpact)], |_| {}).await
 }
 

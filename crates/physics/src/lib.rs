@@ -6,6 +6,8 @@
 //! being checked (`section/outer_diameter`); callers prefix it with where that struct
 //! sits in their own input document (`/inputs/beam/`).
 
+/// The acceleration of a sampled displacement history (second divided differences).
+pub mod acceleration;
 /// Summary figures of an accelerogram: sampling, PGA, Arias intensity.
 pub mod accelerogram;
 pub mod beam;

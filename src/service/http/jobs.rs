@@ -29,8 +29,9 @@ struct ListQuery {
     cursor: Option<i64>,
 }
 
-/// Parses `status`, `processID` (each repeatable and comma-separated), `limit`, `cursor`;
-/// `f` is accepted and ignored (OGC format parameter); anything else is refused.
+/// Parses `status`, `processID`, `sweepID` (each repeatable and comma-separated),
+/// `inSweep` (`true` or `false`), `limit`, `cursor`; `f` is accepted and ignored (OGC
+/// format parameter); anything else is refused.
 fn parse_list_query(pairs: &[(String, String)]) -> Result<ListQuery, Problem> {
     let mut query = ListQuery {
         limit: DEFAULT_LIMIT,
@@ -56,6 +57,18 @@ fn parse_list_query(pairs: &[(String, String)]) -> Result<ListQuery, Problem> {
                 .filter
                 .sweep_ids
                 .extend(value.split(',').filter(|s| !s.is_empty()).map(str::to_owned)),
+            "inSweep" => {
+                query.filter.in_sweep = Some(match value.as_str() {
+                    "true" => true,
+                    "false" => false,
+                    other => {
+                        return Err(Problem::invalid_query(format!(
+                            "`inSweep` must be `true` (runs of sweeps only) or `false` (jobs submitted on \
+                             their own only), not `{other}`"
+                        )));
+                    }
+                });
+            }
             "limit" => {
                 query.limit = value
                     .parse()
@@ -73,7 +86,7 @@ fn parse_list_query(pairs: &[(String, String)]) -> Result<ListQuery, Problem> {
             "f" => {}
             other => {
                 return Err(Problem::invalid_query(format!(
-                    "unknown query parameter `{other}` (expected status, processID, sweepID, limit, cursor)"
+                    "unknown query parameter `{other}` (expected status, processID, sweepID, inSweep, limit, cursor)"
                 )));
             }
         }
@@ -99,6 +112,9 @@ fn list_href(query: &ListQuery, cursor: Option<i64>) -> String {
             encode_component(&query.filter.sweep_ids.join(","))
         ));
     }
+    if let Some(in_sweep) = query.filter.in_sweep {
+        href.push_str(&format!("&inSweep={in_sweep}"));
+    }
     if let Some(cursor) = cursor {
         href.push_str(&format!("&cursor={cursor}"));
     }
@@ -119,14 +135,16 @@ fn encode_component(text: &str) -> String {
 
 /// List jobs
 ///
-/// Newest first. Filters: `status` and `processID` (repeatable, or comma-separated
-/// values). Paging: `limit` jobs per page; the `next` link (keyset `cursor`) gives the
+/// Newest first. Filters: `status`, `processID` and `sweepID` (repeatable, or
+/// comma-separated values), `inSweep` (`false`: only jobs submitted on their own, no
+/// sweep run; `true`: only sweep runs). Paging: `limit` jobs per page; the `next` link (keyset `cursor`) gives the
 /// following page, stable while new jobs arrive.
 #[utoipa::path(get, path = "/jobs", operation_id = "getJobs", tag = "Jobs",
     params(
         ("status" = Option<String>, Query, description = "Only jobs in these statuses, e.g. `running,accepted`"),
         ("processID" = Option<String>, Query, description = "Only jobs of these processes"),
         ("sweepID" = Option<String>, Query, description = "Only runs of these sweeps"),
+        ("inSweep" = Option<bool>, Query, description = "`false`: only jobs submitted on their own (no sweep run); `true`: only runs of sweeps"),
         ("limit" = Option<u32>, Query, description = "Jobs per page, 1 to 1000 (default 10)", minimum = 1, maximum = 1000),
         ("cursor" = Option<i64>, Query, description = "Opaque position from a `next` link"),
     ),
@@ -252,16 +270,37 @@ mod tests {
     }
 
     #[test]
+    fn in_sweep_is_a_boolean() {
+        assert_eq!(
+            parse_list_query(&pairs(&[("inSweep", "false")]))
+                .unwrap()
+                .filter
+                .in_sweep,
+            Some(false)
+        );
+        assert_eq!(
+            parse_list_query(&pairs(&[("inSweep", "true")]))
+                .unwrap()
+                .filter
+                .in_sweep,
+            Some(true)
+        );
+        assert_eq!(parse_list_query(&[]).unwrap().filter.in_sweep, None);
+        assert!(parse_list_query(&pairs(&[("inSweep", "no")])).is_err());
+    }
+
+    #[test]
     fn next_links_keep_the_filters() {
         let query = parse_list_query(&pairs(&[
             ("status", "running"),
             ("processID", "a b"),
             ("limit", "5"),
+            ("inSweep", "false"),
         ]))
         .unwrap();
         assert_eq!(
             list_href(&query, Some(42)),
-            "/jobs?limit=5&status=running&processID=a%20b&cursor=42"
+            "/jobs?limit=5&status=running&processID=a%20b&inSweep=false&cursor=42"
         );
     }
 }

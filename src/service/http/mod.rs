@@ -17,6 +17,7 @@ pub mod landing;
 pub mod models;
 pub mod openapi;
 pub mod processes;
+pub mod response_spectra;
 pub mod results;
 pub mod signal_models;
 pub mod signals;
@@ -113,6 +114,10 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/jobs/{jobId}/results/impacts", get(impacts::impacts))
         .route("/jobs/{jobId}/results/{output}", get(results::output))
         .route("/jobs/{jobId}/results/{output}/spectrum", get(spectra::spectrum))
+        .route(
+            "/jobs/{jobId}/results/{output}/response_spectrum",
+            get(response_spectra::response_spectrum),
+        )
         .route("/sweeps", get(sweeps::list).post(sweeps::create))
         // A record is far larger than an execution request: this route has its own
         // body limit (the innermost limit is the one that applies).

@@ -18,8 +18,8 @@ use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
 use utoipa::{Modify, OpenApi};
 
 use super::{
-    impacts, job_inputs, jobs, landing, models, processes, results, signal_models, signals, spectra,
-    sweep_models, sweeps,
+    impacts, job_inputs, jobs, landing, models, processes, response_spectra, results, signal_models, signals,
+    spectra, sweep_models, sweeps,
 };
 use crate::processes::Registry;
 use crate::service::queue::JobStatus;
@@ -151,6 +151,7 @@ const LINKS: &[(&str, &str, &str, &str, &str, &str, &str)] = &[
     ("/processes/{processId}/execution", "post", "201", "results", "getResult", "jobId", "$response.body#/jobID"),
     ("/processes/{processId}/execution", "post", "201", "history", "getResultOutput", "jobId", "$response.body#/jobID"),
     ("/processes/{processId}/execution", "post", "201", "spectrum", "getResultSpectrum", "jobId", "$response.body#/jobID"),
+    ("/processes/{processId}/execution", "post", "201", "response_spectrum", "getResultResponseSpectrum", "jobId", "$response.body#/jobID"),
     ("/processes/{processId}/execution", "post", "201", "inputs", "getJobInputs", "jobId", "$response.body#/jobID"),
     ("/processes/{processId}/execution", "post", "201", "dismiss", "dismiss", "jobId", "$response.body#/jobID"),
     ("/sweeps", "post", "201", "status", "getSweep", "sweepId", "$response.body#/sweepID"),
@@ -218,6 +219,7 @@ impl Modify for ResourceLinks {
         results::output,
         impacts::impacts,
         spectra::spectrum,
+        response_spectra::response_spectrum,
         sweeps::create,
         sweeps::list,
         sweeps::status,
@@ -250,6 +252,7 @@ impl Modify for ResourceLinks {
         impacts::ImpactPage,
         spectra::SpectrumDocument,
         spectra::SpectrumComparison,
+        response_spectra::HistoryResponseSpectrum,
         models::LandingPage,
         models::Conformance,
         models::Health,

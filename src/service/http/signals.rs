@@ -20,10 +20,10 @@ use super::extract::ApiQuery;
 use super::history_view::Format;
 use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
 use super::models::Link;
+use super::response_spectra::{parse_spectrum_query, spectra_csv};
 use super::signal_models::{DampedSpectrum, SignalList, SignalMetadata, SignalSpectrum};
 use crate::physics::response_spectrum::{self, log_spaced};
 use crate::problem::Problem;
-use crate::processes::columns_csv;
 use crate::service::auth::Tenant;
 use crate::service::signals::SignalReadError;
 use crate::service::signals::create::CreateError;
@@ -327,94 +327,6 @@ pub async fn samples(
         .into_response())
 }
 
-/// Default frequency grid of a spectrum (Hz, points).
-pub const DEFAULT_F_MIN: f64 = 0.1;
-pub const DEFAULT_F_MAX: f64 = 100.0;
-pub const DEFAULT_POINTS: usize = 200;
-/// Most frequencies and damping ratios of one spectrum request.
-pub const MAX_POINTS: usize = 2000;
-pub const MAX_DAMPINGS: usize = 10;
-/// Most oscillator sub-steps one spectrum request may take (about 10 s of computing):
-/// each frequency f steps through every sample interval, in sub-steps of at most 1/64
-/// of its period.
-pub const MAX_SPECTRUM_STEPS: f64 = 2e9;
-
-/// What `GET /signals/{id}/spectrum` asks for.
-#[derive(Debug, Clone, PartialEq)]
-struct SpectrumRequest {
-    dampings: Vec<f64>,
-    f_min: f64,
-    f_max: f64,
-    points: usize,
-    format: Option<String>,
-}
-
-/// Parses `damping` (repeatable or comma-separated; default 0.05), `f_min`, `f_max`,
-/// `points`, `format`; anything else is refused.
-fn parse_spectrum_query(pairs: &[(String, String)]) -> Result<SpectrumRequest, Problem> {
-    let number = |name: &str, text: &str| -> Result<f64, Problem> {
-        text.trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| Problem::invalid_query(format!("`{name}`: `{text}` is not a finite number")))
-    };
-    let mut request = SpectrumRequest {
-        dampings: Vec::new(),
-        f_min: DEFAULT_F_MIN,
-        f_max: DEFAULT_F_MAX,
-        points: DEFAULT_POINTS,
-        format: None,
-    };
-    for (key, value) in pairs {
-        match key.as_str() {
-            "damping" => {
-                for text in value.split(',').filter(|s| !s.trim().is_empty()) {
-                    let xi = number("damping", text)?;
-                    if !(0.0..1.0).contains(&xi) {
-                        return Err(Problem::invalid_query(format!(
-                            "`damping`: {xi} is not a damping ratio in [0, 1)"
-                        )));
-                    }
-                    request.dampings.push(xi);
-                }
-            }
-            "f_min" => request.f_min = number("f_min", value)?,
-            "f_max" => request.f_max = number("f_max", value)?,
-            "points" => {
-                request.points = value
-                    .parse()
-                    .ok()
-                    .filter(|n| (2..=MAX_POINTS).contains(n))
-                    .ok_or_else(|| {
-                        Problem::invalid_query(format!("`points` must be an integer from 2 to {MAX_POINTS}"))
-                    })?;
-            }
-            "format" => request.format = Some(value.clone()),
-            other => {
-                return Err(Problem::invalid_query(format!(
-                    "unknown query parameter `{other}` (expected damping, f_min, f_max, points, format)"
-                )));
-            }
-        }
-    }
-    if request.dampings.is_empty() {
-        request.dampings.push(0.05);
-    }
-    if request.dampings.len() > MAX_DAMPINGS {
-        return Err(Problem::invalid_query(format!(
-            "`damping`: at most {MAX_DAMPINGS} damping ratios per request"
-        )));
-    }
-    if !(request.f_min > 0.0 && request.f_max > request.f_min) {
-        return Err(Problem::invalid_query(format!(
-            "the frequency grid needs 0 < f_min < f_max (got f_min {} Hz, f_max {} Hz)",
-            request.f_min, request.f_max
-        )));
-    }
-    Ok(request)
-}
-
 /// A signal's response spectrum
 ///
 /// The pseudo-acceleration response spectrum PSA(f, ξ) = ω² max|u| of the record (m/s²),
@@ -448,7 +360,7 @@ pub async fn spectrum(
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
     let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
-    let request = parse_spectrum_query(&pairs)?;
+    let request = parse_spectrum_query(&pairs, &[])?.request;
     let format = Format::from_query(request.format.as_deref(), Format::preferred(&headers))?;
     let metadata = state
         .signals
@@ -456,22 +368,8 @@ pub async fn spectrum(
         .await?
         .ok_or_else(|| Problem::no_such_signal(&signal_id))?;
     let frequencies = log_spaced(request.f_min, request.f_max, request.points);
-    // Each frequency steps through every sample, plus 64 sub-steps per period over the
-    // record where its period is shorter than the sample interval.
-    let steps = request.dampings.len() as f64
-        * frequencies
-            .iter()
-            .map(|f| metadata.samples as f64 + 64.0 * f * metadata.duration)
-            .sum::<f64>();
-    if steps > MAX_SPECTRUM_STEPS {
-        return Err(Problem::invalid_query(format!(
-            "this grid takes about {steps:.2e} oscillator steps on this record ({} samples over {} s), \
-             more than the limit of {MAX_SPECTRUM_STEPS:.0e}: ask for fewer `points`, fewer damping \
-             ratios or a lower `f_max`",
-            metadata.samples, metadata.duration
-        ))
-        .into());
-    }
+    let samples = usize::try_from(metadata.samples).unwrap_or(usize::MAX);
+    request.check_cost(&frequencies, samples, metadata.duration)?;
     let record = state
         .signals
         .record(tenant.as_str(), &signal_id)
@@ -502,14 +400,7 @@ pub async fn spectrum(
     };
     let body = match format {
         Format::Json => serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))?,
-        Format::Csv => {
-            let series: Vec<(String, Vec<f64>)> = document
-                .pseudo_acceleration
-                .iter()
-                .map(|s| (format!("psa_{}", s.damping), s.values.clone()))
-                .collect();
-            columns_csv("frequency", &document.frequencies, &series).into_bytes()
-        }
+        Format::Csv => spectra_csv(&document.frequencies, &document.pseudo_acceleration).into_bytes(),
     };
     Ok((
         [(
@@ -519,40 +410,4 @@ pub async fn spectrum(
         body,
     )
         .into_response())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn pairs(items: &[(&str, &str)]) -> Vec<(String, String)> {
-        items.iter().map(|(k, v)| ((*k).into(), (*v).into())).collect()
-    }
-
-    #[test]
-    fn dampings_may_be_repeated_or_comma_separated() {
-        let request = parse_spectrum_query(&pairs(&[
-            ("damping", "0.02,0.05"),
-            ("damping", "0.1"),
-            ("points", "50"),
-        ]))
-        .unwrap();
-        assert_eq!(request.dampings, vec![0.02, 0.05, 0.1]);
-        assert_eq!(request.points, 50);
-        assert_eq!(parse_spectrum_query(&[]).unwrap().dampings, vec![0.05]);
-    }
-
-    #[test]
-    fn bad_spectrum_queries_are_refused() {
-        for bad in [
-            &[("damping", "1.0")][..],
-            &[("damping", "abc")],
-            &[("f_min", "0")],
-            &[("f_min", "10"), ("f_max", "5")],
-            &[("points", "1")],
-            &[("dampnig", "0.05")],
-        ] {
-            assert!(parse_spectrum_query(&pairs(bad)).is_err(), "{bad:?}");
-        }
-    }
 }

@@ -71,15 +71,24 @@ impl JobQueue {
     }
 
     /// Marks the job failed with `problem` as its error (served by `/jobs/{id}/results`).
-    /// A run of a `fail_fast` sweep also dismisses the sweep's runs that have not ended
-    /// (their workers notice within a second), in the same transaction.
-    pub async fn fail(&self, lease: &Lease, problem: &Problem) -> Result<bool, sqlx::Error> {
+    /// `reached`: the percent the run had reached when it stopped (a diverged run's
+    /// progress says where it stopped, even between two heartbeats); `None` keeps the
+    /// last recorded progress (a job that failed before computing). A run of a
+    /// `fail_fast` sweep also dismisses the sweep's runs that have not ended (their
+    /// workers notice within a second), in the same transaction.
+    pub async fn fail(
+        &self,
+        lease: &Lease,
+        problem: &Problem,
+        reached: Option<u8>,
+    ) -> Result<bool, sqlx::Error> {
         let now = self.now();
         with_pool!(&self.db, pool => {
             let mut tx = pool.begin().await?;
             let updated = sqlx::query(concat!(
                 "UPDATE jobs SET status = 'failed', message = $5, error = $6, finished_at = $4, \
-                     updated_at = $4, lease_owner = NULL, lease_expires_at = NULL",
+                     updated_at = $4, lease_owner = NULL, lease_expires_at = NULL, \
+                     progress = COALESCE($7, progress)",
                 guard!()
             ))
             .bind(&lease.job_id)
@@ -88,6 +97,7 @@ impl JobQueue {
             .bind(now)
             .bind(format!("failed: {}", problem.detail))
             .bind(serde_json::to_string(problem).unwrap_or_default())
+            .bind(reached.map(i64::from))
             .execute(&mut *tx)
             .await?;
             if updated.rows_affected() != 1 {

@@ -16,6 +16,7 @@ const LIST_SQLITE: &str = concat!(
        AND ($2 IS NULL OR process_id IN (SELECT value FROM json_each($2))) \
        AND ($3 IS NULL OR seq < $3) \
        AND ($5 IS NULL OR sweep_id IN (SELECT value FROM json_each($5))) \
+       AND ($7 IS NULL OR (sweep_id IS NOT NULL) = $7) \
        AND tenant = $6 \
      ORDER BY seq DESC LIMIT $4"
 );
@@ -27,6 +28,7 @@ const LIST_POSTGRES: &str = concat!(
        AND ($2 IS NULL OR process_id IN (SELECT json_array_elements_text(CAST($2 AS json)))) \
        AND ($3 IS NULL OR seq < $3) \
        AND ($5 IS NULL OR sweep_id IN (SELECT json_array_elements_text(CAST($5 AS json)))) \
+       AND (CAST($7 AS boolean) IS NULL OR (sweep_id IS NOT NULL) = $7) \
        AND tenant = $6 \
      ORDER BY seq DESC LIMIT $4"
 );
@@ -38,6 +40,8 @@ pub struct JobFilter {
     pub process_ids: Vec<String>,
     /// Only runs of these sweeps.
     pub sweep_ids: Vec<String>,
+    /// `Some(false)`: only jobs submitted on their own; `Some(true)`: only sweep runs.
+    pub in_sweep: Option<bool>,
 }
 
 /// A job with what it produced: results document (successful) or problem (failed).
@@ -92,6 +96,7 @@ impl JobQueue {
                 .bind(i64::from(limit))
                 .bind(&sweep_ids)
                 .bind(tenant)
+                .bind(filter.in_sweep)
                 .fetch_all(pool)
                 .await
         })

@@ -35,7 +35,7 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
         .observe_queue_wait(&process_id, Duration::from_millis(wait_ms));
     let Some(process) = ctx.registry.get(&process_id) else {
         let problem = Problem::job_failed(format!("this service no longer offers process `{process_id}`"));
-        record(&lease, "fail", ctx.queue.fail(&lease, &problem).await);
+        record(&lease, "fail", ctx.queue.fail(&lease, &problem, None).await);
         return;
     };
     let started = Instant::now();
@@ -65,7 +65,11 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
         }
         Err(error) => {
             tracing::error!(job = %lease.job_id, %error, "a signal of the job cannot be read");
-            record(&lease, "fail", ctx.queue.fail(&lease, &crashed_problem()).await);
+            record(
+                &lease,
+                "fail",
+                ctx.queue.fail(&lease, &crashed_problem(), None).await,
+            );
             return;
         }
     };
@@ -164,6 +168,7 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
         lost,
         handing_back,
         timed_out: timed_out.then_some(ctx.max_job_time).flatten(),
+        reached: control.percent(),
     };
     let outcome_label = finish(ctx, &lease, outcome, ending).await;
     ctx.metrics
@@ -180,6 +185,9 @@ struct Ending {
     handing_back: bool,
     /// The run went over this wall-time limit.
     timed_out: Option<Duration>,
+    /// The percent the run had reached when it ended (its last progress callback): a
+    /// failed job keeps it, so its progress says where it stopped.
+    reached: u8,
 }
 
 /// Writes the outcome of a run under its lease; returns the outcome's metric label.
@@ -188,6 +196,7 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
         lost,
         handing_back,
         timed_out,
+        reached,
     } = ending;
     match outcome {
         Ok(Ok(_)) | Ok(Err(_)) if lost => "lost",
@@ -215,12 +224,20 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
                 }
                 Ok(Err(error)) => {
                     tracing::error!(job = %lease.job_id, %error, "the process returned an unusable history");
-                    record(lease, "fail", ctx.queue.fail(lease, &crashed_problem()).await);
+                    record(
+                        lease,
+                        "fail",
+                        ctx.queue.fail(lease, &crashed_problem(), Some(reached)).await,
+                    );
                     "crashed"
                 }
                 Err(error) => {
                     tracing::error!(job = %lease.job_id, %error, "storing the results panicked");
-                    record(lease, "fail", ctx.queue.fail(lease, &crashed_problem()).await);
+                    record(
+                        lease,
+                        "fail",
+                        ctx.queue.fail(lease, &crashed_problem(), Some(reached)).await,
+                    );
                     "crashed"
                 }
             }
@@ -231,7 +248,11 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
         }
         Ok(Err(RunError::Cancelled)) if timed_out.is_some() => {
             let problem = Problem::job_time_limit(timed_out.unwrap_or_default());
-            record(lease, "fail", ctx.queue.fail(lease, &problem).await);
+            record(
+                lease,
+                "fail",
+                ctx.queue.fail(lease, &problem, Some(reached)).await,
+            );
             "timed_out"
         }
         // Stopped by a dismissal the supervisor has not noticed yet: the row says so already.
@@ -240,18 +261,28 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
             record(
                 lease,
                 "fail",
-                ctx.queue.fail(lease, &Problem::job_failed(reason)).await,
+                ctx.queue
+                    .fail(lease, &Problem::job_failed(reason), Some(reached))
+                    .await,
             );
             "failed"
         }
         Ok(Err(RunError::Invalid(invalid))) => {
             let problem = Problem::invalid_inputs(&invalid);
-            record(lease, "fail", ctx.queue.fail(lease, &problem).await);
+            record(
+                lease,
+                "fail",
+                ctx.queue.fail(lease, &problem, Some(reached)).await,
+            );
             "failed"
         }
         Err(panic) => {
             tracing::error!(job = %lease.job_id, panic = %panic, "the process panicked");
-            record(lease, "fail", ctx.queue.fail(lease, &crashed_problem()).await);
+            record(
+                lease,
+                "fail",
+                ctx.queue.fail(lease, &crashed_problem(), Some(reached)).await,
+            );
             "crashed"
         }
     }

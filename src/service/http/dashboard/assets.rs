@@ -1,5 +1,7 @@
-//! The dashboard's files, embedded in the binary: scripts, style sheet, and the shipped
-//! examples (`examples/*.json`) offered as templates by the submit page.
+//! The dashboard's files, embedded in the binary: scripts, style sheet, the vendored
+//! plotting library (uPlot, `assets/vendor/`, its version and licence in
+//! `assets/vendor/README.md`), and the shipped examples (`examples/*.json`) offered as
+//! templates by the submit page.
 
 use std::sync::OnceLock;
 
@@ -12,6 +14,8 @@ pub struct Asset {
 }
 
 const JS: &str = "text/javascript; charset=utf-8";
+const CSS: &str = "text/css; charset=utf-8";
+const TEXT: &str = "text/plain; charset=utf-8";
 
 macro_rules! asset {
     ($name:literal, $content_type:expr) => {
@@ -21,6 +25,13 @@ macro_rules! asset {
             bytes: include_bytes!(concat!("assets/", $name)),
         }
     };
+    (vendor $name:literal, $content_type:expr) => {
+        Asset {
+            name: $name,
+            content_type: $content_type,
+            bytes: include_bytes!(concat!("assets/vendor/", $name)),
+        }
+    };
 }
 
 /// Every file served under `/ui/assets/`.
@@ -28,13 +39,20 @@ pub const ASSETS: &[Asset] = &[
     asset!("app.js", JS),
     asset!("util.js", JS),
     asset!("plot.js", JS),
+    asset!("lines.js", JS),
     asset!("lists.js", JS),
     asset!("job.js", JS),
     asset!("hex.js", JS),
     asset!("impacts.js", JS),
+    asset!("spectra.js", JS),
+    asset!("signals.js", JS),
     asset!("sweep.js", JS),
     asset!("submit.js", JS),
-    asset!("style.css", "text/css; charset=utf-8"),
+    asset!("schema.js", JS),
+    asset!("style.css", CSS),
+    asset!(vendor "uPlot.esm.js", JS),
+    asset!(vendor "uPlot.min.css", CSS),
+    asset!(vendor "uPlot.LICENSE", TEXT),
 ];
 
 /// The embedded file called `name`.
@@ -126,6 +144,24 @@ mod tests {
                 ),
             }
         }
+    }
+
+    /// The version the vendor note states is the one the vendored script says it is.
+    #[test]
+    fn the_vendored_uplot_is_the_version_its_note_names() {
+        let note = include_str!("assets/vendor/README.md");
+        let version = note
+            .lines()
+            .find_map(|line| line.strip_prefix("- version: "))
+            .expect("a `- version:` line in vendor/README.md");
+        let script = std::str::from_utf8(find("uPlot.esm.js").unwrap().bytes).unwrap();
+        let header: String = script.lines().take(8).collect();
+        assert!(
+            header.contains(&format!("(v{version})")),
+            "vendor/README.md says {version}, the script's header: {header}"
+        );
+        let license = std::str::from_utf8(find("uPlot.LICENSE").unwrap().bytes).unwrap();
+        assert!(license.starts_with("The MIT License"), "{license}");
     }
 
     #[test]

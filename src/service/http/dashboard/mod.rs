@@ -1,9 +1,10 @@
 //! The dashboard: HTML pages for people, on the same addresses as the JSON API.
 //!
-//! A browser asking for `/`, `/jobs`, `/jobs/{jobId}`, `/sweeps` or `/sweeps/{sweepId}`
-//! gets a small HTML page ([`negotiation`] decides); every other client gets the JSON
-//! exactly as before. The page's scripts then read the JSON API like any client and draw
-//! the plots as SVG in the browser. `/ui/submit` is the submit form, `/ui/assets/{file}`
+//! A browser asking for `/`, `/jobs`, `/jobs/{jobId}`, `/sweeps`, `/sweeps/{sweepId}`,
+//! `/signals` or `/signals/{signalId}` gets a small HTML page ([`negotiation`] decides);
+//! every other client gets the JSON exactly as before. The page's scripts then read the
+//! JSON API like any client and draw the plots in the browser (line plots with the
+//! vendored uPlot, maps, histograms and bars as SVG). `/ui/submit` is the submit form, `/ui/assets/{file}`
 //! the scripts and style sheet, `/ui/examples.json` the shipped examples: all embedded in
 //! the binary ([`assets`]), nothing fetched from elsewhere.
 
@@ -28,6 +29,8 @@ pub enum Page {
     Job,
     Sweeps,
     Sweep,
+    Signals,
+    Signal,
     Submit,
 }
 
@@ -40,6 +43,8 @@ impl Page {
             "/jobs/{jobId}" => Some(Self::Job),
             "/sweeps" => Some(Self::Sweeps),
             "/sweeps/{sweepId}" => Some(Self::Sweep),
+            "/signals" => Some(Self::Signals),
+            "/signals/{signalId}" => Some(Self::Signal),
             _ => None,
         }
     }
@@ -51,6 +56,8 @@ impl Page {
             Self::Job => "job",
             Self::Sweeps => "sweeps",
             Self::Sweep => "sweep",
+            Self::Signals => "signals",
+            Self::Signal => "signal",
             Self::Submit => "submit",
         }
     }
@@ -62,6 +69,8 @@ impl Page {
             Self::Job => "Job · chocmodal",
             Self::Sweeps => "Sweeps · chocmodal",
             Self::Sweep => "Sweep · chocmodal",
+            Self::Signals => "Signals · chocmodal",
+            Self::Signal => "Signal · chocmodal",
             Self::Submit => "Submit · chocmodal",
         }
     }
@@ -77,6 +86,7 @@ pub fn shell(page: Page) -> String {
 <meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
 <title>{title}</title>
+<link rel="stylesheet" href="/ui/assets/uPlot.min.css">
 <link rel="stylesheet" href="/ui/assets/style.css">
 <script type="module" src="/ui/assets/app.js"></script>
 </head>
@@ -86,6 +96,7 @@ pub fn shell(page: Page) -> String {
 <nav>
 <a href="/jobs" data-nav="jobs">Jobs</a>
 <a href="/sweeps" data-nav="sweeps">Sweeps</a>
+<a href="/signals" data-nav="signals">Signals</a>
 <a href="/ui/submit" data-nav="submit">Submit</a>
 <a href="/openapi.json">API</a>
 </nav>
@@ -95,7 +106,7 @@ pub fn shell(page: Page) -> String {
 to any client that does not ask for HTML (see <a href="/openapi.json">the API</a>).</p></noscript>
 </main>
 <footer class="bottom">JSON API: <a href="/processes">processes</a> · <a href="/jobs?f=json">jobs</a> ·
-<a href="/sweeps?f=json">sweeps</a> · <a href="/conformance">conformance</a> · <a href="/openapi.json">OpenAPI</a> ·
+<a href="/sweeps?f=json">sweeps</a> · <a href="/signals?f=json">signals</a> · <a href="/conformance">conformance</a> · <a href="/openapi.json">OpenAPI</a> ·
 <a href="/healthz">health</a> · <a href="/metrics">metrics</a></footer>
 </body>
 </html>

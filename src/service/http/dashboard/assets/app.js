@@ -7,6 +7,8 @@ const pages = {
   home: () => import('./lists.js').then((m) => m.home),
   jobs: () => import('./lists.js').then((m) => m.jobs),
   sweeps: () => import('./lists.js').then((m) => m.sweeps),
+  signals: () => import('./signals.js').then((m) => m.signals),
+  signal: () => import('./signals.js').then((m) => m.signal),
   job: () => import('./job.js').then((m) => m.job),
   sweep: () => import('./sweep.js').then((m) => m.sweep),
   submit: () => import('./submit.js').then((m) => m.submit),

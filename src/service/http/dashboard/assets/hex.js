@@ -6,7 +6,8 @@
 // Then the run's impacts, and each pin's largest deflections and histories.
 
 import {api, card, errorBox, fmt, h, keyValueTable, replace, withUnit} from './util.js';
-import {barChart, figure, linePlot, svgElement as s, viridis} from './plot.js';
+import {barChart, figure, svgElement as s, viridis} from './plot.js';
+import {linePlot} from './lines.js';
 import {envelope, envelopeSeries, history, qualityBadge, reportedPeak, seriesOf, thinned} from './job.js';
 import {STATISTICS, contactImpacts, impactsCard, statisticPicker} from './impacts.js';
 
@@ -89,7 +90,7 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
         envelope(id, results, 'contact_forces', `c${k}`)]);
       replace(plotBox, linePlot({id: 'contact_forces', title: `Contact force c${k}`,
         series: [...envelopeSeries(peaks), ...seriesOf(doc)], hLines: reportedPeak(c.max_force, 'N'),
-        xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(doc, peaks)}));
+        xName: 'time', xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(doc, peaks)}));
     } catch (error) {
       replace(plotBox, errorBox(error));
     }
@@ -167,7 +168,7 @@ async function pinsCard(id, results, pins) {
       const [doc, peaks] = await Promise.all([history(id, 'displacements', wanted),
         envelope(id, results, 'displacements', wanted)]);
       replace(pinBox, linePlot({id: 'displacements', title: `Deflection of pin ${p} along x and y (${wanted})`,
-        series: [...envelopeSeries(peaks), ...seriesOf(doc)], xLabel: 'time (s)', yLabel: 'w (m)',
+        series: [...envelopeSeries(peaks), ...seriesOf(doc)], xName: 'time', xLabel: 'time (s)', yLabel: 'w (m)',
         caption: thinned(doc, peaks)}));
     } catch (error) {
       replace(pinBox, errorBox(error));

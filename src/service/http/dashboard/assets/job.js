@@ -7,12 +7,15 @@
 // to its numbers, and each force or displacement plot draws the history's peak-keeping
 // companion (`<name>_peaks`) with the samples, so the plotted peak is the reported one.
 // Plausibility warnings about the inputs (the status's, or a sweep run's results') are
-// listed under the status, each with the input it points at.
+// listed under the status, each with the input it points at. Every process with a
+// displacement history gets its response spectra (spectra.js).
 
 import {FINISHED, ApiProblem, api, badge, card, download, errorBox, fmt, fmtElapsed, fmtTime, h, keyValueTable,
-  leaves, poll, progressBar, replace, withUnit} from './util.js';
-import {barChart, heatMap, linePlot} from './plot.js';
+  leaves, poll, progressCell, replace, withUnit} from './util.js';
+import {barChart, heatMap} from './plot.js';
+import {linePlot} from './lines.js';
 import {hexBundle} from './hex.js';
+import {responseSpectrumCard} from './spectra.js';
 import {STATISTICS, contactImpacts, impactsCard, statisticPicker} from './impacts.js';
 
 /** Points asked of a history for a plot (min/max thinning keeps every peak). */
@@ -55,7 +58,7 @@ function statusTable(id, status) {
       ['Process', status.processID],
       ['Status', [badge(status.status), status.message && !['queued', 'running', 'finished', 'dismissed'].includes(status.message)
         ? h('span', {class: 'message'}, ` ${status.message}`) : null]],
-      ['Progress', running ? progressBar(status.progress, status.status) : `${status.progress} %`],
+      ['Progress', progressCell(status)],
       ['Created', fmtTime(status.created)],
       ['Started', fmtTime(status.started)],
       ['Finished', fmtTime(status.finished)],
@@ -105,8 +108,9 @@ async function showResults(box, id, status) {
     return;
   }
   const sections = h('div');
+  const spectrumBox = h('div');
   const runWarnings = (status.warnings || []).length ? null : warningsList(results.warnings);
-  replace(box, runWarnings ? card('Warnings', runWarnings) : null, qualityCard(results), sections,
+  replace(box, runWarnings ? card('Warnings', runWarnings) : null, qualityCard(results), sections, spectrumBox,
     downloadsCard(id, results));
   if (status.processID === 'cantilever-impact') {
     await cantilever(sections, id, results);
@@ -117,6 +121,7 @@ async function showResults(box, id, status) {
   } else {
     await generic(sections, id, results);
   }
+  replace(spectrumBox, await responseSpectrumCard(id, status.processID));
 }
 
 function downloadsCard(id, results) {
@@ -239,11 +244,11 @@ async function cantilever(box, id, results) {
     linePlot({id: 'tip_displacement', title: 'Tip displacement w(L, t)',
       series: [...envelopeSeries(tipPeaks, COMPARED), ...seriesOf(tip, COMPARED)],
       hLines: reportedPeak(n.min_tip_displacement, 'm'),
-      xLabel: 'time (s)', yLabel: 'w (m)', caption: thinned(tip, tipPeaks)}),
+      xName: 'time', xLabel: 'time (s)', yLabel: 'w (m)', caption: thinned(tip, tipPeaks)}),
     linePlot({id: 'contact_force', title: 'Contact force',
       series: [...envelopeSeries(forcePeaks, COMPARED), ...seriesOf(force, COMPARED)],
       hLines: reportedPeak(n.max_contact_force, 'N'),
-      xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(force, forcePeaks)}));
+      xName: 'time', xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(force, forcePeaks)}));
   const highest = Math.max(...(r.free_frequencies_hz || []).slice(0, 2), ...(r.contact_frequencies_hz || []).slice(0, 2));
   const fMax = h('input', {type: 'number', min: 0, step: 'any', value: Number.isFinite(highest) ? fmt(1.25 * highest, 2) : 200,
     'aria-label': 'highest frequency (Hz)'});
@@ -255,7 +260,7 @@ async function cantilever(box, id, results) {
       const cmp = doc.comparison;
       replace(drawn, linePlot({id: 'tip_displacement-spectrum', title: 'Power spectral density of w(L, t)',
         series: doc.series.map((item) => ({name: item.name, x: doc.frequency, y: item.values, ...COMPARED[item.name]})),
-        xLabel: 'frequency (Hz)', yLabel: 'Γ (m²/Hz)', logY: true,
+        xName: 'frequency', xLabel: 'frequency (Hz)', yLabel: 'Γ (m²/Hz)', logY: true,
         markers: cmp ? [{x: cmp.frequency, label: `max |Γnum − Γref| at ${fmt(cmp.frequency, 4)} Hz`}] : [],
         caption: cmp ? h('span', {class: 'muted', 'data-spectrum-f-err': cmp.f_err},
           ` f_err = ${fmt(cmp.f_err, 3)} = max |Γnum − Γref| / max Γ, at ${fmt(cmp.frequency, 4)} Hz`) : null}));
@@ -351,7 +356,7 @@ async function bundle(box, id, results) {
           envelope(id, results, 'contact_forces', `c${k}`)]);
         replace(plotBox, linePlot({id: 'contact_forces', title: `Contact force c${k}`,
           series: [...envelopeSeries(peaks), ...seriesOf(doc)], hLines: reportedPeak(c.max_force, 'N'),
-          xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(doc, peaks)}));
+          xName: 'time', xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(doc, peaks)}));
       } catch (error) {
         replace(plotBox, errorBox(error));
       }
@@ -376,7 +381,7 @@ async function bundle(box, id, results) {
           envelope(id, results, 'displacements', name)]);
         replace(pinBox, linePlot({id: 'displacements', title: `Deflection of pin ${p} (${name})`,
           series: [...envelopeSeries(peaks), ...seriesOf(doc)],
-          xLabel: 'time (s)', yLabel: 'w (m)', caption: thinned(doc, peaks)}));
+          xName: 'time', xLabel: 'time (s)', yLabel: 'w (m)', caption: thinned(doc, peaks)}));
       } catch (error) {
         replace(pinBox, errorBox(error));
       }
@@ -400,7 +405,7 @@ async function generic(box, id, results) {
     if (name === 'impacts') continue;
     const names = await seriesNames(id, name);
     const doc = await history(id, name, names.slice(0, 6).join(','));
-    append(box, card(name, linePlot({id: name, title: name, series: seriesOf(doc), xLabel: 'time (s)', yLabel: name,
+    append(box, card(name, linePlot({id: name, title: name, series: seriesOf(doc), xName: 'time', xLabel: 'time (s)', yLabel: name,
       caption: names.length > 6 ? h('span', {class: 'muted'}, ` first 6 of ${names.length} series`) : thinned(doc)})));
   }
 }

@@ -1,8 +1,8 @@
 // The home page, the job list and the sweep list. Lists refresh themselves: every second
 // while something in them is queued or running (progress bars move), every 5 s otherwise.
 
-import {FINISHED, api, badge, card, errorBox, fmtElapsed, fmtTime, h, progressBar, replace, shortId, sweepBadge}
-  from './util.js';
+import {FINISHED, api, badge, card, errorBox, fmtElapsed, h, progressBar, progressCell, replace, shortId,
+  sweepBadge, timeCell} from './util.js';
 
 const STATUSES = ['accepted', 'running', 'successful', 'failed', 'dismissed'];
 
@@ -30,10 +30,9 @@ function jobRow(job) {
     h('td', {}, badge(job.status), job.message && (job.status === 'failed'
         || (job.status === 'successful' && job.message !== 'finished'))
       ? h('div', {class: 'message', title: job.message}, job.message) : null),
-    h('td', {}, job.status === 'running' || job.status === 'accepted' ? progressBar(job.progress, job.status)
-      : h('span', {class: 'muted'}, job.status === 'successful' ? '100 %' : '')),
-    h('td', {}, fmtTime(job.created)),
-    h('td', {}, fmtTime(job.finished)),
+    h('td', {}, progressCell(job)),
+    h('td', {}, timeCell(job.created)),
+    h('td', {}, timeCell(job.finished)),
     h('td', {class: 'muted'}, fmtElapsed(job.started, job.finished)),
     h('td', {}, sweep));
 }
@@ -62,8 +61,8 @@ function sweepTable(sweeps) {
       h('td', {}, sweepBadge(sweep)),
       h('td', {}, FINISHED.has(sweep.status) ? '' : progressBar(sweep.progress, sweep.status)),
       h('td', {}, `${sweep.runs}`, h('div', {class: 'message'}, countsText(sweep.counts))),
-      h('td', {}, fmtTime(sweep.created)),
-      h('td', {}, fmtTime(sweep.finished)))))));
+      h('td', {}, timeCell(sweep.created)),
+      h('td', {}, timeCell(sweep.finished)))))));
 }
 
 const busyJobs = (doc) => doc.jobs.some((job) => !FINISHED.has(job.status));
@@ -107,11 +106,15 @@ function filterBar(params, processes) {
   const statusLinks = [['all', null], ...STATUSES.map((s) => [s === 'accepted' ? 'queued' : s, s])]
     .map(([label, value]) => h('a', {href: link(label, {status: value}),
       class: (value || '') === current ? 'chip current' : 'chip'}, label));
+  const inSweep = params.get('inSweep');
+  const sweepLinks = [['with sweep runs', null], ['without sweep runs', 'false'], ['sweep runs only', 'true']]
+    .map(([label, value]) => h('a', {href: link(label, {inSweep: value}), 'data-in-sweep': value ?? 'any',
+      class: (value || '') === (inSweep || '') ? 'chip current' : 'chip'}, label));
   const select = h('select', {'aria-label': 'Process',
     onchange: (event) => { location.href = link('', {processID: event.target.value || null}); }},
   h('option', {value: ''}, 'every process'),
   processes.map((p) => h('option', {value: p.id, selected: params.get('processID') === p.id}, p.id)));
-  return h('div', {class: 'filters'}, statusLinks, select);
+  return h('div', {class: 'filters'}, statusLinks, select, h('span', {class: 'chips'}, sweepLinks));
 }
 
 export async function jobs(main) {

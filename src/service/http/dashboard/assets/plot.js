@@ -1,6 +1,6 @@
-// Hand-drawn SVG plots: line plots (linear or logarithmic y), heat maps with a contour
-// line, histograms and bar charts. Each figure carries data-* attributes (the series
-// drawn, their extremes, the cells) so that tests can check what is on the page.
+// SVG figures on categories and bins: heat maps with a contour line, histograms and bar
+// charts (line plots, interactive, are lines.js's). Each figure carries data-* attributes
+// (the cells, the bars and their values) so that tests can check what is on the page.
 
 import {h, fmt} from './util.js';
 
@@ -68,13 +68,6 @@ export function viridis(t) {
   return `rgb(${c[0]},${c[1]},${c[2]})`;
 }
 
-function legend(series) {
-  return h('div', {class: 'legend'}, series.map((item, k) =>
-    h('span', {class: 'key'},
-      h('span', {class: `swatch c${item.color ?? k}${item.dashed ? ' dashed' : ''}${item.envelope ? ' envelope' : ''}`}),
-      item.label || item.name)));
-}
-
 function figure(id, title, caption, svg, extra = {}) {
   return h('figure', {class: 'plot', 'data-plot': id, ...extra},
     h('figcaption', {}, h('span', {class: 'title'}, title), caption), svg);
@@ -88,91 +81,6 @@ function axisLabels(width, height, margin, xLabel, yLabel) {
       'text-anchor': 'middle',
       transform: `rotate(-90 14 ${margin.top + (height - margin.top - margin.bottom) / 2})`}, yLabel || ''),
   ];
-}
-
-/**
- * A line plot. `series`: [{name, label, x: [...], y: [...], dashed, color, envelope}]
- * (`envelope`: drawn light, behind, for the peak-per-interval companion of a history); `logY` draws
- * y on a log scale (values ≤ 0 sit on the floor, at most `logRange` decades below the
- * top); `markers`: vertical lines [{x, label}]; `hLines`: horizontal lines [{y, label}].
- */
-export function linePlot({id, title, caption, series, xLabel, yLabel, logY = false, logRange = 10,
-  height = 300, markers = [], hLines = []}) {
-  const margin = {left: 78, right: 18, top: 14, bottom: 46};
-  const width = WIDTH;
-  const [x0, x1] = extent(series.flatMap((item) => item.x));
-  let [y0, y1] = extent(series.flatMap((item) => (logY ? item.y.filter((v) => v > 0) : item.y)));
-  for (const line of hLines) {
-    if (!logY || line.y > 0) {
-      y0 = Math.min(y0, line.y);
-      y1 = Math.max(y1, line.y);
-    }
-  }
-  if (!Number.isFinite(x0) || !Number.isFinite(y0)) {
-    return figure(id, title, h('span', {class: 'muted'}, ' no data'), h('div'));
-  }
-  const xSpan = x1 > x0 ? [x0, x1] : [x0 - 1, x0 + 1];
-  let ySpan;
-  if (logY) {
-    const top = Math.log10(y1);
-    const bottom = Math.max(Math.log10(y0), top - logRange);
-    ySpan = top > bottom ? [bottom - 0.05 * (top - bottom), top + 0.05 * (top - bottom)] : [top - 1, top + 1];
-  } else {
-    const pad = y1 > y0 ? 0.05 * (y1 - y0) : Math.abs(y1) * 0.1 || 1;
-    ySpan = [y0 - pad, y1 + pad];
-  }
-  const plotW = width - margin.left - margin.right;
-  const plotH = height - margin.top - margin.bottom;
-  const X = (x) => margin.left + ((x - xSpan[0]) / (xSpan[1] - xSpan[0])) * plotW;
-  const Y = (y) => {
-    const v = logY ? Math.log10(Math.max(y, 10 ** ySpan[0])) : y;
-    return margin.top + plotH - ((v - ySpan[0]) / (ySpan[1] - ySpan[0])) * plotH;
-  };
-  const grid = [];
-  for (const t of niceTicks(xSpan[0], xSpan[1], 8)) {
-    grid.push(s('line', {class: 'grid', x1: round(X(t)), x2: round(X(t)), y1: margin.top, y2: margin.top + plotH}));
-    grid.push(s('text', {class: 'tick', x: round(X(t)), y: margin.top + plotH + 16, 'text-anchor': 'middle'}, fmt(t, 3)));
-  }
-  const yTicks = logY ? decadeTicks(ySpan[0], ySpan[1]).map((e) => 10 ** e) : niceTicks(ySpan[0], ySpan[1], 6);
-  for (const t of yTicks) {
-    grid.push(s('line', {class: 'grid', x1: margin.left, x2: margin.left + plotW, y1: round(Y(t)), y2: round(Y(t))}));
-    grid.push(s('text', {class: 'tick', x: margin.left - 6, y: round(Y(t)) + 4, 'text-anchor': 'end'},
-      logY ? `1e${Math.round(Math.log10(t))}` : fmt(t, 3)));
-  }
-  const paths = series.map((item, k) => {
-    let d = '';
-    let pen = false;
-    for (let i = 0; i < item.x.length; i++) {
-      const x = item.x[i];
-      const y = item.y[i];
-      if (!Number.isFinite(x) || !Number.isFinite(y)) {
-        pen = false;
-        continue;
-      }
-      d += `${pen ? 'L' : 'M'}${round(X(x))} ${round(Y(y))}`;
-      pen = true;
-    }
-    const [min, max] = extent(item.y);
-    return s('path', {class: `series c${item.color ?? k}${item.dashed ? ' dashed' : ''}${item.envelope ? ' envelope' : ''}`, d,
-      'data-series': item.name, 'data-points': item.x.length, 'data-min': min, 'data-max': max});
-  });
-  const lines = [
-    ...markers.filter((m) => m.x >= xSpan[0] && m.x <= xSpan[1]).map((m) => s('g', {class: 'marker', 'data-marker': m.x},
-      s('line', {x1: round(X(m.x)), x2: round(X(m.x)), y1: margin.top, y2: margin.top + plotH}),
-      s('text', {x: round(X(m.x)) + 4, y: margin.top + 12}, m.label || ''))),
-    ...hLines.map((l) => s('g', {class: 'marker', 'data-hline': l.y},
-      s('line', {x1: margin.left, x2: margin.left + plotW, y1: round(Y(l.y)), y2: round(Y(l.y))}),
-      s('text', {x: margin.left + plotW - 4, y: round(Y(l.y)) - 4, 'text-anchor': 'end'}, l.label || ''))),
-  ];
-  const svg = s('svg', {viewBox: `0 0 ${width} ${height}`, role: 'img', 'aria-label': title, class: 'chart'},
-    s('defs', {}, s('clipPath', {id: `clip-${id}`},
-      s('rect', {x: margin.left, y: margin.top, width: plotW, height: plotH}))),
-    grid,
-    s('rect', {class: 'frame', x: margin.left, y: margin.top, width: plotW, height: plotH}),
-    s('g', {'clip-path': `url(#clip-${id})`}, paths),
-    lines,
-    axisLabels(width, height, margin, xLabel, yLabel));
-  return figure(id, title, [caption || null, legend(series)], svg, {'data-log-y': String(logY)});
 }
 
 /**

@@ -7,6 +7,18 @@
 // refused as invalid, its errors are shown), `?sweep=<sweepId>` (its definition).
 
 import {api, errorBox, h, pointerToken, post, replace} from './util.js';
+import {fieldInfo, schemaAt, taggedVariants} from './schema.js';
+
+/** The schema of a request body of `process`: its `inputs` (from the process description). */
+const bodySchemas = new Map();
+function bodySchema(process) {
+  if (!bodySchemas.has(process)) {
+    bodySchemas.set(process, api(`/processes/${process}`).then((description) => ({properties: {inputs: {properties:
+      Object.fromEntries(Object.entries(description.inputs || {}).map(([name, input]) => [name, input.schema]))}}}))
+      .catch(() => null));
+  }
+  return bodySchemas.get(process);
+}
 
 export async function submit(main) {
   const params = new URLSearchParams(location.search);
@@ -75,11 +87,29 @@ export async function submit(main) {
     state.body = readForm(form, state.body);
     text.value = JSON.stringify(state.body, null, 2);
   };
+  let schema = null;
   const renderForm = () => {
-    replace(form, fields(state.body, '', null));
+    replace(form, fields(state.body, '', null, {root: schema, body: state.body, onVariant}));
     text.value = JSON.stringify(state.body, null, 2);
   };
-  const render = () => {
+  // Another `type` of a tagged object (a section, a pulse, a gap law): the members both
+  // variants have are kept, the new one's required members are offered empty.
+  const onVariant = (pointer, tag) => {
+    syncText();
+    const found = taggedVariants(schemaAt(schema, state.body, pointer)).find((v) => v.tag === tag);
+    if (!found) return;
+    const old = getAt(state.body, pointer) || {};
+    const next = {type: tag};
+    for (const name of Object.keys(found.variant.properties)) {
+      if (name === 'type') continue;
+      if (old[name] !== undefined) next[name] = old[name];
+      else if ((found.variant.required || []).includes(name)) next[name] = '';
+    }
+    setAt(state.body, pointer, next);
+    renderForm();
+  };
+  const render = async () => {
+    schema = await bodySchema(state.process);
     templateSelect.value = state.file || '';
     processSelect.value = state.process;
     processSelect.disabled = state.kind === 'sweep';
@@ -87,7 +117,7 @@ export async function submit(main) {
     renderForm();
     replace(outcome);
   };
-  processSelect.addEventListener('change', () => render());
+  processSelect.addEventListener('change', () => { render(); });
   const send = async () => {
     syncText();
     sendButton.disabled = true;
@@ -121,7 +151,7 @@ export async function submit(main) {
       outcome, form,
       h('details', {}, h('summary', {}, 'Edit as JSON'), text),
       h('p', {}, sendButton)));
-  render();
+  await render();
   if (pending) {
     showErrors(form, outcome, pending, `Job ${params.get('from')} was refused; fix the fields marked and submit again.`);
   }
@@ -133,29 +163,78 @@ function typeOf(value) {
   return typeof value;
 }
 
-/** Form controls for a JSON value at `pointer`: fieldsets for objects and arrays of objects, inputs for the rest. */
-function fields(value, pointer, key) {
+/** The unit label of a field: the unit, `–` for a dimensionless number, `#` for an integer. */
+function unitLabel(unit) {
+  if (!unit) return null;
+  const text = {dimensionless: '–', integer: '#'}[unit] || unit;
+  const title = {dimensionless: 'dimensionless', integer: 'a whole number'}[unit] || `in ${unit}`;
+  return h('span', {class: 'unit', 'data-unit': unit, title}, text);
+}
+
+/** What the form shows of the field at `pointer`: its schema's unit and choices. A sweep's
+ *  axis values take the unit of the input their axis points at. */
+function infoAt(pointer, key, ctx) {
+  if (!ctx.root) return fieldInfo(null);
+  const axis = /^\/axes\/(\d+)\/(values|linspace|logspace|uniform|normal|lognormal)/.exec(pointer);
+  if (axis && ctx.body.axes && ctx.body.axes[Number(axis[1])]) {
+    const target = ctx.body.axes[Number(axis[1])].pointer;
+    return fieldInfo(typeof target === 'string' ? schemaAt(ctx.root, ctx.body, `/inputs${target}`) : null);
+  }
+  if (key === 'type') {
+    const parent = pointer.slice(0, pointer.lastIndexOf('/'));
+    const tags = taggedVariants(schemaAt(ctx.root, ctx.body, parent)).map((v) => v.tag);
+    if (tags.length > 1) return {unit: null, choices: tags, keywords: [], tagOf: parent};
+  }
+  return fieldInfo(schemaAt(ctx.root, ctx.body, pointer));
+}
+
+/** Form controls for a JSON value at `pointer`: fieldsets for objects and arrays of
+ *  objects, a select for a choice among names, inputs for the rest, each with its unit. */
+function fields(value, pointer, key, ctx) {
   if (value && typeof value === 'object' && !Array.isArray(value)) {
-    const children = Object.entries(value).map(([k, v]) => fields(v, `${pointer}/${pointerToken(k)}`, k));
+    const children = Object.entries(value).map(([k, v]) => fields(v, `${pointer}/${pointerToken(k)}`, k, ctx));
     if (key === null) return children;
     return h('fieldset', {'data-pointer': pointer}, h('legend', {}, key), children);
   }
   if (Array.isArray(value) && value.length && value.every((v) => v && typeof v === 'object')) {
-    const items = value.map((v, k) => fields(v, `${pointer}/${k}`, `${key} ${k}`));
+    const items = value.map((v, k) => fields(v, `${pointer}/${k}`, `${key} ${k}`, ctx));
     const body = value.length > 12
       ? h('details', {}, h('summary', {}, `${value.length} items`), items)
       : items;
     return h('fieldset', {'data-pointer': pointer, class: 'list'}, h('legend', {}, `${key} (${value.length})`), body);
   }
+  const info = infoAt(pointer, key, ctx);
+  if (info.choices && (typeof value === 'string' || value === undefined)) {
+    const choices = info.choices.includes(value) || value === '' || value === undefined ? info.choices : [value, ...info.choices];
+    const select = h('select', {'data-pointer': pointer, 'data-type': 'string', 'data-choices': info.choices.length,
+      onchange: info.tagOf ? (event) => ctx.onVariant(info.tagOf, event.target.value) : null},
+    choices.map((choice) => h('option', {value: choice, selected: choice === value}, choice)));
+    return h('label', {class: 'field'}, h('span', {class: 'name'}, key), select);
+  }
   const isJson = Array.isArray(value) || (value !== null && typeof value === 'object');
+  const list = info.keywords.length ? `keywords${pointer.replaceAll('/', '-')}` : null;
   const input = h('input', {
     type: 'text',
     'data-pointer': pointer,
     'data-type': isJson ? 'json' : typeOf(value),
     value: isJson ? JSON.stringify(value) : value === null ? 'null' : String(value),
     spellcheck: 'false',
+    list,
+    title: info.description || null,
   });
-  return h('label', {class: 'field'}, h('span', {class: 'name'}, key), input);
+  return h('label', {class: 'field'}, h('span', {class: 'name'}, key),
+    h('span', {class: 'control'}, input, unitLabel(info.unit)),
+    list ? h('datalist', {id: list}, info.keywords.map((word) => h('option', {value: word}))) : null);
+}
+
+/** The value at a JSON pointer of `root` (undefined when absent). */
+function getAt(root, pointer) {
+  let node = root;
+  for (const token of pointer.split('/').slice(1).map((t) => t.replaceAll('~1', '/').replaceAll('~0', '~'))) {
+    if (node === null || typeof node !== 'object') return undefined;
+    node = node[Array.isArray(node) ? Number(token) : token];
+  }
+  return node;
 }
 
 /** Sets `value` at a JSON pointer of `root` (existing containers only); `undefined` removes the member. */
@@ -171,7 +250,7 @@ function setAt(root, pointer, value) {
 /** A copy of `body` with every input's value: numbers, booleans and null as such, other text as strings. */
 function readForm(form, body) {
   const copy = structuredClone(body);
-  for (const input of form.querySelectorAll('input[data-pointer]')) {
+  for (const input of form.querySelectorAll('input[data-pointer], select[data-pointer]')) {
     const text = input.value.trim();
     let value;
     if (text === '') {

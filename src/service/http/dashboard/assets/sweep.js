@@ -4,7 +4,8 @@
 
 import {FINISHED, api, badge, card, download, errorBox, fmt, fmtColumn, fmtTime, h, keyValueTable, poll, progressBar,
   replace, shortId, sweepBadge} from './util.js';
-import {heatMap, histogram, linePlot} from './plot.js';
+import {heatMap, histogram} from './plot.js';
+import {linePlot} from './lines.js';
 
 /** Rows of the results table shown on the page (the CSV has them all). */
 const TABLE_ROWS = 500;
@@ -160,7 +161,7 @@ function calibrationCard(calibration, axes, jobOf) {
     const label = (c) => axes.map((p) => `${p} = ${fmtColumn(c.parameters[p], p)}`).join(', ');
     const title = 'f_err over the grid';
     if (!state.y) {
-      replace(mapBox, linePlot({id: 'calibration', title, xLabel: state.x, yLabel: 'f_err', logY: true,
+      replace(mapBox, linePlot({id: 'calibration', title, xName: state.x, xLabel: state.x, yLabel: 'f_err', logY: true,
         series: [{name: 'f_err', x: shown.map((c) => c.parameters[state.x]), y: shown.map((c) => c.f_err)}],
         hLines: [{y: threshold, label: `f_err = ${fmt(threshold)}`}]}));
       return;

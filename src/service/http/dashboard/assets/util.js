@@ -186,6 +186,15 @@ export function fmtTime(text) {
     `${pad(d.getHours())}:${pad(d.getMinutes())}:${pad(d.getSeconds())}`;
 }
 
+/** An RFC 3339 time for a table cell: `MM-DD HH:MM:SS` in the current year (the full
+ *  date and time as its tooltip), else as fmtTime. */
+export function timeCell(text) {
+  const full = fmtTime(text);
+  const d = new Date(text);
+  if (!text || Number.isNaN(d.getTime()) || d.getFullYear() !== new Date().getFullYear()) return full;
+  return h('span', {title: full}, full.slice(5));
+}
+
 /** Seconds between two RFC 3339 times, as `1.23 s`, `4 min 05 s`, ... */
 export function fmtElapsed(from, to) {
   if (!from || !to) return '';
@@ -216,9 +225,11 @@ export function sweepBadge(sweep) {
   return element;
 }
 
-/** A progress bar for a percentage 0–100; `data-value` holds the fraction 0–1. */
-export function progressBar(percent, status) {
+/** A progress bar for a percentage 0–100; `data-value` holds the fraction 0–1; `prefix`
+ *  goes before the percent (`stopped at` for a run that ended early). */
+export function progressBar(percent, status, prefix = '') {
   const fraction = Math.max(0, Math.min(1, (Number(percent) || 0) / 100));
+  const label = `${prefix ? `${prefix} ` : ''}${Math.round(fraction * 100)} %`;
   const bar = h('div', {
     class: `progress ${status || ''}`,
     role: 'progressbar',
@@ -226,9 +237,18 @@ export function progressBar(percent, status) {
     'aria-valuemax': 100,
     'aria-valuenow': Math.round(fraction * 100),
     'data-value': fraction,
-    title: `${Math.round(fraction * 100)} %`,
+    title: label,
   }, h('div', {class: 'fill', style: `width: ${(fraction * 100).toFixed(1)}%`}));
-  return h('span', {class: 'progress-cell'}, bar, h('span', {class: 'percent'}, `${Math.round(fraction * 100)} %`));
+  return h('span', {class: 'progress-cell'}, bar, h('span', {class: 'percent'}, label));
+}
+
+/** A job's progress: the bar while it is queued or running, and where a failed or
+ *  dismissed run stopped. */
+export function progressCell(job) {
+  if (job.status === 'running' || job.status === 'accepted') return progressBar(job.progress, job.status);
+  if (job.status === 'successful') return h('span', {class: 'muted'}, '100 %');
+  if (job.progress > 0) return progressBar(job.progress, job.status, 'stopped at');
+  return h('span', {class: 'muted'}, job.status === 'failed' ? 'before its first step' : '');
 }
 
 /** A JSON pointer token (RFC 6901): `~` and `/` escaped. */
@@ -269,6 +289,16 @@ export function errorBox(error) {
     h('strong', {}, problem.title || 'Error'), ' ', problem.detail || String(error.message || error));
 }
 
+/** Saves `blob` as a file called `filename` (the browser's download). */
+export function saveBlob(blob, filename) {
+  const url = URL.createObjectURL(blob);
+  const link = h('a', {href: url, download: filename});
+  document.body.append(link);
+  link.click();
+  link.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 10000);
+}
+
 /** A download link, saved as `filename`. */
 export function download(href, filename) {
   // With a token, a plain link would go without it: fetch, then save the bytes.
@@ -280,14 +310,7 @@ export function download(href, filename) {
         if (!response.ok) throw new ApiProblem(response.status, null);
         return response.blob();
       })
-      .then((blob) => {
-        const url = URL.createObjectURL(blob);
-        const link = h('a', {href: url, download: filename});
-        document.body.append(link);
-        link.click();
-        link.remove();
-        setTimeout(() => URL.revokeObjectURL(url), 10000);
-      })
+      .then((blob) => saveBlob(blob, filename))
       .catch((error) => window.alert(`Download failed: ${error.message}`));
   };
   return h('a', {class: 'download', href, download: filename, onclick: save}, filename);

@@ -1,0 +1,379 @@
+//! Pseudo-acceleration response spectra over HTTP: the query both routes share (damping
+//! ratios, the log-spaced frequency grid, its cost ceiling, the CSV form), and
+//! `GET /jobs/{jobId}/results/{output}/response_spectrum`, the spectrum of a point of the
+//! model from one column of a displacement history (an in-structure response spectrum).
+//! `/signals/{id}/spectrum` (`signals.rs`) is the spectrum of a stored record.
+
+use axum::extract::{Extension, Path, Query, State};
+use axum::http::HeaderMap;
+use axum::response::Response;
+use serde::Serialize;
+use utoipa::ToSchema;
+
+use super::AppState;
+use super::error::ApiError;
+use super::history_view::{Format, respond};
+use super::signal_models::DampedSpectrum;
+use crate::physics::acceleration::acceleration_of_displacement;
+use crate::physics::response_spectrum::{self, log_spaced};
+use crate::problem::Problem;
+use crate::processes::{HistoryKind, columns_csv};
+use crate::service::auth::Tenant;
+use crate::service::{store, thinning};
+
+/// Default frequency grid of a spectrum (Hz, points).
+pub const DEFAULT_F_MIN: f64 = 0.1;
+pub const DEFAULT_F_MAX: f64 = 100.0;
+pub const DEFAULT_POINTS: usize = 200;
+/// Most frequencies and damping ratios of one spectrum request.
+pub const MAX_POINTS: usize = 2000;
+pub const MAX_DAMPINGS: usize = 10;
+/// Most oscillator sub-steps one spectrum request may take (about 10 s of computing):
+/// each frequency f steps through every sample interval, in sub-steps of at most 1/64
+/// of its period.
+pub const MAX_SPECTRUM_STEPS: f64 = 2e9;
+
+/// What a response-spectrum request asks for (`/signals/{id}/spectrum`,
+/// `/jobs/{id}/results/{output}/response_spectrum`).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct SpectrumRequest {
+    /// Damping ratios ξ (dimensionless, in [0, 1)).
+    pub dampings: Vec<f64>,
+    /// Lowest and highest frequency of the grid (Hz).
+    pub f_min: f64,
+    pub f_max: f64,
+    /// Frequencies of the grid, log-spaced.
+    pub points: usize,
+    pub format: Option<String>,
+}
+
+/// A parsed response-spectrum query: the request, and the values of the route's own
+/// parameters (`extra` of [`parse_spectrum_query`]) in the order given.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct SpectrumQuery {
+    pub request: SpectrumRequest,
+    pub extra: Vec<(String, String)>,
+}
+
+impl SpectrumRequest {
+    /// 400 when the grid would take more than [`MAX_SPECTRUM_STEPS`] oscillator steps on a
+    /// record of `samples` samples over `duration` (s): each frequency f steps through
+    /// every sample, plus 64 sub-steps per period where its period is shorter than the
+    /// sample interval.
+    pub fn check_cost(&self, frequencies: &[f64], samples: usize, duration: f64) -> Result<(), Problem> {
+        let steps = self.dampings.len() as f64
+            * frequencies
+                .iter()
+                .map(|f| samples as f64 + 64.0 * f * duration)
+                .sum::<f64>();
+        if steps > MAX_SPECTRUM_STEPS {
+            return Err(Problem::invalid_query(format!(
+                "this grid takes about {steps:.2e} oscillator steps on this record ({samples} samples over \
+                 {duration} s), more than the limit of {MAX_SPECTRUM_STEPS:.0e}: ask for fewer `points`, fewer \
+                 damping ratios or a lower `f_max`"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Parses `damping` (repeatable or comma-separated; default 0.05), `f_min`, `f_max`,
+/// `points`, `format`, and the route's own parameters named in `extra` (kept as given);
+/// anything else is refused.
+pub(super) fn parse_spectrum_query(
+    pairs: &[(String, String)],
+    extra: &[&str],
+) -> Result<SpectrumQuery, Problem> {
+    let number = |name: &str, text: &str| -> Result<f64, Problem> {
+        text.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| Problem::invalid_query(format!("`{name}`: `{text}` is not a finite number")))
+    };
+    let mut request = SpectrumRequest {
+        dampings: Vec::new(),
+        f_min: DEFAULT_F_MIN,
+        f_max: DEFAULT_F_MAX,
+        points: DEFAULT_POINTS,
+        format: None,
+    };
+    let mut own = Vec::new();
+    for (key, value) in pairs {
+        match key.as_str() {
+            key if extra.contains(&key) => own.push((key.to_owned(), value.clone())),
+            "damping" => {
+                for text in value.split(',').filter(|s| !s.trim().is_empty()) {
+                    let xi = number("damping", text)?;
+                    if !(0.0..1.0).contains(&xi) {
+                        return Err(Problem::invalid_query(format!(
+                            "`damping`: {xi} is not a damping ratio in [0, 1)"
+                        )));
+                    }
+                    request.dampings.push(xi);
+                }
+            }
+            "f_min" => request.f_min = number("f_min", value)?,
+            "f_max" => request.f_max = number("f_max", value)?,
+            "points" => {
+                request.points = value
+                    .parse()
+                    .ok()
+                    .filter(|n| (2..=MAX_POINTS).contains(n))
+                    .ok_or_else(|| {
+                        Problem::invalid_query(format!("`points` must be an integer from 2 to {MAX_POINTS}"))
+                    })?;
+            }
+            "format" => request.format = Some(value.clone()),
+            other => {
+                let expected: Vec<&str> = ["damping", "f_min", "f_max", "points", "format"]
+                    .into_iter()
+                    .chain(extra.iter().copied())
+                    .collect();
+                return Err(Problem::invalid_query(format!(
+                    "unknown query parameter `{other}` (expected {})",
+                    expected.join(", ")
+                )));
+            }
+        }
+    }
+    if request.dampings.is_empty() {
+        request.dampings.push(0.05);
+    }
+    if request.dampings.len() > MAX_DAMPINGS {
+        return Err(Problem::invalid_query(format!(
+            "`damping`: at most {MAX_DAMPINGS} damping ratios per request"
+        )));
+    }
+    if !(request.f_min > 0.0 && request.f_max > request.f_min) {
+        return Err(Problem::invalid_query(format!(
+            "the frequency grid needs 0 < f_min < f_max (got f_min {} Hz, f_max {} Hz)",
+            request.f_min, request.f_max
+        )));
+    }
+    Ok(SpectrumQuery { request, extra: own })
+}
+
+/// `frequency,psa_<damping>...`: one row per frequency (Hz), one column per damping ratio
+/// (m/s²).
+pub(super) fn spectra_csv(frequencies: &[f64], spectra: &[DampedSpectrum]) -> String {
+    let series: Vec<(String, Vec<f64>)> = spectra
+        .iter()
+        .map(|s| (format!("psa_{}", s.damping), s.values.clone()))
+        .collect();
+    columns_csv("frequency", frequencies, &series)
+}
+
+/// The pseudo-acceleration response spectrum of one column of a displacement history.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct HistoryResponseSpectrum {
+    /// Output name, e.g. `displacements`.
+    pub output: String,
+    /// The column, e.g. `p0` (a pin tip), `numerical`.
+    pub series: String,
+    /// Mean sample interval of the history (s); the acceleration is read well up to
+    /// about a tenth of the sampling rate, 1/(10 × this).
+    pub sample_interval: f64,
+    /// Samples of the acceleration record: the history's, but its first and last.
+    pub samples: usize,
+    /// Largest |acceleration| of the record (m/s²): the spectrum tends to it at high
+    /// frequency (the zero-period acceleration).
+    pub peak_acceleration: f64,
+    /// Oscillator frequencies (Hz), log-spaced from `f_min` to `f_max`.
+    pub frequencies: Vec<f64>,
+    /// One spectrum per damping ratio asked for, in the order asked.
+    pub pseudo_acceleration: Vec<DampedSpectrum>,
+}
+
+/// Response spectrum of a displacement history
+///
+/// The pseudo-acceleration response spectrum PSA(f, ξ) = ω² max|u| (m/s²) of the motion
+/// of one column of a displacement history: the acceleration at each interior sample by
+/// second divided differences of the displacement (`physics::acceleration`), then the
+/// oscillators of `physics::response_spectrum` as for a signal (at rest at the first
+/// acceleration sample, followed one damped period after the last). The histories are in
+/// the wrapper's frame: for a run with a base excitation this is the spectrum of the
+/// motion relative to the wrapper. Only displacement histories (`kind` `displacement` in
+/// the process description) have one: another output is a 404. `series`: the column
+/// (default the first); `damping`, `f_min`, `f_max`, `points`: as for a signal's
+/// spectrum; `format=csv` (or `Accept: text/csv`): `frequency,psa_<damping>...`.
+#[utoipa::path(get, path = "/jobs/{jobId}/results/{output}/response_spectrum", operation_id = "getResultResponseSpectrum",
+    tag = "Results",
+    params(
+        ("jobId" = String, Path, description = "Job id"),
+        ("output" = String, Path, description = "A displacement history, e.g. `displacements`", example = "displacements"),
+        ("series" = Option<String>, Query, description = "The column, e.g. `p0` (default: the first)"),
+        ("damping" = Option<String>, Query, description = "Damping ratios in [0, 1), repeatable or comma-separated (default 0.05)"),
+        ("f_min" = Option<f64>, Query, description = "Lowest frequency (Hz, default 0.1)"),
+        ("f_max" = Option<f64>, Query, description = "Highest frequency (Hz, default 100)"),
+        ("points" = Option<usize>, Query, description = "Number of log-spaced frequencies, 2 to 2000 (default 200)"),
+        ("format" = Option<String>, Query, description = "`csv` or `json` (default from `Accept`, else JSON)"),
+    ),
+    responses(
+        (status = 200, description = "The spectrum (frequencies in Hz, PSA in m/s²)",
+            content(
+                (HistoryResponseSpectrum = "application/json"),
+                (String = "text/csv")
+            ),
+            headers(("ETag" = String))),
+        (status = 304, description = "Unchanged since the `If-None-Match` tag"),
+        (status = 400, description = "Invalid query parameter, an unknown column, or a grid too costly for this history",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 404, description = "No such job or displacement history, or results not ready",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 422, description = "The history is too short (fewer than 4 samples)",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
+pub async fn response_spectrum(
+    State(state): State<AppState>,
+    Extension(tenant): Extension<Tenant>,
+    Path((job_id, output)): Path<(String, String)>,
+    query: Result<Query<Vec<(String, String)>>, axum::extract::rejection::QueryRejection>,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
+    let SpectrumQuery { request, extra } = parse_spectrum_query(&pairs, &["series"])?;
+    let series = match extra.as_slice() {
+        [] => None,
+        [(_, name)] if !name.is_empty() && !name.contains(',') => Some(name.clone()),
+        _ => return Err(Problem::invalid_query("`series` names one column, once").into()),
+    };
+    let format = Format::from_query(request.format.as_deref(), Format::preferred(&headers))?;
+    let job = state
+        .queue
+        .get(tenant.as_str(), &job_id)
+        .await?
+        .ok_or_else(|| Problem::no_such_job(&job_id))?;
+    let kind = state
+        .registry
+        .get(&job.process_id)
+        .and_then(|process| process.history_kind(&output));
+    if kind != Some(HistoryKind::Displacement) {
+        let mut problem = Problem::no_such_output(&job_id, &format!("{output}/response_spectrum"));
+        problem.detail = match kind {
+            Some(kind) => format!(
+                "`{output}` of job `{job_id}` is a {} history: only displacement histories have a response spectrum",
+                kind.as_str()
+            ),
+            None => format!("job `{job_id}` has no displacement history `{output}`"),
+        };
+        return Err(problem.into());
+    }
+    respond(
+        &state,
+        &tenant,
+        &job_id,
+        &output,
+        &headers,
+        format,
+        "computing a response spectrum",
+        move |stored| render(stored, series.as_deref(), &request, format),
+    )
+    .await
+}
+
+fn render(
+    stored: &store::StoredHistory,
+    series: Option<&str>,
+    request: &SpectrumRequest,
+    format: Format,
+) -> Result<Vec<u8>, ApiError> {
+    let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
+    let name = series
+        .map(str::to_owned)
+        .or_else(|| history.series.first().map(|(name, _)| name.clone()))
+        .unwrap_or_default();
+    let history = thinning::pick_series(history, Some(&name)).map_err(Problem::invalid_query)?;
+    let (name, displacement) = history
+        .series
+        .into_iter()
+        .next()
+        .ok_or_else(|| Problem::invalid_query(format!("`{}` has no column", history.name)))?;
+    let record = acceleration_of_displacement(&history.time, &displacement).map_err(|e| {
+        Problem::from_status(
+            422,
+            "Unprocessable Content",
+            format!("`{}` column `{name}`: {e}", history.name),
+        )
+    })?;
+    let duration = record.time.last().unwrap_or(&0.0) - record.time.first().unwrap_or(&0.0);
+    let frequencies = log_spaced(request.f_min, request.f_max, request.points);
+    request.check_cost(&frequencies, record.time.len(), duration)?;
+    let spectra = request
+        .dampings
+        .iter()
+        .map(|&xi| response_spectrum::pseudo_acceleration(&record, &frequencies, xi))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| ApiError::Internal(format!("the response spectrum of a stored history failed: {e}")))?;
+    let spectra: Vec<DampedSpectrum> = spectra
+        .into_iter()
+        .map(|s| DampedSpectrum {
+            damping: s.damping,
+            values: s.pseudo_acceleration,
+        })
+        .collect();
+    if format == Format::Csv {
+        return Ok(spectra_csv(&frequencies, &spectra).into_bytes());
+    }
+    let document = HistoryResponseSpectrum {
+        output: history.name,
+        series: name,
+        sample_interval: (history.time[history.time.len() - 1] - history.time[0])
+            / (history.time.len() - 1) as f64,
+        samples: record.time.len(),
+        peak_acceleration: record.values.iter().fold(0.0, |peak: f64, a| peak.max(a.abs())),
+        frequencies,
+        pseudo_acceleration: spectra,
+    };
+    serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pairs(items: &[(&str, &str)]) -> Vec<(String, String)> {
+        items.iter().map(|(k, v)| ((*k).into(), (*v).into())).collect()
+    }
+
+    #[test]
+    fn dampings_may_be_repeated_or_comma_separated() {
+        let request = parse_spectrum_query(
+            &pairs(&[("damping", "0.02,0.05"), ("damping", "0.1"), ("points", "50")]),
+            &[],
+        )
+        .unwrap()
+        .request;
+        assert_eq!(request.dampings, vec![0.02, 0.05, 0.1]);
+        assert_eq!(request.points, 50);
+        assert_eq!(
+            parse_spectrum_query(&[], &[]).unwrap().request.dampings,
+            vec![0.05]
+        );
+    }
+
+    #[test]
+    fn bad_spectrum_queries_are_refused() {
+        for bad in [
+            &[("damping", "1.0")][..],
+            &[("damping", "abc")],
+            &[("f_min", "0")],
+            &[("f_min", "10"), ("f_max", "5")],
+            &[("points", "1")],
+            &[("dampnig", "0.05")],
+        ] {
+            assert!(parse_spectrum_query(&pairs(bad), &[]).is_err(), "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn a_route_names_its_own_parameters() {
+        let query =
+            parse_spectrum_query(&pairs(&[("series", "p0"), ("damping", "0.02")]), &["series"]).unwrap();
+        assert_eq!(query.extra, vec![("series".to_owned(), "p0".to_owned())]);
+        assert_eq!(query.request.dampings, vec![0.02]);
+        let refused = parse_spectrum_query(&pairs(&[("series", "p0")]), &[]).unwrap_err();
+        assert!(refused.detail.contains("`series`"), "{}", refused.detail);
+        let refused = parse_spectrum_query(&pairs(&[("serie", "p0")]), &["series"]).unwrap_err();
+        assert!(refused.detail.ends_with("format, series)"), "{}", refused.detail);
+    }
+}
