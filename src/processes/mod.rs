@@ -14,8 +14,11 @@ pub mod cost;
 pub mod hex_bundle_dynamics;
 pub mod hex_inputs;
 pub mod impact_report;
+pub mod input_schema;
 pub mod inputs;
 pub mod metrics;
+/// The member at fault when a tagged object fails to parse.
+pub mod misfit;
 pub mod model_check;
 /// The shared parts of results documents (quality, energy) as serialized types.
 pub mod report;

@@ -20,7 +20,7 @@ use super::signal_input::{SignalLibrary, SignalSlot};
 use super::warnings::{self, Subject, Warning};
 use super::{
     CostLimits, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, Validated, WorkEstimate,
-    inputs,
+    input_schema,
 };
 
 /// One history a simulation writes: served as `/jobs/{id}/results/{name}` (CSV or JSON).
@@ -129,11 +129,11 @@ impl<S: Simulation> Process for S {
     }
 
     fn inputs_description(&self) -> serde_json::Value {
-        inputs::ogc_inputs(&inputs::schema_of::<S::Inputs>())
+        input_schema::ogc_inputs(&input_schema::schema_of::<S::Inputs>())
     }
 
     fn inputs_schema(&self) -> Option<serde_json::Value> {
-        Some(inputs::schema_of::<S::Inputs>())
+        Some(input_schema::schema_of::<S::Inputs>())
     }
 
     fn outputs_description(&self) -> serde_json::Value {
