@@ -92,8 +92,7 @@ impl History {
 }
 
 /// CSV text of a key column (`time`, `frequency`) and named series of equal length, with
-/// a `<key>,<series...>` header; each number the shortest text that reads back as the
-/// same f64.
+/// a `<key>,<series...>` header; each number as [`crate::csv_format`] writes it.
 pub fn columns_csv(key: &str, keys: &[f64], series: &[(String, Vec<f64>)]) -> String {
     let mut out = String::with_capacity(keys.len() * (series.len() + 1) * 24);
     out.push_str(key);
@@ -103,10 +102,10 @@ pub fn columns_csv(key: &str, keys: &[f64], series: &[(String, Vec<f64>)]) -> St
     }
     out.push('\n');
     for (row, k) in keys.iter().enumerate() {
-        out.push_str(&format!("{k:e}"));
+        crate::csv_format::push_number(&mut out, *k);
         for (_, values) in series {
             out.push(',');
-            out.push_str(&format!("{:e}", values[row]));
+            crate::csv_format::push_number(&mut out, values[row]);
         }
         out.push('\n');
     }
