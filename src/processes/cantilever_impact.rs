@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
+use super::columns::{self, Column};
 use super::impact_report::{self, ContactImpacts, ImpactSummary, ImpactsInput};
 use super::inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::model_check::{self, StandIn};
@@ -425,6 +426,26 @@ impl Simulation for CantileverImpact {
     type Inputs = CantileverInputs;
     type Results = CantileverResults;
     type Plan = Plan;
+
+    /// `numerical` and `reference`: the tip deflection (m) or the contact force (N) of
+    /// each solution.
+    fn column(output: &str, name: &str, _document: &serde_json::Value) -> Option<Column> {
+        let solution = match name {
+            "numerical" => "the numerical (modal) scheme",
+            "reference" => "the semi-analytic reference",
+            _ => return None,
+        };
+        let (unit, what) = match output.trim_end_matches("_peaks") {
+            "tip_displacement" => ("m", "tip deflection w(L), positive away from the spring"),
+            "contact_force" => ("N", "tip contact force"),
+            _ => return None,
+        };
+        Some(Column::new(
+            name,
+            unit,
+            columns::of_output(output, format!("{what}, {solution}")),
+        ))
+    }
 
     fn prepare(inputs: CantileverInputs) -> Result<Plan, InvalidInputs> {
         let mut errors: Vec<FieldError> = at("/inputs/beam", inputs.beam.validate());

@@ -10,6 +10,8 @@ pub mod basis_report;
 pub mod bundle_dynamics;
 pub mod bundle_inputs;
 pub mod cantilever_impact;
+/// What each column of a history is: name, unit, what it measures.
+pub mod columns;
 pub mod cost;
 pub mod hex_bundle_dynamics;
 pub mod hex_inputs;
@@ -46,6 +48,7 @@ mod static_correction_tests;
 use std::ops::ControlFlow;
 use std::sync::Arc;
 
+pub use columns::Column;
 pub use cost::{CostLimits, TooCostly, WorkEstimate};
 pub use simulation::{HistoryOutput, Output, Simulation};
 pub use warnings::Warning;
@@ -197,6 +200,15 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     }
     /// OGC process description `outputs` object: `{name: {title, description, schema}}`.
     fn outputs_description(&self) -> serde_json::Value;
+    /// What each column of the history `output` is, read from the run's results
+    /// `document`: the `time` column, then one per series of `names`, in order. Default:
+    /// the series undescribed.
+    fn history_columns(&self, output: &str, names: &[String], document: &serde_json::Value) -> Vec<Column> {
+        let _ = (output, document);
+        std::iter::once(Column::time())
+            .chain(names.iter().map(Column::unknown))
+            .collect()
+    }
     /// Parses and checks the `inputs` object of an execution request, and estimates what
     /// running it will cost (a service compares that with its [`CostLimits`]). Pointers in
     /// the errors start with `/inputs`. Accepted inputs come with their plausibility

@@ -9,6 +9,7 @@ mod skip;
 
 mod capabilities;
 mod cors;
+mod csv;
 mod dashboard;
 mod database;
 mod dismissal;
