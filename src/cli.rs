@@ -220,13 +220,7 @@ fn contacts_csv(document: &serde_json::Value) -> Option<String> {
         .map(crate::processes::metrics::flatten_scalars)
         .collect();
     let header: Vec<&str> = rows[0].iter().map(|(name, _)| name.as_str()).collect();
-    let cell = |value: &serde_json::Value| match value {
-        serde_json::Value::String(text) if text.contains([',', '"']) => {
-            format!("\"{}\"", text.replace('"', "\"\""))
-        }
-        serde_json::Value::String(text) => text.clone(),
-        other => other.to_string(),
-    };
+    let cell = crate::csv_format::cell;
     let mut out = format!("contact,{}\n", header.join(","));
     for (k, row) in rows.iter().enumerate() {
         let cells: Vec<String> = header

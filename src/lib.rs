@@ -5,6 +5,8 @@
 
 /// The `chocmodal` command line (serve, run).
 pub mod cli;
+/// CSV as every output writes it: one number format, one quoting rule (a leaf).
+pub mod csv_format;
 /// Request bodies as JSON values, with pointer-bearing errors (numbers out of range).
 pub mod json_body;
 /// Pure numerics: beams, modal bases, contacts, explicit integration, reference solution.

@@ -302,8 +302,8 @@ fn check(record: &Table, lines: &[usize]) -> Result<(), RecordError> {
     }
 }
 
-/// The record as CSV lines `time,acceleration` (with that header), each number the
-/// shortest text that reads back as the same f64, produced `rows` lines at a time.
+/// The record as CSV lines `time,acceleration` (with that header), each number as
+/// [`crate::csv_format`] writes it, produced `rows` lines at a time.
 pub fn csv_chunks(record: Arc<Table>, rows: usize) -> impl Iterator<Item = String> + Send + 'static {
     let rows = rows.max(1);
     let header = std::iter::once("time,acceleration\n".to_owned());
@@ -311,7 +311,10 @@ pub fn csv_chunks(record: Arc<Table>, rows: usize) -> impl Iterator<Item = Strin
         let last = (first + rows).min(record.time.len());
         let mut chunk = String::with_capacity((last - first) * 48);
         for k in first..last {
-            chunk.push_str(&format!("{:e},{:e}\n", record.time[k], record.values[k]));
+            crate::csv_format::push_number(&mut chunk, record.time[k]);
+            chunk.push(',');
+            crate::csv_format::push_number(&mut chunk, record.values[k]);
+            chunk.push('\n');
         }
         chunk
     });

@@ -49,7 +49,40 @@ fn run_prints_the_results_document_and_writes_csv_histories() {
         lines.count() as u64,
         document["numerical"]["impacts"].as_u64().unwrap()
     );
+    for entry in std::fs::read_dir(&out).unwrap() {
+        let path = entry.unwrap().path();
+        assert_numbers_canonical(
+            &std::fs::read_to_string(&path).unwrap(),
+            &path.display().to_string(),
+        );
+    }
     std::fs::remove_dir_all(&out).ok();
+}
+
+/// Every number of a CSV below its header is written as the service writes them (and as
+/// the JSON documents do): an integer, or the shortest text that reads back as the same
+/// double.
+fn assert_numbers_canonical(csv: &str, what: &str) {
+    let canonical = |cell: &str| {
+        let integer = cell.strip_prefix('-').unwrap_or(cell);
+        (!integer.is_empty() && integer.bytes().all(|b| b.is_ascii_digit()))
+            || cell
+                .parse::<f64>()
+                .ok()
+                .and_then(serde_json::Number::from_f64)
+                .is_some_and(|n| n.to_string() == cell)
+    };
+    let mut seen = 0;
+    for cell in csv.lines().skip(1).flat_map(|line| line.split(',')) {
+        if cell.parse::<f64>().is_ok() {
+            seen += 1;
+            assert!(
+                canonical(cell),
+                "{what}: `{cell}` is not the shortest text of its number"
+            );
+        }
+    }
+    assert!(seen > 0, "{what}: no number");
 }
 
 #[test]
@@ -97,6 +130,7 @@ fn a_bundle_run_writes_its_contact_statistics_as_csv() {
             "{written} vs {reported}"
         );
     }
+    assert_numbers_canonical(&csv, "contacts.csv");
     std::fs::remove_dir_all(&out).ok();
 }
 

@@ -301,6 +301,10 @@ impl Simulation for BundleDynamics {
     type Results = BundleResults;
     type Plan = Plan;
 
+    fn column(output: &str, name: &str, document: &serde_json::Value) -> Option<super::Column> {
+        super::columns::row(output, name, document)
+    }
+
     fn signals(inputs: &mut BundleInputs) -> Vec<super::signal_input::SignalSlot<'_>> {
         inputs.excitation.signal_references()
     }

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::impact_report::ImpactsInput;
+use super::input_schema::{NonNegativeNumber, PositiveNumber};
 use super::inputs::{BeamInput, SolverInput};
 use super::warnings::WarningsInput;
 use crate::physics::bundle::{BundleLayout, GapDistribution, GapState, Levels, LocalClosure};
@@ -19,40 +20,60 @@ pub struct BundleInputs {
     /// The pin shared by the whole row (one modal basis).
     pub pin: BeamInput,
     /// Explicit form: number of pins, numbered 0.. from the left wall.
+    #[schema(minimum = 1, maximum = 2000)]
     pub pins: Option<usize>,
     /// Explicit form: every potential contact.
     pub contacts: Option<Vec<ContactInput>>,
     /// Generator form, instead of `pins` and `contacts`.
     pub bundle: Option<BundleGenerator>,
+    /// The initial state: at rest, or released from bent shapes.
     #[serde(default)]
+    #[schema(default = json!({}))]
     pub initial: InitialInput,
+    /// The loads: the wrapper's acceleration, forces on the pins.
     #[serde(default)]
+    #[schema(default = json!({}))]
     pub excitation: ExcitationInput,
+    /// Explicit integration.
     #[serde(default)]
+    #[schema(schema_with = super::input_schema::auto_solver_schema, default = json!({}))]
     pub solver: SolverInput,
+    /// History sampling and impact counting.
     #[serde(default)]
+    #[schema(default = json!({}))]
     pub output: OutputInput,
     /// Plausibility warnings (a unit slip, nothing exciting the model, ...): `on`
     /// (default) or `off`; never a refusal.
     #[serde(default)]
+    #[schema(default = "on")]
     pub warnings: WarningsInput,
 }
 
-/// A potential point contact between `left` and `right` ("wall" or a pin number).
+/// A potential point contact between `left` and `right` ("wall" or a pin number): at
+/// height z, penetration δ = w_left(z) − w_right(z) − gap (a wall's w is 0), force
+/// F = max(0, stiffness·δ + damping·δ̇) while δ > 0, pushing `left` toward the left wall
+/// and `right` toward the right wall.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactInput {
+    /// The body on the left: "wall" (the left wall) or a pin number (0 … pins − 1).
     pub left: BodyInput,
+    /// The body on the right: "wall" (the right wall) or a pin number, another body
+    /// than `left`.
     pub right: BodyInput,
-    /// Height from the pin feet (m).
+    /// Height from the pin feet (m), at most the pin length.
+    #[schema(minimum = 0.0)]
     pub height: f64,
     /// Gap at rest (m).
     #[serde(default)]
+    #[schema(default = 0.0, minimum = 0.0)]
     pub gap: f64,
-    /// Penalty stiffness (N/m).
+    /// Penalty stiffness Kc (N/m).
+    #[schema(minimum = 0.0)]
     pub stiffness: f64,
-    /// Dashpot (N·s/m).
+    /// Dashpot cc (N·s/m), acting only while the contact is closed.
     #[serde(default)]
+    #[schema(default = 0.0, minimum = 0.0)]
     pub damping: f64,
 }
 
@@ -120,41 +141,52 @@ impl ContactInput {
     }
 }
 
-/// Generator form of a row of pins between two walls.
+/// Generator form of a row of pins between two walls: at each level, one contact
+/// between the left wall and pin 0, between each pin and the next, and between the last
+/// pin and the right wall (levels × (pins + 1) contacts, at most 100000).
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BundleGenerator {
-    /// Number of pins.
+    /// Number of pins, numbered 0.. from the left wall.
+    #[schema(minimum = 1, maximum = 2000)]
     pub pins: usize,
-    /// Contact levels: `{first, spacing, count}` or a list of heights (m).
+    /// Contact levels (m from the pin feet): `{first, spacing, count}` or a list of
+    /// heights.
     pub levels: LevelsInput,
-    /// Stiffness of every contact (N/m).
+    /// Penalty stiffness Kc of every contact (N/m).
+    #[schema(minimum = 0.0)]
     pub stiffness: f64,
-    /// Dashpot of every contact (N·s/m).
+    /// Dashpot cc of every contact (N·s/m), acting only while it is closed.
     #[serde(default)]
+    #[schema(default = 0.0, minimum = 0.0)]
     pub damping: f64,
     /// Nominal wall–pin gap (m).
+    #[schema(minimum = 0.0)]
     pub wall_gap: f64,
     /// Nominal pin–pin gap (m).
+    #[schema(minimum = 0.0)]
     pub pin_gap: f64,
-    /// Gap state (default uniform: the nominal gaps).
+    /// Gap state: the nominal gaps, one per contact, or random draws.
     #[serde(default)]
+    #[schema(default = json!({"type": "uniform"}))]
     pub gaps: GapsInput,
     /// Local gap changes (irradiation swelling), applied after `gaps`, in order.
     #[serde(default)]
+    #[schema(default = json!([]))]
     pub closures: Vec<ClosureInput>,
 }
 
-/// Contact levels.
-///
-/// Deserialized by hand rather than as an untagged enum: an object is parsed as
-/// [`RegularLevels`] and a list as heights, so that a mistake inside either (an unknown
-/// member, a wrong type) is reported at its own pointer, not as "matches no variant".
-/// The `serde` attribute only shapes the schema.
+// Deserialized by hand rather than as an untagged enum: an object is parsed as
+// `RegularLevels` and a list as heights, so that a mistake inside either (an unknown
+// member, a wrong type) is reported at its own pointer, not as "matches no variant".
+// The `serde` attribute only shapes the schema.
+/// Contact levels: `{first, spacing, count}`, or a list of heights (m from the pin feet,
+/// strictly increasing, within (0, pin length]).
 #[derive(Debug, Clone, PartialEq, ToSchema)]
 #[serde(untagged)]
 pub enum LevelsInput {
     Regular(RegularLevels),
+    #[schema(value_type = Vec<PositiveNumber>)]
     Explicit(Vec<f64>),
 }
 
@@ -182,36 +214,45 @@ impl<'de> Deserialize<'de> for LevelsInput {
     }
 }
 
-/// Levels first + k·spacing, k = 0..count (m).
+/// Levels first + k·spacing, k = 0..count (m), the last at most the pin length.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RegularLevels {
-    /// Height of the lowest level (m).
+    /// Height of the lowest level (m from the pin feet).
+    #[schema(exclusive_minimum = 0.0)]
     pub first: f64,
-    /// Distance between two levels (m).
+    /// Distance between two levels (m), enough to tell the levels apart in floating
+    /// point.
+    #[schema(exclusive_minimum = 0.0)]
     pub spacing: f64,
     /// Number of levels.
+    #[schema(minimum = 1)]
     pub count: usize,
 }
 
-/// Gap state.
+/// Gap state: `uniform`, `per_contact` or `random`.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum GapsInput {
-    /// Nominal gaps everywhere. (A struct variant: serde ignores `deny_unknown_fields`
-    /// on the unit variants of internally tagged enums, and a typo must not pass.)
+    // A struct variant: serde ignores `deny_unknown_fields` on the unit variants of
+    // internally tagged enums, and a typo must not pass.
+    /// The nominal gaps everywhere.
     Uniform {},
-    /// One gap per contact (m), in expansion order (level by level: wall–0, 0–1, …, n−1–wall).
+    /// One gap per contact, in expansion order (level by level: wall–0, 0–1, …, n−1–wall).
     PerContact {
-        /// The gaps (m), one per contact.
+        /// The gaps (m), levels × (pins + 1) of them.
+        #[schema(value_type = Vec<NonNegativeNumber>)]
         values: Vec<f64>,
     },
     /// Independent draws in expansion order, reproducible from the seed on every machine.
     Random {
+        /// The law of the draws.
         distribution: DistributionInput,
+        /// Seed of the draws (an integer from 0 to 2⁶⁴ − 1).
         seed: u64,
-        /// Draws multiply the nominal gaps instead of being gaps (m).
+        /// Draws multiply the nominal gaps (dimensionless) instead of being gaps (m).
         #[serde(default)]
+        #[schema(default = false)]
         relative: bool,
     },
 }
@@ -222,22 +263,28 @@ impl Default for GapsInput {
     }
 }
 
-/// Law of random gaps.
+/// Law of random gaps (m, or factors on the nominal gaps when `relative`): `uniform` or
+/// `normal`.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum DistributionInput {
-    /// Uniform law between `low` and `high`.
+    /// Uniform law on [low, high].
     Uniform {
-        /// Smallest draw (m; dimensionless for `relative` gaps).
+        /// Lowest value (m; dimensionless for `relative` gaps).
+        #[schema(minimum = 0.0)]
         low: f64,
-        /// Largest draw (m; dimensionless for `relative` gaps).
+        /// Highest value, at least `low` (m; dimensionless for `relative` gaps).
+        #[schema(minimum = 0.0)]
         high: f64,
     },
     /// Normal law truncated at 0 (resampled, a true truncated normal).
     Normal {
-        /// Mean of the law before truncation (m; dimensionless for `relative` gaps).
+        /// Mean of the law before truncation (m; dimensionless for `relative` gaps), at
+        /// least −30 × `std` (and at least 0 when `std` is 0).
         mean: f64,
-        /// Standard deviation (m; dimensionless for `relative` gaps).
+        /// Standard deviation of the law before truncation (m; dimensionless for
+        /// `relative` gaps).
+        #[schema(minimum = 0.0)]
         std: f64,
     },
 }
@@ -249,13 +296,14 @@ pub enum DistributionInput {
 pub struct ClosureInput {
     /// First level of the zone (0 = the lowest).
     pub first_level: usize,
-    /// Last level of the zone (included).
+    /// Last level of the zone, at least `first_level`, below the level count.
     pub last_level: usize,
-    /// First pin of the zone (0 = next to the left wall).
+    /// First pin of the zone.
     pub first_pin: usize,
-    /// Last pin of the zone (included).
+    /// Last pin of the zone, at least `first_pin`, below the pin count.
     pub last_pin: usize,
-    /// Multiplier of the gaps (dimensionless, ≥ 0; 0 closes them).
+    /// Multiplier of the gaps (dimensionless).
+    #[schema(minimum = 0.0)]
     pub factor: f64,
 }
 
@@ -310,9 +358,11 @@ impl BundleGenerator {
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct InitialInput {
-    /// Release of each pin from its static tip-load shape with this tip deflection (m);
-    /// one per pin, or empty for all at rest.
+    /// Release of each pin, at rest, from its static tip-load shape with this tip
+    /// deflection (m, positive toward the right wall); one per pin, or empty for all at
+    /// rest and straight. A release needs a free top.
     #[serde(default)]
+    #[schema(default = json!([]))]
     pub tip_displacements: Vec<f64>,
 }
 
@@ -320,22 +370,25 @@ pub struct InitialInput {
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ExcitationInput {
-    /// Absolute acceleration of the pin feet, toward the right wall (m/s²); the walls
-    /// (and the top supports of pins held at both ends) move with the feet unless given
-    /// their own. Results are relative to the feet.
+    /// Absolute acceleration a(t) of the pin feet (m/s²), positive toward the right
+    /// wall; the walls (and the top supports of pins held at both ends) move with the
+    /// feet unless given their own. Deflections and contact forces are relative to the
+    /// feet, in whose frame each pin feels the inertial load −m·a(t) per unit length:
+    /// a > 0 pushes the pins toward the left wall.
     pub base_acceleration: Option<BaseAccelerationInput>,
-    /// Absolute acceleration of both walls, toward the right wall (m/s²), when they do
-    /// not move with the feet (a wrapper hitting its neighbour). Pins held at both ends
-    /// have their top support on the walls and follow them quasi-statically. A signal of
-    /// amplitude 0 holds the walls still while the feet shake.
+    /// Absolute acceleration of both walls (m/s²), positive toward the right wall, when
+    /// they do not move with the feet (a wrapper hitting its neighbour). Pins held at
+    /// both ends have their top support on the walls and follow them quasi-statically.
+    /// A signal of amplitude 0 holds the walls still while the feet shake.
     pub wall_acceleration: Option<BaseAccelerationInput>,
     /// The left wall's own absolute acceleration (m/s²), instead of `wall_acceleration`;
     /// the other wall follows the feet unless given too.
     pub left_wall_acceleration: Option<BaseAccelerationInput>,
     /// The right wall's own absolute acceleration (m/s²), instead of `wall_acceleration`.
     pub right_wall_acceleration: Option<BaseAccelerationInput>,
-    /// Force histories at a height of a pin, toward the right wall (N).
+    /// Force histories at a height of a pin, positive toward the right wall (N).
     #[serde(default)]
+    #[schema(default = json!([]))]
     pub point_forces: Vec<PointForceInput>,
 }
 
@@ -391,60 +444,70 @@ impl ExcitationInput {
     }
 }
 
-/// Base acceleration a(t).
+/// Base acceleration a(t) (m/s²), positive toward the right wall (the +x axis of a
+/// hexagonal bundle's direction), starting at t = 0.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum BaseAccelerationInput {
-    /// amplitude (m/s²) · sin(π t / duration (s)) during `duration`, then 0.
+    /// amplitude · sin(π t / duration) during `duration`, then 0.
     HalfSine {
-        /// Peak acceleration (m/s²).
+        /// Peak acceleration (m/s²), signed.
         amplitude: f64,
         /// Length of the pulse (s).
+        #[schema(exclusive_minimum = 0.0)]
         duration: f64,
     },
-    /// amplitude (m/s²) · sin(2π frequency (Hz) t) for `cycles` periods, then 0.
+    /// amplitude · sin(2π frequency t) for `cycles` periods, then 0.
     Sine {
-        /// Peak acceleration (m/s²).
+        /// Peak acceleration (m/s²), signed.
         amplitude: f64,
         /// Frequency (Hz).
+        #[schema(exclusive_minimum = 0.0)]
         frequency: f64,
-        /// Number of periods (dimensionless, may be fractional).
+        /// Number of periods (a fraction ends mid-period).
+        #[schema(exclusive_minimum = 0.0)]
         cycles: f64,
     },
-    /// Samples: time (s), acceleration (m/s²); linear between them, 0 outside.
+    /// Samples, linear between them, 0 after the last.
     Table {
-        /// Sample times (s), increasing.
+        /// Sample times (s), at least two, ≥ 0 and strictly increasing.
+        #[schema(value_type = Vec<NonNegativeNumber>)]
         time: Vec<f64>,
         /// Acceleration at each time (m/s²).
         acceleration: Vec<f64>,
     },
-    /// amplitude (m/s²) · sin²(π t / duration (s)) during `duration`, then 0
-    /// (velocity change amplitude · duration / 2).
+    /// amplitude · sin²(π t / duration) during `duration`, then 0 (velocity change
+    /// amplitude · duration / 2).
     Haversine {
-        /// Peak acceleration (m/s²).
+        /// Peak acceleration (m/s²), signed.
         amplitude: f64,
         /// Length of the pulse (s).
+        #[schema(exclusive_minimum = 0.0)]
         duration: f64,
     },
-    /// amplitude (m/s²) · t / duration (s) during `duration`, then 0 at once
-    /// (velocity change amplitude · duration / 2).
+    /// amplitude · t / duration during `duration`, then 0 at once (velocity change
+    /// amplitude · duration / 2).
     TerminalPeakSawtooth {
-        /// Peak acceleration, at the end (m/s²).
+        /// Peak acceleration (m/s²), signed.
         amplitude: f64,
         /// Length of the pulse (s).
+        #[schema(exclusive_minimum = 0.0)]
         duration: f64,
     },
-    /// Linear rise to amplitude (m/s²) in `rise` (s), `plateau` (s) at it, linear fall
-    /// to 0 in `fall` (s); a ramp or the plateau may be 0, not all three (velocity change
-    /// amplitude · (rise/2 + plateau + fall/2)).
+    /// Linear rise to `amplitude` in `rise`, `plateau` at it, linear fall to 0 in `fall`;
+    /// a ramp or the plateau may be 0, not all three (velocity change amplitude ·
+    /// (rise/2 + plateau + fall/2)).
     Trapezoid {
-        /// Plateau acceleration (m/s²).
+        /// Plateau acceleration (m/s²), signed.
         amplitude: f64,
-        /// Time of the rising ramp (s).
+        /// Duration of the rise (s).
+        #[schema(minimum = 0.0)]
         rise: f64,
-        /// Time at the amplitude (s).
+        /// Duration of the plateau (s).
+        #[schema(minimum = 0.0)]
         plateau: f64,
-        /// Time of the falling ramp (s).
+        /// Duration of the fall (s).
+        #[schema(minimum = 0.0)]
         fall: f64,
     },
     /// A synthetic earthquake matching a target response spectrum, drawn from a seed.
@@ -527,16 +590,19 @@ impl BaseAccelerationInput {
     }
 }
 
-/// A force table applied at a height of one pin.
+/// A force table applied at a height of one pin, positive toward the right wall.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PointForceInput {
+    /// The loaded pin (0 … pins − 1).
     pub pin: usize,
-    /// Height from the foot (m).
+    /// Height from the foot (m), at most the pin length.
+    #[schema(minimum = 0.0)]
     pub height: f64,
-    /// Sample times (s).
+    /// Sample times (s), at least two, ≥ 0 and strictly increasing.
+    #[schema(value_type = Vec<NonNegativeNumber>)]
     pub time: Vec<f64>,
-    /// Force at those times (N), linear between them, 0 outside.
+    /// Force at those times (N), linear between them, 0 after the last.
     pub force: Vec<f64>,
 }
 
@@ -557,10 +623,13 @@ impl PointForceInput {
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OutputInput {
-    /// Time between two history samples (s), a whole number of steps; default 1e-4 s
-    /// (every step when the step is longer).
+    /// Time between two history samples (s), a whole number of steps; 1e-4 s when left
+    /// out (every step when the step is longer).
+    #[schema(exclusive_minimum = 0.0)]
     pub interval: Option<f64>,
-    /// Heights (m) of the deflections recorded for every pin; default: the pin tips.
+    /// Heights (m from the feet, within the pin) of the deflections recorded for every
+    /// pin; the pin tips when left out.
+    #[schema(value_type = Option<Vec<NonNegativeNumber>>)]
     pub heights: Option<Vec<f64>>,
     /// How impacts are counted and tabulated; default: every closure is an impact.
     pub impacts: Option<ImpactsInput>,

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
+use super::columns::{self, Column};
 use super::impact_report::{self, ContactImpacts, ImpactSummary, ImpactsInput};
 use super::inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::model_check::{self, StandIn};
@@ -21,6 +22,11 @@ use crate::physics::modal::ModalBasis;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
 use crate::physics::spectrum::spectral_error;
 
+/// The schema of the `solver` block, with this process's defaults.
+fn solver_schema() -> utoipa::openapi::RefOr<utoipa::openapi::Schema> {
+    super::input_schema::solver_schema(SOLVER_DEFAULTS)
+}
+
 /// Threshold of f_err below which the paper calls two signals identical.
 pub const AGREEMENT_THRESHOLD: f64 = 0.2;
 /// The solver's defaults: the paper's step, 1e-5 s, over 0.5 s.
@@ -33,39 +39,57 @@ const SOLVER_DEFAULTS: SolverDefaults = SolverDefaults {
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CantileverInputs {
-    /// The cantilever (clamped at its foot, free at its top).
+    /// The cantilever: clamped at its foot, free at its top (the only supports this
+    /// process takes).
     pub beam: BeamInput,
+    /// The spring at the tip.
     #[serde(default)]
+    #[schema(default = json!({}))]
     pub contact: ContactInput,
+    /// The initial state.
     #[serde(default)]
+    #[schema(default = json!({}))]
     pub release: ReleaseInput,
+    /// Explicit integration of the numerical model.
     #[serde(default)]
+    #[schema(schema_with = solver_schema, default = json!({}))]
     pub solver: SolverInput,
+    /// The semi-analytic reference.
     #[serde(default)]
+    #[schema(default = json!({}))]
     pub reference: ReferenceInput,
+    /// History sampling and impact counting.
     #[serde(default)]
+    #[schema(default = json!({}))]
     pub output: OutputInput,
     /// Plausibility warnings (a unit slip, nothing exciting the model, ...): `on`
     /// (default) or `off`; never a refusal.
     #[serde(default)]
+    #[schema(default = "on")]
     pub warnings: WarningsInput,
 }
 
-/// The tip contact: a spring below the tip, acting while w(L) < −gap.
+/// The tip contact: a spring below the tip (on the side of negative deflection),
+/// pushing while w(L) < −gap.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(as = TipContactInput)]
 pub struct ContactInput {
     /// Rk = Kc L³ / 3EI (dimensionless): contact stiffness over the static tip
-    /// stiffness. Exactly one of `rk` and `stiffness`; default `rk` = 1.
+    /// stiffness. Give `rk` or `stiffness`, not both; `rk` = 1 when both are left out.
+    #[schema(minimum = 0.0)]
     pub rk: Option<f64>,
-    /// Contact stiffness Kc (N/m).
+    /// Contact stiffness Kc (N/m), instead of `rk`.
+    #[schema(minimum = 0.0)]
     pub stiffness: Option<f64>,
     /// Gap between the tip at rest and the spring (m).
     #[serde(default)]
+    #[schema(default = 0.0, minimum = 0.0)]
     pub gap: f64,
-    /// Contact dashpot cc (N·s/m); the reference has none.
+    /// Contact dashpot cc (N·s/m), acting only while the contact is closed; the
+    /// reference has none.
     #[serde(default)]
+    #[schema(default = 0.0, minimum = 0.0)]
     pub damping: f64,
 }
 
@@ -75,6 +99,7 @@ pub struct ContactInput {
 pub struct ReleaseInput {
     /// Tip deflection of the release shape (m), positive away from the spring.
     #[serde(default = "default_release")]
+    #[schema(default = 1e-3)]
     pub tip_displacement: f64,
 }
 impl Default for ReleaseInput {
@@ -92,8 +117,9 @@ fn default_release() -> f64 {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceInput {
-    /// Modes per analytic basis (clamped-free and clamped-spring), 1..60 (default 30).
+    /// Modes per analytic basis (clamped-free and clamped-spring).
     #[serde(default = "default_reference_modes")]
+    #[schema(default = 30, minimum = 1, maximum = 60)]
     pub modes: usize,
 }
 impl Default for ReferenceInput {
@@ -112,7 +138,9 @@ fn default_reference_modes() -> usize {
 #[serde(deny_unknown_fields)]
 #[schema(as = CantileverOutputInput)]
 pub struct OutputInput {
-    /// Time between two history samples (s), a whole number of steps; default: every step.
+    /// Time between two history samples (s), a whole number of steps; every step when
+    /// left out.
+    #[schema(exclusive_minimum = 0.0)]
     pub interval: Option<f64>,
     /// How impacts are counted and tabulated; default: every closure is an impact.
     pub impacts: Option<ImpactsInput>,
@@ -403,6 +431,26 @@ impl Simulation for CantileverImpact {
     type Inputs = CantileverInputs;
     type Results = CantileverResults;
     type Plan = Plan;
+
+    /// `numerical` and `reference`: the tip deflection (m) or the contact force (N) of
+    /// each solution.
+    fn column(output: &str, name: &str, _document: &serde_json::Value) -> Option<Column> {
+        let solution = match name {
+            "numerical" => "the numerical (modal) scheme",
+            "reference" => "the semi-analytic reference",
+            _ => return None,
+        };
+        let (unit, what) = match output.trim_end_matches("_peaks") {
+            "tip_displacement" => ("m", "tip deflection w(L), positive away from the spring"),
+            "contact_force" => ("N", "tip contact force"),
+            _ => return None,
+        };
+        Some(Column::new(
+            name,
+            unit,
+            columns::of_output(output, format!("{what}, {solution}")),
+        ))
+    }
 
     fn prepare(inputs: CantileverInputs) -> Result<Plan, InvalidInputs> {
         let mut errors: Vec<FieldError> = at("/inputs/beam", inputs.beam.validate());

@@ -268,6 +268,10 @@ impl Simulation for HexBundleDynamics {
     type Results = HexResults;
     type Plan = Plan;
 
+    fn column(output: &str, name: &str, document: &serde_json::Value) -> Option<super::Column> {
+        super::columns::hex(output, name, document)
+    }
+
     fn signals(inputs: &mut HexInputs) -> Vec<super::signal_input::SignalSlot<'_>> {
         inputs.excitation.signal_references()
     }

@@ -11,6 +11,7 @@ use utoipa::ToSchema;
 
 use super::bundle_inputs::{BaseAccelerationInput, DistributionInput};
 use super::impact_report::ImpactsInput;
+use super::input_schema::NonNegativeNumber;
 use super::inputs::{BeamInput, SectionInput, SolverInput};
 use super::warnings::WarningsInput;
 use crate::physics::bundle::GapDistribution;
@@ -23,25 +24,37 @@ pub struct HexInputs {
     /// The pin shared by every pin of the bundle: one modal basis, used for the bending
     /// along x and along y. A tube section's outer diameter is the clad diameter D.
     pub pin: BeamInput,
+    /// The bundle's geometry: rings, pitch, wires, wrapper.
     pub bundle: HexGeometryInput,
+    /// Penalty laws of the wire contacts.
     pub contact: HexContactInput,
-    /// Gap state (default: the nominal clearances from the geometry).
+    /// Gap state: the nominal clearances from the geometry (or given ones), one gap per
+    /// contact, or random draws.
     #[serde(default)]
+    #[schema(default = json!({"type": "uniform"}))]
     pub gaps: HexGapsInput,
     /// Local gap changes (swelling), applied after `gaps`, in order.
     #[serde(default)]
+    #[schema(default = json!([]))]
     pub closures: Vec<HexClosureInput>,
     /// Every pin moved toward one flat (a bundle pressed against the wrapper), applied last.
     pub offset: Option<OffsetInput>,
+    /// The wrapper's acceleration in the transverse plane.
     #[serde(default)]
+    #[schema(default = json!({}))]
     pub excitation: HexExcitationInput,
+    /// Explicit integration.
     #[serde(default)]
+    #[schema(schema_with = super::input_schema::auto_solver_schema, default = json!({}))]
     pub solver: SolverInput,
+    /// History sampling and selection, impact counting.
     #[serde(default)]
+    #[schema(default = json!({}))]
     pub output: HexOutputInput,
     /// Plausibility warnings (a unit slip, nothing exciting the model, ...): `on`
     /// (default) or `off`; never a refusal.
     #[serde(default)]
+    #[schema(default = "on")]
     pub warnings: WarningsInput,
 }
 
@@ -53,15 +66,21 @@ pub struct HexGeometryInput {
     #[schema(minimum = 1, maximum = 9)]
     pub rings: usize,
     /// P, distance between neighbouring pin centres (m), ≥ D + d_w.
+    #[schema(exclusive_minimum = 0.0)]
     pub pitch: f64,
     /// d_w, spacer wire diameter (m).
+    #[schema(exclusive_minimum = 0.0)]
     pub wire_diameter: f64,
-    /// H, axial length of one wire turn (m), ≥ 6 beam element lengths.
+    /// H, axial length of one wire turn (m), ≥ 6 beam element lengths (and at most
+    /// 100000 contact levels, one every H/12, over the pin).
+    #[schema(exclusive_minimum = 0.0)]
     pub wire_lead: f64,
     /// F, inner flat-to-flat distance of the wrapper (m), ≥ √3·n·P + D + 2·d_w.
+    #[schema(exclusive_minimum = 0.0)]
     pub wrapper_flat_to_flat: f64,
-    /// D, clad outer diameter (m); default: the pin section's outer diameter (required
-    /// with an explicit section).
+    /// D, clad outer diameter (m); the pin section's outer diameter when left out
+    /// (required with an explicit section).
+    #[schema(exclusive_minimum = 0.0)]
     pub pin_diameter: Option<f64>,
     /// Direction of every wire at the pin foot (degrees, counter-clockwise from +x).
     #[serde(default)]
@@ -69,6 +88,7 @@ pub struct HexGeometryInput {
     pub wire_start_angle: f64,
     /// Sense in which the wires turn going up.
     #[serde(default)]
+    #[schema(default = "right")]
     pub handedness: HandednessInput,
 }
 
@@ -86,41 +106,50 @@ pub enum HandednessInput {
 #[serde(deny_unknown_fields)]
 pub struct HexContactInput {
     /// Kc of the pin–pin contacts (N/m).
+    #[schema(minimum = 0.0)]
     pub stiffness: f64,
-    /// cc of the pin–pin contacts (N·s/m).
+    /// cc of the pin–pin contacts (N·s/m), acting only while a contact is closed.
     #[serde(default)]
-    #[schema(default = 0.0)]
+    #[schema(default = 0.0, minimum = 0.0)]
     pub damping: f64,
-    /// Kc of the pin–wrapper contacts (N/m); default: `stiffness`.
+    /// Kc of the pin–wrapper contacts (N/m); `stiffness` when left out.
+    #[schema(minimum = 0.0)]
     pub wall_stiffness: Option<f64>,
-    /// cc of the pin–wrapper contacts (N·s/m); default: `damping`.
+    /// cc of the pin–wrapper contacts (N·s/m); `damping` when left out.
+    #[schema(minimum = 0.0)]
     pub wall_damping: Option<f64>,
 }
 
-/// Gap state of the bundle.
+/// Gap state of the bundle: `uniform`, `per_contact` or `random`.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum HexGapsInput {
-    /// One gap for every pin–pin contact and one for every wall contact (m); an absent
-    /// value keeps the nominal clearance (P − D − d_w between pins, from the
-    /// flat-to-flat for the wall).
+    /// One gap for every pin–pin contact and one for every wall contact.
     Uniform {
-        /// Gap of every pin–pin contact (m).
+        /// Gap of every pin–pin contact (m); the nominal clearance P − D − d_w when
+        /// left out.
+        #[schema(minimum = 0.0)]
         pin_pin: Option<f64>,
-        /// Gap of every pin–wall contact (m).
+        /// Gap of every pin–wrapper contact (m); the nominal clearance from the
+        /// flat-to-flat when left out.
+        #[schema(minimum = 0.0)]
         pin_wall: Option<f64>,
     },
-    /// One gap per contact (m), in contact order (results `contacts`).
+    /// One gap per contact, in contact order (results `contacts`).
     PerContact {
         /// The gaps (m), one per contact.
+        #[schema(value_type = Vec<NonNegativeNumber>)]
         values: Vec<f64>,
     },
     /// Independent draws in contact order, reproducible from the seed on every machine.
     Random {
+        /// The law of the draws.
         distribution: DistributionInput,
+        /// Seed of the draws (an integer from 0 to 2⁶⁴ − 1).
         seed: u64,
-        /// Draws multiply the nominal clearances instead of being gaps (m).
+        /// Draws multiply the nominal clearances (dimensionless) instead of being gaps (m).
         #[serde(default)]
+        #[schema(default = false)]
         relative: bool,
     },
 }
@@ -140,16 +169,23 @@ impl Default for HexGapsInput {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HexClosureInput {
-    /// First ring of the zone (0 = the centre pin).
+    /// First ring of the zone (0 = the centre pin), with `last_ring`.
     pub first_ring: Option<usize>,
+    /// Last ring of the zone, at least `first_ring`, at most `bundle.rings`.
     pub last_ring: Option<usize>,
-    /// First sector of the zone (sextants 0..6 of the centre angles [s·60°, (s+1)·60°)).
+    /// First sector of the zone (sextants 0..5 of the centre angles [s·60°, (s+1)·60°)),
+    /// with `last_sector`.
+    #[schema(maximum = 5)]
     pub first_sector: Option<usize>,
+    /// Last sector of the zone, at least `first_sector`.
+    #[schema(maximum = 5)]
     pub last_sector: Option<usize>,
-    /// Level indices (0 = the lowest; results `geometry.levels`).
+    /// First level of the zone (0 = the lowest; results `geometry.levels`).
     pub first_level: usize,
+    /// Last level of the zone, at least `first_level`, below the level count.
     pub last_level: usize,
-    /// Multiplier of the gaps (dimensionless, ≥ 0; 0 closes them).
+    /// Multiplier of the gaps (dimensionless).
+    #[schema(minimum = 0.0)]
     pub factor: f64,
 }
 
@@ -158,9 +194,11 @@ pub struct HexClosureInput {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OffsetInput {
-    /// The flat moved toward (0..6).
+    /// The flat the pins move toward (0..5, flat k's outward normal at k·60° + 30°).
+    #[schema(maximum = 5)]
     pub flat: usize,
-    /// How far every pin moves (m).
+    /// How far (m): at most what keeps every wall gap ≥ 0.
+    #[schema(minimum = 0.0)]
     pub distance: f64,
 }
 
@@ -170,14 +208,16 @@ pub struct OffsetInput {
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HexExcitationInput {
-    /// The signal (m/s²) along `direction`.
+    /// The wrapper's acceleration (m/s²), positive along `direction`. Deflections and
+    /// contact forces are relative to the wrapper, in whose frame each pin feels the
+    /// inertial load −m·a(t) per unit length (opposite to the acceleration).
     pub base_acceleration: Option<BaseAccelerationInput>,
     /// Direction of `base_acceleration` (degrees, counter-clockwise from +x; 30 is flat
-    /// 0's normal). Default 0.
+    /// 0's normal); 0 when left out. Only with `base_acceleration`.
     pub direction: Option<f64>,
-    /// Component along x (m/s²), instead of `base_acceleration`.
+    /// Component along +x (m/s²), instead of `base_acceleration`.
     pub base_acceleration_x: Option<BaseAccelerationInput>,
-    /// Component along y (m/s²), instead of `base_acceleration`.
+    /// Component along +y (m/s²), instead of `base_acceleration`.
     pub base_acceleration_y: Option<BaseAccelerationInput>,
     /// The wrapper's own absolute acceleration (m/s²) along `wrapper_direction`, when it
     /// does not move with the pin feet (hitting its neighbour). Pins held at both ends
@@ -218,12 +258,16 @@ impl HexExcitationInput {
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HexOutputInput {
-    /// Time between two history samples (s), a whole number of steps; default 1e-4 s.
+    /// Time between two history samples (s), a whole number of steps; 1e-4 s when left
+    /// out (every step when the step is longer).
+    #[schema(exclusive_minimum = 0.0)]
     pub interval: Option<f64>,
-    /// Heights (m) of the deflections (x and y) recorded for every pin; default: the tips.
+    /// Heights (m from the feet, within the pin) of the deflections (x and y) recorded
+    /// for every pin; the tips when left out.
+    #[schema(value_type = Option<Vec<NonNegativeNumber>>)]
     pub heights: Option<Vec<f64>>,
     /// Contacts whose force histories are recorded (statistics are kept for every
-    /// contact); default: the wall contacts.
+    /// contact); the wall contacts when left out.
     pub contacts: Option<ContactSelectionInput>,
     /// How impacts are counted and tabulated; default: every closure is an impact.
     pub impacts: Option<ImpactsInput>,
@@ -233,7 +277,7 @@ pub struct HexOutputInput {
     pub blocks: Option<usize>,
 }
 
-/// A selection of contacts.
+/// A selection of contacts: `all`, `none`, `walls`, `list`, `levels` or `rings`.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ContactSelectionInput {
@@ -243,12 +287,25 @@ pub enum ContactSelectionInput {
     None {},
     /// The pin–wrapper contacts.
     Walls {},
-    /// These contact indices (results `contacts` order).
-    List { contacts: Vec<usize> },
-    /// The contacts on levels first..=last (indices).
-    Levels { first: usize, last: usize },
-    /// The contacts involving a pin of rings first..=last (0 = the centre pin).
-    Rings { first: usize, last: usize },
+    /// These contacts.
+    List {
+        /// Contact indices (results `contacts` order), each once.
+        contacts: Vec<usize>,
+    },
+    /// The contacts on some levels.
+    Levels {
+        /// First level (0 = the lowest).
+        first: usize,
+        /// Last level, at least `first`.
+        last: usize,
+    },
+    /// The contacts involving a pin of some rings.
+    Rings {
+        /// First ring (0 = the centre pin).
+        first: usize,
+        /// Last ring, at least `first`, at most `bundle.rings`.
+        last: usize,
+    },
 }
 
 impl HexInputs {

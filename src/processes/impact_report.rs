@@ -274,23 +274,24 @@ pub fn rows_of(history: &History) -> Option<Vec<Impact>> {
 }
 
 /// CSV text of `rows` with the [`COLUMNS`] header: counts as integers, every other
-/// number the shortest text that reads back as the same f64 (as the histories).
+/// number as [`crate::csv_format`] writes it (as the histories).
 pub fn table_csv<'a>(rows: impl IntoIterator<Item = &'a Impact>) -> String {
+    use crate::csv_format::number;
     let mut out = COLUMNS.join(",");
     out.push('\n');
     for r in rows {
         out.push_str(&format!(
-            "{},{:e},{:e},{:e},{:e},{:e},{:e},{},{:e},{:e}\n",
+            "{},{},{},{},{},{},{},{},{},{}\n",
             r.contact,
-            r.start,
-            r.peak_time,
-            r.peak_force,
-            r.impulse,
-            r.duration,
-            r.approach_velocity,
+            number(r.start),
+            number(r.peak_time),
+            number(r.peak_force),
+            number(r.impulse),
+            number(r.duration),
+            number(r.approach_velocity),
             r.rebounds,
-            r.dissipated,
-            r.energy
+            number(r.dissipated),
+            number(r.energy)
         ));
     }
     out
@@ -329,7 +330,7 @@ mod tests {
         assert!(
             lines
                 .next()
-                .is_some_and(|l| l.starts_with("3,1e-1,") && l.contains(",2,"))
+                .is_some_and(|l| l.starts_with("3,0.1,") && l.contains(",2,"))
         );
         // A history that is not a table is not read as one.
         let other = History {

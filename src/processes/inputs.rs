@@ -15,44 +15,57 @@ use crate::physics::beam::{BeamSpec, Section, Support};
 use crate::physics::integrate::{Check, DEFAULT_TOLERANCE, Settings, TimeStep};
 use crate::physics::stability::Scheme;
 
+// The bounds of `length`, `young_modulus`, `density` and of the section's sizes are
+// `physics::beam::PLAUSIBLE_RANGES`: far outside any structure, and inside them the modal
+// analysis stays within the range of doubles (`tests/schema_contract` holds them equal).
 /// A uniform, slender Euler–Bernoulli beam (one fuel pin) and its modal truncation.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BeamInput {
-    /// Length L (m).
+    /// Length L (m), from the foot (x = 0) to the top (x = L).
+    #[schema(minimum = 1e-6, maximum = 1e5)]
     pub length: f64,
     /// Young's modulus E (Pa).
+    #[schema(minimum = 1.0, maximum = 1e15)]
     pub young_modulus: f64,
-    /// Density ρ (kg/m³).
+    /// Density ρ of the material (kg/m³).
+    #[schema(minimum = 1e-3, maximum = 1e9)]
     pub density: f64,
+    /// Cross-section: a circular tube, or its area and second moment of area.
     pub section: SectionInput,
     /// Added mass per unit length (kg/m): fuel column, surrounding fluid.
     #[serde(default)]
-    #[schema(default = 0.0)]
+    #[schema(default = 0.0, minimum = 0.0, maximum = 1e9)]
     pub added_mass_per_length: f64,
-    /// Number of Hermite beam elements.
+    /// Number of Hermite beam elements along the length.
     #[serde(default = "default_elements")]
     #[schema(default = 40, minimum = 1, maximum = 400)]
     pub elements: usize,
-    /// Number of modes kept in the modal basis.
+    /// Number of modes kept in the modal basis: at most the free degrees of freedom of
+    /// the mesh (two per node, less those the supports hold: 2 × `elements` for a
+    /// clamped foot and a free top).
     #[serde(default = "default_modes")]
     #[schema(default = 10, minimum = 1)]
     pub modes: usize,
-    /// Modal damping ratio ξ (dimensionless): one value for every mode, or one per
-    /// mode (a shorter list repeats its last value).
+    /// Modal damping ratio ξ (dimensionless, in [0, 1)): one value for every mode, or
+    /// one per mode (a shorter list repeats its last value; pseudo-modes take the last).
     #[serde(default = "default_damping")]
+    #[schema(default = 0.01)]
     pub damping_ratio: DampingInput,
-    /// Boundary conditions (clamped foot, free top by default).
+    /// Boundary conditions at the two ends.
     #[serde(default)]
+    #[schema(default = json!({"foot": "clamped", "top": "free"}))]
     pub supports: SupportsInput,
-    /// Static correction of the truncated basis: `contacts` (default) adds one
-    /// pseudo-mode per distinct contact height (the static response to a unit force
-    /// there, M-orthonormalised against the modes), `none` keeps the modes alone.
+    /// Static correction of the truncated basis: `contacts` adds one pseudo-mode per
+    /// distinct contact height (the static response to a unit force there,
+    /// M-orthonormalised against the modes), `none` keeps the modes alone
+    /// (docs/static-correction.md).
     #[serde(default)]
+    #[schema(default = "contacts")]
     pub static_correction: StaticCorrectionInput,
 }
 
-/// Static correction of the modal basis (docs/static-correction.md).
+/// Static correction of the modal basis: `none` or `contacts`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum StaticCorrectionInput {
@@ -76,35 +89,41 @@ fn default_damping() -> DampingInput {
     DampingInput::Uniform(0.01)
 }
 
-/// Cross-section.
+/// Cross-section: `tube` (diameters) or `explicit` (area and second moment of area).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum SectionInput {
-    /// Circular tube (m).
+    /// Circular tube.
     Tube {
-        /// Outer diameter (m).
+        /// Outer diameter (m); a hexagonal bundle's clad diameter D.
+        #[schema(minimum = 1e-7, maximum = 1e3)]
         outer_diameter: f64,
-        /// Inner diameter (m); 0 for a solid rod.
+        /// Inner diameter (m), smaller than the outer one; 0 for a solid rod.
+        #[schema(minimum = 0.0)]
         inner_diameter: f64,
     },
-    /// Area (m²) and second moment of area (m⁴).
+    /// Any section, by its area and second moment of area.
     Explicit {
-        /// Cross-section area A (m²).
+        /// Area A (m²).
+        #[schema(minimum = 1e-15, maximum = 1e6)]
         area: f64,
         /// Second moment of area I about the bending axis (m⁴).
+        #[schema(minimum = 1e-30, maximum = 1e12)]
         inertia: f64,
     },
 }
 
-/// Modal damping ratio (dimensionless): a number for every mode, or a list, one per mode.
-#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+/// Modal damping ratio: a number for every mode, or a list, one per mode (its schema:
+/// [`super::input_schema`]).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(untagged, expecting = "a damping ratio or a list of damping ratios")]
 pub enum DampingInput {
     Uniform(f64),
     PerMode(Vec<f64>),
 }
 
-/// Boundary condition at one end.
+/// Boundary condition at one end: `free`, `pinned` (deflection held) or `clamped`
+/// (deflection and rotation held).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum SupportInput {
@@ -113,13 +132,18 @@ pub enum SupportInput {
     Clamped,
 }
 
-/// Supports at the foot (x = 0) and the top (x = L).
+/// Supports at the foot (x = 0) and the top (x = L): together they must prevent
+/// rigid-body motion (clamp one end, or pin both).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SupportsInput {
+    /// Support at the foot (x = 0).
     #[serde(default = "clamped")]
+    #[schema(default = "clamped")]
     pub foot: SupportInput,
+    /// Support at the top (x = L).
     #[serde(default = "free")]
+    #[schema(default = "free")]
     pub top: SupportInput,
 }
 
@@ -289,9 +313,9 @@ pub enum SchemeInput {
     Tchamwa,
 }
 
-/// A time step (s), or `"auto"`: chosen for accuracy (the tolerance) within stability,
-/// dividing the output interval.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+/// A time step in seconds, or `"auto"`: chosen for accuracy (the tolerance) within
+/// stability, dividing the output interval (its schema: [`super::input_schema`]).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(untagged, expecting = "a time step in seconds or \"auto\"")]
 pub enum TimeStepInput {
     Seconds(f64),
@@ -331,33 +355,39 @@ pub fn default_tolerance() -> f64 {
     DEFAULT_TOLERANCE
 }
 
-/// Explicit integration settings (every process's `solver` block).
+/// Explicit integration settings (every process's `solver` block; each process states
+/// its own defaults for `time_step` and `duration`).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SolverInput {
+    /// Explicit integration scheme.
     #[serde(default)]
+    #[schema(default = "central_difference")]
     pub scheme: SchemeInput,
-    /// Tchamwa–Wielgosz parameter φ (dimensionless, in [1, 2]; default 1.1).
+    /// Tchamwa–Wielgosz parameter φ (dimensionless), with the `tchamwa` scheme only (refused with
+    /// `central_difference`); 1.1 when left out.
+    #[schema(minimum = 1.0, maximum = 2.0)]
     pub phi: Option<f64>,
-    /// Time step (s) or "auto": chosen for accuracy at `tolerance` within stability, a
-    /// whole number of steps per output interval. Default: "auto", except for
-    /// `cantilever-impact` (1e-5 s, the paper's).
+    /// Time step (s), or "auto": chosen for accuracy at `tolerance` within stability, a
+    /// whole number of steps per output interval. A given step must not exceed the
+    /// critical step of the model with every contact closed.
     #[serde(default, deserialize_with = "present")]
     #[schema(value_type = TimeStepInput)]
     pub time_step: Option<TimeStepInput>,
-    /// Simulated duration (s). Default: 0.2 s (0.5 s for `cantilever-impact`).
+    /// Simulated duration (s), from t = 0.
     #[serde(default, deserialize_with = "present")]
-    #[schema(value_type = f64)]
+    #[schema(value_type = f64, exclusive_minimum = 0.0)]
     pub duration: Option<f64>,
-    /// Relative accuracy target (dimensionless, in (0, 1); default 1e-3): `auto` picks its step so that
+    /// Relative accuracy target (dimensionless, in (0, 1)): `auto` picks its step so that
     /// the energy balance closes within it and peaks are within 10 × it, and
     /// `quality.verdict` judges against it. Larger values trade accuracy for speed (sweeps).
     #[serde(default = "default_tolerance")]
     #[schema(default = 1e-3, exclusive_minimum = 0.0, exclusive_maximum = 1.0)]
     pub tolerance: f64,
-    /// Accuracy check: `step_halving` (default; the run repeated at Δt/2, three times the
-    /// cost) or `none` (cheap sweeps).
+    /// Accuracy check: `step_halving` (the run repeated at Δt/2, three times the cost)
+    /// or `none` (cheap sweeps).
     #[serde(default)]
+    #[schema(default = "step_halving")]
     pub check: CheckInput,
 }
 
@@ -532,7 +562,8 @@ pub fn stepping(
         Check::StepHalving => 3.0,
         Check::None => 1.0,
     };
-    let samples = (steps / every + 1) as f64;
+    // Saturated counts (a step far below the duration) must not overflow.
+    let samples = (steps / every) as f64 + 1.0;
     let estimate = super::WorkEstimate {
         steps: passes * steps as f64,
         pass_steps: settings.duration / step.time_step,
@@ -576,7 +607,7 @@ fn join_pointer(prefix: &str, field: &str) -> String {
 }
 
 /// Deserializes process inputs strictly; a failure names its JSON pointer (under `/inputs`).
-pub fn parse<T: DeserializeOwned>(inputs: &serde_json::Value) -> Result<T, InvalidInputs> {
+pub fn parse<T: DeserializeOwned + ToSchema>(inputs: &serde_json::Value) -> Result<T, InvalidInputs> {
     serde_path_to_error::deserialize(super::strict_json::Strict(inputs)).map_err(|error| {
         let mut pointer = format!("/inputs{}", crate::pointer::pointer_of(error.path()));
         let detail = error.into_inner().to_string();
@@ -614,6 +645,12 @@ pub fn parse<T: DeserializeOwned>(inputs: &serde_json::Value) -> Result<T, Inval
             pointer.push_str(field);
             return InvalidInputs(vec![FieldError::new(pointer, "is required")]);
         }
+        // A wrong value inside a tagged object is reported at the object: point at the
+        // member whose value does not fit its type.
+        let within = pointer.strip_prefix("/inputs").unwrap_or_default();
+        if let Some(member) = super::misfit::locate(&super::input_schema::schema_of::<T>(), inputs, within) {
+            pointer = format!("/inputs{member}");
+        }
         InvalidInputs(vec![FieldError::new(pointer, detail)])
     })
 }
@@ -633,70 +670,4 @@ fn object_holding(scope: &serde_json::Value, field: &str, at: &str) -> Option<St
             .find_map(|(index, child)| object_holding(child, field, &format!("{at}/{index}"))),
         _ => None,
     }
-}
-
-/// A self-contained JSON schema of `T` (component references inlined).
-pub fn schema_of<T: ToSchema>() -> serde_json::Value {
-    let mut components = Vec::new();
-    T::schemas(&mut components);
-    let components: std::collections::HashMap<String, serde_json::Value> = components
-        .into_iter()
-        .map(|(name, schema)| (name, serde_json::to_value(schema).unwrap_or_default()))
-        .collect();
-    let mut root = serde_json::to_value(T::schema()).unwrap_or_default();
-    inline_references(&mut root, &components, 0);
-    root
-}
-
-fn inline_references(
-    value: &mut serde_json::Value,
-    components: &std::collections::HashMap<String, serde_json::Value>,
-    depth: usize,
-) {
-    const PREFIX: &str = "#/components/schemas/";
-    match value {
-        serde_json::Value::Object(map) => {
-            if let Some(serde_json::Value::String(reference)) = map.get("$ref")
-                && let Some(name) = reference.strip_prefix(PREFIX)
-                && let Some(schema) = components.get(name)
-                && depth < 32
-            {
-                *value = schema.clone();
-                inline_references(value, components, depth + 1);
-                return;
-            }
-            for child in map.values_mut() {
-                inline_references(child, components, depth);
-            }
-        }
-        serde_json::Value::Array(items) => items
-            .iter_mut()
-            .for_each(|v| inline_references(v, components, depth)),
-        _ => {}
-    }
-}
-
-/// OGC `inputs` description from the schema of the whole inputs object: one entry per
-/// top-level property, with its title, description, schema and occurrence.
-pub fn ogc_inputs(schema: &serde_json::Value) -> serde_json::Value {
-    let required: Vec<&str> = schema["required"]
-        .as_array()
-        .map(|r| r.iter().filter_map(|v| v.as_str()).collect())
-        .unwrap_or_default();
-    let mut inputs = serde_json::Map::new();
-    if let Some(properties) = schema["properties"].as_object() {
-        for (name, property) in properties {
-            inputs.insert(
-                name.clone(),
-                serde_json::json!({
-                    "title": name,
-                    "description": property.get("description").cloned().unwrap_or_default(),
-                    "schema": property,
-                    "minOccurs": if required.contains(&name.as_str()) { 1 } else { 0 },
-                    "maxOccurs": 1,
-                }),
-            );
-        }
-    }
-    serde_json::Value::Object(inputs)
 }

@@ -10,12 +10,17 @@ pub mod basis_report;
 pub mod bundle_dynamics;
 pub mod bundle_inputs;
 pub mod cantilever_impact;
+/// What each column of a history is: name, unit, what it measures.
+pub mod columns;
 pub mod cost;
 pub mod hex_bundle_dynamics;
 pub mod hex_inputs;
 pub mod impact_report;
+pub mod input_schema;
 pub mod inputs;
 pub mod metrics;
+/// The member at fault when a tagged object fails to parse.
+pub mod misfit;
 pub mod model_check;
 /// The shared parts of results documents (quality, energy) as serialized types.
 pub mod report;
@@ -43,6 +48,7 @@ mod static_correction_tests;
 use std::ops::ControlFlow;
 use std::sync::Arc;
 
+pub use columns::Column;
 pub use cost::{CostLimits, TooCostly, WorkEstimate};
 pub use simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 pub use warnings::Warning;
@@ -89,8 +95,7 @@ impl History {
 }
 
 /// CSV text of a key column (`time`, `frequency`) and named series of equal length, with
-/// a `<key>,<series...>` header; each number the shortest text that reads back as the
-/// same f64.
+/// a `<key>,<series...>` header; each number as [`crate::csv_format`] writes it.
 pub fn columns_csv(key: &str, keys: &[f64], series: &[(String, Vec<f64>)]) -> String {
     let mut out = String::with_capacity(keys.len() * (series.len() + 1) * 24);
     out.push_str(key);
@@ -100,10 +105,10 @@ pub fn columns_csv(key: &str, keys: &[f64], series: &[(String, Vec<f64>)]) -> St
     }
     out.push('\n');
     for (row, k) in keys.iter().enumerate() {
-        out.push_str(&format!("{k:e}"));
+        crate::csv_format::push_number(&mut out, *k);
         for (_, values) in series {
             out.push(',');
-            out.push_str(&format!("{:e}", values[row]));
+            crate::csv_format::push_number(&mut out, values[row]);
         }
         out.push('\n');
     }
@@ -202,6 +207,15 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     fn history_kind(&self, output: &str) -> Option<HistoryKind> {
         let _ = output;
         None
+    }
+    /// What each column of the history `output` is, read from the run's results
+    /// `document`: the `time` column, then one per series of `names`, in order. Default:
+    /// the series undescribed.
+    fn history_columns(&self, output: &str, names: &[String], document: &serde_json::Value) -> Vec<Column> {
+        let _ = (output, document);
+        std::iter::once(Column::time())
+            .chain(names.iter().map(Column::unknown))
+            .collect()
     }
     /// Parses and checks the `inputs` object of an execution request, and estimates what
     /// running it will cost (a service compares that with its [`CostLimits`]). Pointers in

@@ -2,7 +2,7 @@
 //!
 //! serde stops at the first problem, so a request missing three members would learn of
 //! them on three tries, and of its value errors only after them. When parsing fails,
-//! the inputs' schema ([`super::inputs::schema_of`]) names every required member that
+//! the inputs' schema ([`super::input_schema::schema_of`]) names every required member that
 //! is absent, at any depth (inside the alternative a tagged object's `type` selects).
 //! Each is then filled with a stand-in that validation refuses (a negative number, 0
 //! for a count, the first of an enumeration, an object of stand-ins), and the filled
@@ -29,7 +29,12 @@ pub fn prepare<I: DeserializeOwned + ToSchema, P>(
     };
     let mut filled = json.clone();
     let mut missing = Vec::new();
-    fill(&mut filled, &inputs::schema_of::<I>(), "/inputs", &mut missing);
+    fill(
+        &mut filled,
+        &super::input_schema::schema_of::<I>(),
+        "/inputs",
+        &mut missing,
+    );
     if missing.is_empty() {
         return Err(first);
     }

@@ -48,8 +48,7 @@ pub struct SignalInput {
     #[serde(default, deserialize_with = "present")]
     #[schema(value_type = String)]
     pub path: Option<String>,
-    /// Factor on every sample (dimensionless, default 1): a sweep over it scales the
-    /// record.
+    /// Factor on every sample (dimensionless, signed): a sweep over it scales the record.
     #[serde(default = "one")]
     #[schema(default = 1.0)]
     pub scale: f64,

@@ -19,8 +19,8 @@ use super::required;
 use super::signal_input::{SignalLibrary, SignalSlot};
 use super::warnings::{self, Subject, Warning};
 use super::{
-    CostLimits, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, Validated, WorkEstimate,
-    inputs,
+    Column, CostLimits, History, InvalidInputs, Process, ProgressFn, RunError, RunOutput, Validated,
+    WorkEstimate, input_schema,
 };
 
 /// One history a simulation writes: served as `/jobs/{id}/results/{name}` (CSV or JSON).
@@ -111,6 +111,12 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
     fn metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
         super::metrics::flatten_scalars(document)
     }
+    /// What the series `name` of the history `output` is (unit, what it measures), read
+    /// from the run's results `document`; `None` leaves it undescribed.
+    fn column(output: &str, name: &str, document: &serde_json::Value) -> Option<Column> {
+        let _ = (output, name, document);
+        None
+    }
 }
 
 /// Parses, attaches the stored signals referenced, prepares, checks against the
@@ -157,11 +163,11 @@ impl<S: Simulation> Process for S {
     }
 
     fn inputs_description(&self) -> serde_json::Value {
-        inputs::ogc_inputs(&inputs::schema_of::<S::Inputs>())
+        input_schema::ogc_inputs(&input_schema::schema_of::<S::Inputs>())
     }
 
     fn inputs_schema(&self) -> Option<serde_json::Value> {
-        Some(inputs::schema_of::<S::Inputs>())
+        Some(input_schema::schema_of::<S::Inputs>())
     }
 
     fn history_kind(&self, output: &str) -> Option<HistoryKind> {
@@ -230,6 +236,16 @@ impl<S: Simulation> Process for S {
 
     fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
         S::metrics(document)
+    }
+
+    fn history_columns(&self, output: &str, names: &[String], document: &serde_json::Value) -> Vec<Column> {
+        std::iter::once(Column::time())
+            .chain(
+                names
+                    .iter()
+                    .map(|name| S::column(output, name, document).unwrap_or_else(|| Column::unknown(name))),
+            )
+            .collect()
     }
 
     fn schemas(&self, schemas: &mut Vec<(String, RefOr<Schema>)>) {

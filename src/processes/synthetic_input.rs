@@ -11,6 +11,7 @@ use std::sync::{Arc, OnceLock};
 use serde::Deserialize;
 use utoipa::ToSchema;
 
+use super::input_schema::PositiveNumber;
 use crate::physics::InputIssue;
 use crate::physics::loads::Table;
 use crate::physics::synthetic::{self, SpectrumCompatible, TargetSpectrum};
@@ -24,30 +25,34 @@ use crate::physics::synthetic::{self, SpectrumCompatible, TargetSpectrum};
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SpectrumCompatibleInput {
+    /// The response spectrum the record must match.
     pub target: TargetSpectrumInput,
     /// Record length (s); the record is 0 after it.
+    #[schema(exclusive_minimum = 0.0)]
     pub duration: f64,
     /// Length of the envelope's plateau (s), shorter than `duration`; the strong motion
     /// must last two periods of the target's lowest frequency.
+    #[schema(exclusive_minimum = 0.0)]
     pub strong_motion: f64,
     /// Seed of the random phases (any integer from 0 to 2⁶⁴ − 1): a sweep axis over seeds
     /// is a Monte Carlo campaign over earthquakes.
     pub seed: u64,
-    /// Build-up time of the envelope (s); default a quarter of duration − strong_motion.
+    /// Build-up time of the envelope (s), shorter than duration − strong_motion; a
+    /// quarter of duration − strong_motion when left out.
     #[serde(default, deserialize_with = "present")]
-    #[schema(value_type = f64)]
+    #[schema(value_type = f64, exclusive_minimum = 0.0)]
     pub rise: Option<f64>,
-    /// Sampling interval of the record (s); default min(0.005, 1/(5 f_max)), f_max the
-    /// target's highest frequency (which must stay below 1/(5 × time_step)).
+    /// Sampling interval of the record (s), at most 1/(5 f_max), f_max the target's
+    /// highest frequency; min(0.005, 1/(5 f_max)) when left out.
     #[serde(default, deserialize_with = "present")]
-    #[schema(value_type = f64)]
+    #[schema(value_type = f64, exclusive_minimum = 0.0)]
     pub time_step: Option<f64>,
     /// Largest relative deviation of the record's spectrum from the target over the
-    /// target's band (dimensionless, default 0.1); a record that cannot reach it is refused.
+    /// target's band (dimensionless); a record that cannot reach it is refused.
     #[serde(default = "default_tolerance")]
     #[schema(default = 0.1, exclusive_minimum = 0.0, exclusive_maximum = 1.0)]
     pub tolerance: f64,
-    /// Most correction rounds (default 40).
+    /// Most correction rounds.
     #[serde(default = "default_max_iterations")]
     #[schema(default = 40, minimum = 1, maximum = 100)]
     pub max_iterations: usize,
@@ -60,12 +65,15 @@ pub struct SpectrumCompatibleInput {
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TargetSpectrumInput {
-    /// Frequencies (Hz), positive and strictly increasing; the first and last bound the
-    /// band the record must match. Straight lines between points on log–log axes.
+    /// Frequencies (Hz), at least two, strictly increasing; the first and last bound the
+    /// band the record must match, the first at least 2/strong_motion (the strong motion
+    /// lasts two periods of it). Straight lines between points on log–log axes.
+    #[schema(value_type = Vec<PositiveNumber>)]
     pub frequencies: Vec<f64>,
-    /// Pseudo-acceleration at each frequency (m/s²), positive.
+    /// Pseudo-acceleration at each frequency (m/s²).
+    #[schema(value_type = Vec<PositiveNumber>)]
     pub accelerations: Vec<f64>,
-    /// Damping ratio of the spectrum (dimensionless, between 0 and 1; default 0.05).
+    /// Damping ratio of the spectrum (dimensionless).
     #[serde(default = "default_damping")]
     #[schema(default = 0.05, exclusive_minimum = 0.0, exclusive_maximum = 1.0)]
     pub damping: f64,

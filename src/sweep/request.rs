@@ -42,31 +42,33 @@ pub struct SweepRequest {
     #[serde(default)]
     #[schema(value_type = Object, required = true)]
     pub inputs: Member<Map<String, Value>>,
+    /// The inputs that vary from run to run, at least one.
     #[serde(default)]
     #[schema(value_type = Vec<SweepAxis>, required = true)]
     pub axes: Member<Vec<Member<SweepAxis>>>,
-    /// `grid` (default with list axes only), `monte_carlo` (default with a random axis)
-    /// or `latin_hypercube`.
+    /// `grid` (the default with list axes only), `monte_carlo` (the default with a
+    /// random axis) or `latin_hypercube`.
     #[serde(default)]
-    #[schema(value_type = Option<String>)]
+    #[schema(value_type = Design, required = false)]
     pub design: Member<Design>,
-    /// Draws per grid cell of the list axes; required with random axes.
+    /// Draws per grid cell of the list axes; required with random axes (only with them).
     #[serde(default)]
-    #[schema(value_type = Option<u64>)]
+    #[schema(value_type = u64, required = false, minimum = 1)]
     pub samples: Member<u64>,
-    /// Seed of the random draws (default 0): the same seed gives the same runs on every machine.
+    /// Seed of the random draws (an integer from 0 to 2⁶⁴ − 1): the same seed gives the
+    /// same runs on every machine.
     #[serde(default)]
-    #[schema(value_type = Option<u64>)]
+    #[schema(value_type = u64, required = false, default = 0)]
     pub seed: Member<u64>,
-    /// `continue` (default) or `fail_fast`: the first failed run dismisses the others.
+    /// `continue` or `fail_fast`: the first failed run dismisses the others.
     #[serde(default)]
-    #[schema(value_type = Option<String>)]
+    #[schema(value_type = Policy, required = false, default = "continue")]
     pub policy: Member<Policy>,
-    /// `refuse` (default): any invalid generated run refuses the whole sweep (422);
-    /// `record`: invalid runs are recorded as failed jobs with their `invalid-inputs`
-    /// problem, never queued, and the valid ones run (maps across a stability limit).
+    /// `refuse`: any invalid generated run refuses the whole sweep (422); `record`:
+    /// invalid runs are recorded as failed jobs with their `invalid-inputs` problem,
+    /// never queued, and the valid ones run (maps across a stability limit).
     #[serde(default)]
-    #[schema(value_type = Option<String>)]
+    #[schema(value_type = InvalidRuns, required = false, default = "refuse")]
     pub invalid_runs: Member<InvalidRuns>,
     // Members that are not part of a request, refused each at its pointer.
     #[serde(flatten)]
@@ -97,29 +99,33 @@ pub struct SweepAxis {
     #[serde(default, skip_serializing_if = "Member::is_missing")]
     #[schema(value_type = String, required = true)]
     pub pointer: Member<String>,
-    /// Explicit values, any JSON.
+    /// Explicit values, any JSON, at least one.
     #[serde(default, skip_serializing_if = "Member::is_missing")]
-    #[schema(value_type = Option<Vec<Object>>)]
+    #[schema(value_type = Vec<Object>, required = false)]
     pub values: Member<Vec<Value>>,
-    /// `[start, stop, count]`: count evenly spaced values, both ends included.
+    /// `[start, stop, count]`: count (1 to 1000000) evenly spaced values, both ends
+    /// exact, the inner ones rounded to 15 significant digits.
     #[serde(default, skip_serializing_if = "Member::is_missing")]
-    #[schema(value_type = Option<Vec<f64>>)]
+    #[schema(value_type = Vec<f64>, required = false)]
     pub linspace: Member<Spacing>,
-    /// `[start, stop, count]`: count geometrically spaced values (not exponents), start and stop > 0.
+    /// `[start, stop, count]`: count (1 to 1000000) geometrically spaced values (not
+    /// exponents), start and stop > 0, both ends exact, the inner ones rounded to 15
+    /// significant digits.
     #[serde(default, skip_serializing_if = "Member::is_missing")]
-    #[schema(value_type = Option<Vec<f64>>)]
+    #[schema(value_type = Vec<f64>, required = false)]
     pub logspace: Member<Spacing>,
-    /// `[low, high]`: uniform draws on [low, high).
+    /// `[low, high]`: uniform draws on [low, high), finite, low < high.
     #[serde(default, skip_serializing_if = "Member::is_missing")]
-    #[schema(value_type = Option<Vec<f64>>)]
+    #[schema(value_type = Vec<f64>, required = false)]
     pub uniform: Member<Bounds>,
-    /// `{"mean", "std"}`: normal draws.
+    /// `{"mean", "std"}`: normal draws (finite mean, std ≥ 0).
     #[serde(default, skip_serializing_if = "Member::is_missing")]
-    #[schema(value_type = Option<Object>)]
+    #[schema(value_type = Object, required = false)]
     pub normal: Member<LawParameters>,
-    /// `{"mean", "std"}` of the natural logarithm of the value: lognormal draws.
+    /// `{"mean", "std"}` of the natural logarithm of the value: lognormal draws (finite
+    /// mean, std ≥ 0).
     #[serde(default, skip_serializing_if = "Member::is_missing")]
-    #[schema(value_type = Option<Object>)]
+    #[schema(value_type = Object, required = false)]
     pub lognormal: Member<LawParameters>,
     // Members that are not part of an axis, refused each at its pointer.
     #[serde(flatten)]
@@ -226,9 +232,10 @@ pub struct LawParameters {
     pub unknown: Map<String, Value>,
 }
 
-/// How the runs are chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// How the runs are chosen: `grid`, `monte_carlo` or `latin_hypercube`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 #[serde(try_from = "String", into = "&'static str")]
+#[schema(rename_all = "snake_case")]
 pub enum Design {
     /// Cartesian product of list axes (no random axis).
     Grid,
@@ -254,9 +261,10 @@ impl Design {
     }
 }
 
-/// What a failed run does to the rest of the sweep.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// What a failed run does to the rest of the sweep: `continue` or `fail_fast`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 #[serde(try_from = "String", into = "&'static str")]
+#[schema(rename_all = "snake_case")]
 pub enum Policy {
     /// The other runs go on; the sweep ends `successful` once every run ended.
     Continue,
@@ -279,9 +287,11 @@ impl Policy {
     }
 }
 
-/// What happens to generated runs whose inputs the process refuses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// What happens to generated runs whose inputs the process refuses: `refuse` or
+/// `record`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 #[serde(try_from = "String", into = "&'static str")]
+#[schema(rename_all = "snake_case")]
 pub enum InvalidRuns {
     /// The whole sweep is refused (422), nothing is queued.
     Refuse,

@@ -82,9 +82,10 @@ pub fn build(pointers: &[String], records: &[RunRecord]) -> Table {
 }
 
 impl Table {
-    /// CSV with a header of the column names; absent values are empty cells, strings are
-    /// quoted when they need it, numbers keep full precision.
+    /// CSV with a header of the column names; absent values are empty cells, the rest
+    /// as [`crate::csv_format::cell`] writes them (numbers in full precision).
     pub fn to_csv(&self) -> String {
+        use crate::csv_format::{cell, quote};
         let mut out = String::new();
         out.push_str(
             &self
@@ -99,26 +100,12 @@ impl Table {
             let cells: Vec<String> = self
                 .columns
                 .iter()
-                .map(|column| match row.get(column) {
-                    None | Some(Value::Null) => String::new(),
-                    Some(Value::String(text)) => quote(text),
-                    Some(Value::Number(n)) => n.to_string(),
-                    Some(Value::Bool(b)) => b.to_string(),
-                    Some(other) => quote(&other.to_string()),
-                })
+                .map(|column| row.get(column).map(cell).unwrap_or_default())
                 .collect();
             out.push_str(&cells.join(","));
             out.push('\n');
         }
         out
-    }
-}
-
-fn quote(text: &str) -> String {
-    if text.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", text.replace('"', "\"\""))
-    } else {
-        text.to_owned()
     }
 }
 

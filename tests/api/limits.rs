@@ -123,6 +123,8 @@ async fn the_shipped_examples_pass_the_default_ceilings() {
         ("bundle-dynamics", "bundle-random-gaps.json"),
         ("bundle-dynamics", "bundle-local-closure.json"),
         ("bundle-dynamics", "bundle-sine-auto.json"),
+        ("bundle-dynamics", "bundle-minimal-sine.json"),
+        ("bundle-dynamics", "bundle-minimal-table.json"),
         ("bundle-dynamics", "bundle-haversine.json"),
         ("bundle-dynamics", "bundle-earthquake.json"),
     ] {

@@ -10,6 +10,7 @@ mod skip;
 
 mod capabilities;
 mod cors;
+mod csv;
 mod dashboard;
 mod dashboard_plots;
 mod database;

@@ -106,7 +106,7 @@ async fn thinning_keeps_the_peaks_of_a_history() {
         .await
         .unwrap();
     assert!(csv.lines().count() <= 201);
-    assert!(csv.contains(",5e1,"), "CSV keeps the 50 N spike");
+    assert!(csv.contains(",50.0,"), "CSV keeps the 50 N spike");
 }
 
 #[tokio::test]

@@ -12,6 +12,7 @@ use super::error::ApiError;
 use super::results::{successful, with_retry_after};
 use crate::problem::Problem;
 use crate::service::auth::Tenant;
+use crate::service::queue::read::JobOutcome;
 use crate::service::store::StoredHistory;
 
 /// The representation asked for.
@@ -75,10 +76,11 @@ pub(super) fn capped_max_points(requested: Option<usize>, cap: usize) -> Result<
     Ok(requested.map_or(cap, |n| n.min(cap)))
 }
 
-/// `output` of the job `job_id`, rendered by `render` in `format`: 404 (with `Retry-After`
-/// while the job is not finished) unless the job succeeded and recorded that output.
-/// Decompressing, thinning and transforming a long history is CPU work, so `render` runs
-/// on the blocking pool; `work` names it in the error should it panic.
+/// `output` of the job `job_id`, rendered by `render` in `format` (with the job's outcome:
+/// its process and results document): 404 (with `Retry-After` while the job is not
+/// finished) unless the job succeeded and recorded that output. Decompressing, thinning
+/// and transforming a long history is CPU work, so `render` runs on the blocking pool;
+/// `work` names it in the error should it panic.
 pub(super) async fn respond<F>(
     state: &AppState,
     tenant: &Tenant,
@@ -90,17 +92,17 @@ pub(super) async fn respond<F>(
     render: F,
 ) -> Result<Response, ApiError>
 where
-    F: FnOnce(&StoredHistory) -> Result<Vec<u8>, ApiError> + Send + 'static,
+    F: FnOnce(&StoredHistory, &JobOutcome) -> Result<Vec<u8>, ApiError> + Send + 'static,
 {
     with_retry_after(
         async {
-            successful(job_id, state.queue.outcome(tenant.as_str(), job_id).await?)?;
+            let outcome = successful(job_id, state.queue.outcome(tenant.as_str(), job_id).await?)?;
             let stored = state
                 .queue
                 .history(tenant.as_str(), job_id, output)
                 .await?
                 .ok_or_else(|| Problem::no_such_output(job_id, output))?;
-            let rendered = tokio::task::spawn_blocking(move || render(&stored))
+            let rendered = tokio::task::spawn_blocking(move || render(&stored, &outcome))
                 .await
                 .map_err(|e| ApiError::Internal(format!("{work} panicked: {e}")))??;
             Ok(tagged(headers, format.content_type(), rendered, HeaderMap::new()))

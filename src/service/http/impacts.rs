@@ -91,7 +91,7 @@ pub async fn impacts(
         &headers,
         format,
         "rendering the impacts",
-        move |stored| {
+        move |stored, _| {
             let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
             let rows = impact_report::rows_of(&history)
                 .ok_or_else(|| ApiError::Internal("the stored impacts are not a table".into()))?;

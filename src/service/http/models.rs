@@ -214,6 +214,9 @@ pub struct HistoryDocument {
     pub total_points: usize,
     /// Whether min/max thinning was applied (`max_points`).
     pub thinned: bool,
+    /// What each column is, in the CSV's order: `time` (s), then each series with its
+    /// unit and what it measures (`c12`: N, `contact wall–p0 at 0.18 m`).
+    pub columns: Vec<crate::processes::Column>,
     /// Sample times (s), increasing.
     pub time: Vec<f64>,
     pub series: Vec<Series>,

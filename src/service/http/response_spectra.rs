@@ -266,7 +266,7 @@ pub async fn response_spectrum(
         &headers,
         format,
         "computing a response spectrum",
-        move |stored| render(stored, series.as_deref(), &request, format),
+        move |stored, _| render(stored, series.as_deref(), &request, format),
     )
     .await
 }

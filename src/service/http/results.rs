@@ -11,6 +11,7 @@ use super::extract::ApiQuery;
 use super::history_view::{Format, capped_max_points, require_finite, respond};
 use super::models::{HistoryDocument, Results, Series};
 use crate::problem::Problem;
+use crate::processes::Column;
 use crate::service::auth::Tenant;
 use crate::service::queue::JobStatus;
 use crate::service::queue::read::JobOutcome;
@@ -35,6 +36,11 @@ pub struct HistoryQuery {
     pub max_points: Option<usize>,
     /// Only these series, comma-separated and in this order (e.g. `c3,c17`); default: all.
     pub series: Option<String>,
+    /// The CSV header: `short` (default), the column names (`time,c0,c1`), or `long`,
+    /// each name followed by its unit and what it measures (`c12 [N] contact wall–p0 at
+    /// 0.18 m`; the name is the cell's first word). The JSON form always has `columns`.
+    #[param(pattern = "^(short|long)$")]
+    pub header: Option<String>,
 }
 
 /// Why a finished-or-not job has no results to show; `Ok` carries the outcome of a successful one.
@@ -106,9 +112,11 @@ pub async fn results(
 
 /// One time history
 ///
-/// CSV (`time,<series...>`, full precision) or JSON, optionally restricted to
-/// `t_start <= time <= t_end` (s), to the `series` named, and thinned to `max_points`
-/// rows with min/max buckets. A window longer than the service's cap
+/// CSV (`time,<series...>`, each number the shortest text that reads back exactly) or
+/// JSON, optionally restricted to `t_start <= time <= t_end` (s), to the `series` named,
+/// and thinned to `max_points` rows with min/max buckets. The JSON form's `columns` say
+/// what each column is (unit, what it measures); `header=long` puts the same in the CSV
+/// header (`c12 [N] contact wall–p0 at 0.18 m`). A window longer than the service's cap
 /// (`--max-history-points`) is thinned to it: page through long histories with
 /// `t_start` and `t_end` for full resolution.
 #[utoipa::path(get, path = "/jobs/{jobId}/results/{output}", operation_id = "getResultOutput", tag = "Results",
@@ -137,7 +145,17 @@ pub async fn output(
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
     let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
+    let long_header = match query.header.as_deref() {
+        None | Some("short") => false,
+        Some("long") => true,
+        Some(other) => {
+            return Err(
+                Problem::invalid_query(format!("`header` must be `short` or `long`, not `{other}`")).into(),
+            );
+        }
+    };
     require_finite([("t_start", query.t_start), ("t_end", query.t_end)], "s")?;
+    let registry = state.registry.clone();
     // However long the history, a response holds at most the service's cap.
     query.max_points = Some(capped_max_points(query.max_points, state.max_history_points)?);
     respond(
@@ -148,20 +166,72 @@ pub async fn output(
         &headers,
         format,
         "rendering a history",
-        move |stored| render(stored, &query, format),
+        move |stored, outcome| {
+            let view = View {
+                query: &query,
+                format,
+                long_header,
+            };
+            render(stored, &columns_of(&registry, outcome), view)
+        },
     )
     .await
 }
 
-fn render(stored: &store::StoredHistory, query: &HistoryQuery, format: Format) -> Result<Vec<u8>, ApiError> {
+/// How a history is shown.
+struct View<'a> {
+    query: &'a HistoryQuery,
+    format: Format,
+    long_header: bool,
+}
+
+/// What the columns of a history of this job are: its process describes them from the
+/// job's results document.
+fn columns_of<'a>(
+    registry: &'a crate::processes::Registry,
+    outcome: &'a JobOutcome,
+) -> impl Fn(&crate::processes::History) -> Vec<Column> + 'a {
+    move |history| {
+        let document: serde_json::Value = outcome
+            .results
+            .as_deref()
+            .and_then(|text| serde_json::from_str(text).ok())
+            .unwrap_or_default();
+        let names: Vec<String> = history.series.iter().map(|(name, _)| name.clone()).collect();
+        match registry.get(&outcome.record.process_id) {
+            Some(process) => process.history_columns(&history.name, &names, &document),
+            None => std::iter::once(Column::time())
+                .chain(names.iter().map(Column::unknown))
+                .collect(),
+        }
+    }
+}
+
+fn render(
+    stored: &store::StoredHistory,
+    columns: &dyn Fn(&crate::processes::History) -> Vec<Column>,
+    view: View<'_>,
+) -> Result<Vec<u8>, ApiError> {
+    let query = view.query;
     let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
     let history = thinning::pick_series(history, query.series.as_deref()).map_err(Problem::invalid_query)?;
     let selected = thinning::select(&history, query.t_start, query.t_end, query.max_points);
-    if format == Format::Csv {
-        return Ok(selected.to_csv().into_bytes());
+    if view.format == Format::Csv {
+        let csv = selected.to_csv();
+        if !view.long_header {
+            return Ok(csv.into_bytes());
+        }
+        // The descriptive header in place of the names' line.
+        let body = csv.split_once('\n').map_or("", |(_, body)| body);
+        let header: Vec<String> = columns(&selected)
+            .iter()
+            .map(|c| crate::csv_format::quote(&c.long_header()).into_owned())
+            .collect();
+        return Ok(format!("{}\n{body}", header.join(",")).into_bytes());
     }
     let in_window = thinning::count_in_window(&history.time, query.t_start, query.t_end);
     let document = HistoryDocument {
+        columns: columns(&selected),
         output: selected.name,
         points: selected.time.len(),
         total_points: history.time.len(),

@@ -126,7 +126,7 @@ pub async fn spectrum(
         &headers,
         format,
         "computing a spectrum",
-        move |stored| render(stored, &query, format),
+        move |stored, _| render(stored, &query, format),
     )
     .await
 }

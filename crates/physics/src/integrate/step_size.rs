@@ -219,10 +219,13 @@ pub fn resolve(model: &Model<'_>, settings: &Settings) -> Result<StepSize, Simul
                 .into_iter()
                 .min_by(|a, b| a.0.total_cmp(&b.0))
                 .unwrap_or((STABILITY_FRACTION * critical, StepLimit::Stability));
-            // Never longer than the run, and a whole number of steps per sample.
+            // Never longer than the run, and a whole number of steps per sample (a run far
+            // shorter than the interval, with a step too short to count them, has only
+            // its first sample).
             dt = dt.min(settings.duration);
             if let Some(interval) = settings.output_interval
                 && interval > 0.0
+                && (interval / dt).is_finite()
             {
                 dt = interval / (interval / dt).ceil();
             }

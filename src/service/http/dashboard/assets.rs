@@ -86,6 +86,8 @@ pub const EXAMPLES: &[Example] = &[
     example!("bundle-random-gaps.json", Some("bundle-dynamics")),
     example!("bundle-local-closure.json", Some("bundle-dynamics")),
     example!("bundle-sine-auto.json", Some("bundle-dynamics")),
+    example!("bundle-minimal-sine.json", Some("bundle-dynamics")),
+    example!("bundle-minimal-table.json", Some("bundle-dynamics")),
     example!("bundle-haversine.json", Some("bundle-dynamics")),
     example!("bundle-earthquake.json", Some("bundle-dynamics")),
     example!("sdnl104c.json", Some("bundle-dynamics")),
