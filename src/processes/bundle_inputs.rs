@@ -464,7 +464,7 @@ pub enum BaseAccelerationInput {
         /// Frequency (Hz).
         #[schema(exclusive_minimum = 0.0)]
         frequency: f64,
-        /// Number of periods (a fraction ends mid-period).
+        /// Number of periods (dimensionless; a fraction ends mid-period).
         #[schema(exclusive_minimum = 0.0)]
         cycles: f64,
     },
