@@ -132,10 +132,20 @@ pub fn bundle() -> Vec<Value> {
         json!({"type": "per_contact", "values": [1e-4, 1e-4, 1e-4, 1e-4, 0.0, 1e-4, 1e-4, 1e-4]}),
     ];
     let mut examples = vec![explicit, explicit_section];
-    for (k, base) in base_accelerations().into_iter().enumerate() {
-        examples.push(generator(gap_states[k % gap_states.len()].clone(), base));
+    let bases = base_accelerations();
+    for (k, base) in bases.iter().enumerate() {
+        examples.push(generator(gap_states[k % gap_states.len()].clone(), base.clone()));
     }
     examples[3]["bundle"]["levels"] = json!([0.6, 1.0]);
+    // The walls' own motions, every signal form on each member.
+    for (k, base) in bases.iter().enumerate() {
+        let mut both = generator(gap_states[k % gap_states.len()].clone(), bases[0].clone());
+        both["excitation"]["wall_acceleration"] = base.clone();
+        let mut each = generator(gap_states[(k + 1) % gap_states.len()].clone(), bases[0].clone());
+        each["excitation"]["left_wall_acceleration"] = base.clone();
+        each["excitation"]["right_wall_acceleration"] = bases[(k + 1) % bases.len()].clone();
+        examples.extend([both, each]);
+    }
     examples
 }
 
@@ -224,6 +234,17 @@ pub fn hex() -> Vec<Value> {
         examples.push(hex_example(
             gap_states[(k + 1) % gap_states.len()].clone(),
             json!({"base_acceleration_x": base, "base_acceleration_y": bases[(k + 1) % bases.len()]}),
+            selections[(k + 1) % selections.len()].clone(),
+        ));
+        // The wrapper's own motion, along a direction and as components.
+        examples.push(hex_example(
+            gap_states[k % gap_states.len()].clone(),
+            json!({"base_acceleration": bases[0], "wrapper_acceleration": base, "wrapper_direction": 10.0}),
+            selections[k % selections.len()].clone(),
+        ));
+        examples.push(hex_example(
+            gap_states[(k + 1) % gap_states.len()].clone(),
+            json!({"wrapper_acceleration_x": base, "wrapper_acceleration_y": bases[(k + 1) % bases.len()]}),
             selections[(k + 1) % selections.len()].clone(),
         ));
     }
