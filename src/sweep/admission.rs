@@ -326,6 +326,29 @@ mod tests {
         }
     }
 
+    /// `logspace` values are the decades when the range spans whole decades
+    /// ([0.1, 1e6, 8]: 0.1, 1, 10, …, 1e6 exactly, not 99999.9999999999), and read as
+    /// written between them ([1, 100, 5]: 3.16227766016838, 10, 31.6227766016838).
+    #[test]
+    fn logspace_lands_on_the_decades() {
+        let values = |start: f64, stop: f64, count: usize| {
+            let mut body = calibration();
+            body["axes"] = json!([{"pointer": "/contact/rk", "logspace": [start, stop, count]}]);
+            let admitted = admit(&body, &Registry::builtin(), &limits(), &SignalLibrary::default()).unwrap();
+            admitted
+                .runs
+                .iter()
+                .map(|run| run.inputs["contact"]["rk"].as_f64().unwrap())
+                .collect::<Vec<f64>>()
+        };
+        assert_eq!(values(0.1, 1e6, 8), [0.1, 1.0, 10.0, 100.0, 1e3, 1e4, 1e5, 1e6]);
+        let between = values(1.0, 100.0, 5);
+        let expected = [1.0, 10f64.sqrt(), 10.0, 1000f64.sqrt(), 100.0];
+        for (value, exact) in between.iter().zip(expected) {
+            assert!((value - exact).abs() <= 1e-14 * exact, "{value} vs {exact}");
+        }
+    }
+
     #[test]
     fn every_run_is_admitted_in_order_and_invalid_ones_are_recorded() {
         let admitted = admit(

@@ -421,7 +421,14 @@ fn spaced(spacing: &Member<Spacing>, logarithmic: bool) -> Result<(Vec<f64>, [&N
                 (0, _) => start,
                 (i, _) if i == count - 1 => stop,
                 (_, false) => significant(start + (stop - start) * fraction),
-                (_, true) => significant(start * (stop / start).powf(fraction)),
+                // Through decimal exponents weighed by whole numbers, so that decades
+                // land on exact powers of ten (0.1 … 1e6 in 8 gives 1e5, not
+                // 99999.99999999991 from start × ratio^fraction).
+                (i, true) => {
+                    let last = (count - 1) as f64;
+                    let exponent = (start.log10() * (last - i as f64) + stop.log10() * i as f64) / last;
+                    significant(10f64.powf(exponent))
+                }
             }
         })
         .collect();
