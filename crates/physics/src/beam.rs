@@ -6,7 +6,7 @@
 //! `n` are `2n` (w) and `2n + 1` (θ). Matrices are dense, row-major, over all DOFs;
 //! [`BeamModel::free_dofs`] lists the DOFs left free by the supports.
 
-use super::{InputIssue, number, require_non_negative, require_positive};
+use super::{InputIssue, number, number_beside, require_non_negative, require_positive};
 
 /// A beam's widest plausible values, each `(field, lowest, highest, unit, why)`: far
 /// outside any structure (a value in the wrong unit, 1000 times off, stays inside them
@@ -72,7 +72,7 @@ fn require_within(
                  leaves the range of floating-point numbers",
                 number(low),
                 number(high),
-                number(value)
+                number_beside(value, if value < low { low } else { high })
             ),
         ));
     }
@@ -225,7 +225,7 @@ impl BeamSpec {
                     "must be at most {} kg/m (got {} kg/m): beyond, the modal analysis leaves the range of \
                      floating-point numbers",
                     number(MAX_ADDED_MASS_PER_LENGTH),
-                    number(self.added_mass_per_length)
+                    number_beside(self.added_mass_per_length, MAX_ADDED_MASS_PER_LENGTH)
                 ),
             ));
         }

@@ -91,6 +91,18 @@ pub fn number(value: f64) -> String {
     }
 }
 
+/// `value` as [`number`] prints it, unless it would read like `bound` (a value just
+/// beyond a bound, 1.0000001e9 beside 1e9): then every digit, so that the message shows
+/// why it is refused.
+pub fn number_beside(value: f64, bound: f64) -> String {
+    let short = number(value);
+    if value != bound && short == number(bound) {
+        format!("{value:e}")
+    } else {
+        short
+    }
+}
+
 /// Checks that `value` is finite and strictly positive; records an issue otherwise.
 pub fn require_positive(issues: &mut Vec<InputIssue>, field: &str, value: f64) {
     if !value.is_finite() {
@@ -117,7 +129,15 @@ pub fn require_non_negative(issues: &mut Vec<InputIssue>, field: &str, value: f6
 
 #[cfg(test)]
 mod number_tests {
-    use super::number;
+    use super::{number, number_beside};
+
+    /// A value just beyond a bound is printed with every digit, not as the bound.
+    #[test]
+    fn a_value_beside_its_bound_shows_why_it_is_refused() {
+        assert_eq!(number_beside(1.0000001e9, 1e9), "1.0000001e9");
+        assert_eq!(number_beside(2e9, 1e9), "2e9");
+        assert_eq!(number_beside(1e9, 1e9), "1e9");
+    }
 
     /// Messages print what a person would type: the shortest decimal of the value at six
     /// significant digits, with an exponent only far from 1.
