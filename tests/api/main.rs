@@ -11,6 +11,7 @@ mod skip;
 mod capabilities;
 mod cors;
 mod dashboard;
+mod dashboard_hex;
 mod dashboard_plots;
 mod database;
 mod dismissal;
