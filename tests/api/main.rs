@@ -12,6 +12,7 @@ mod capabilities;
 mod cors;
 mod csv;
 mod dashboard;
+mod dashboard_hex;
 mod dashboard_plots;
 mod database;
 mod dismissal;

@@ -4,6 +4,10 @@
 // slider, and the force history and impacts of a clicked contact (histories exist for
 // the recorded contacts only: `output.contacts`; statistics and impacts for every one).
 // Then the run's impacts, and each pin's largest deflections and histories.
+//
+// For tests: the cross-section figure carries `data-level`, `data-measure` (the colouring
+// statistic), `data-contacts-shown` and `data-selected`; its pins `data-pin`, its segments
+// `data-contact` and `data-value`, and the colour scale's top `data-scale-max`.
 
 import {api, card, errorBox, fmt, h, keyValueTable, replace, withUnit} from './util.js';
 import {barChart, figure, svgElement as s, viridis} from './plot.js';
@@ -65,7 +69,7 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
     const z = levels[level];
     replace(label, `level ${level}: z = ${fmt(z.height, 4)} m, wires at ${fmt(z.wire_angle)}°` +
       (z.flat === null ? ` (toward neighbours in direction ${z.neighbour_direction})` : ` (toward flat ${z.flat})`));
-    replace(drawing, crossSection(results, pins, contacts, byLevel[level], measure, selected, select));
+    replace(drawing, crossSection(results, pins, contacts, level, byLevel[level], measure, selected, select));
   };
   const select = async (k) => {
     selected = k;
@@ -105,7 +109,7 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
  * The bundle seen from above at one level: y up, the wrapper's inner hexagon (flat k's
  * outward normal at k·60° + 30°), the pins, and the level's contacts as segments.
  */
-function crossSection(results, pins, contacts, shown, measure, selected, onselect) {
+function crossSection(results, pins, contacts, level, shown, measure, selected, onselect) {
   const g = results.geometry;
   const apothem = g.wrapper_flat_to_flat / 2;
   const corner = apothem / Math.cos(Math.PI / 6);
@@ -121,7 +125,8 @@ function crossSection(results, pins, contacts, shown, measure, selected, onselec
   const top = Math.max(...contacts.map(valueOf), 0) || 1;
   const radius = (g.pin_diameter / 2) * scale;
   const circles = pins.map((p) => s('circle', {class: 'pin', cx: X(p.position[0]).toFixed(1), cy: Y(p.position[1]).toFixed(1),
-    r: radius.toFixed(1), fill: '#eef1f4', stroke: '#9aa5b1'}, s('title', {}, `pin ${p.pin} (ring ${p.ring})`)));
+    r: radius.toFixed(1), fill: '#eef1f4', stroke: '#9aa5b1', 'data-pin': p.pin},
+  s('title', {}, `pin ${p.pin} (ring ${p.ring})`)));
   const numbers = pins.length <= 61 ? pins.map((p) => s('text', {class: 'tick', x: X(p.position[0]).toFixed(1),
     y: (Y(p.position[1]) + 4).toFixed(1), 'text-anchor': 'middle'}, p.pin)) : [];
   const segments = shown.map((k) => {
@@ -148,8 +153,10 @@ function crossSection(results, pins, contacts, shown, measure, selected, onselec
     'aria-label': 'bundle cross-section', style: `max-width: ${SIZE}px`},
   s('polygon', {points: hexagon, fill: 'none', stroke: '#17212e', 'stroke-width': 2}), circles, numbers, segments);
   return figure('cross-section', `Contacts of the level, coloured by ${m.label}`,
-    h('span', {class: 'muted'}, ` dark: 0, yellow: ${fmt(top, 3)} ${m.unit} (the largest over all levels); ` +
-      'grey: never loaded; click a contact for its history'), svg, {'data-contacts-shown': shown.length});
+    h('span', {class: 'muted', 'data-scale-max': top},
+      ` dark: 0, yellow: ${fmt(top, 3)} ${m.unit} (the largest over all levels); ` +
+      'grey: never loaded; click a contact for its history'), svg,
+    {'data-level': level, 'data-measure': measure, 'data-contacts-shown': shown.length, 'data-selected': selected});
 }
 
 async function pinsCard(id, results, pins) {
