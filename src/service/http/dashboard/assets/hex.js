@@ -92,11 +92,13 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
     try {
       const [doc, peaks] = await Promise.all([history(id, 'contact_forces', `c${k}`),
         envelope(id, results, 'contact_forces', `c${k}`)]);
+      // A contact clicked since asks for its own history: this answer is stale.
+      if (selected !== k) return;
       replace(plotBox, linePlot({id: 'contact_forces', title: `Contact force c${k}`,
         series: [...envelopeSeries(peaks), ...seriesOf(doc)], hLines: reportedPeak(c.max_force, 'N'),
         xName: 'time', xLabel: 'time (s)', yLabel: 'F (N)', caption: thinned(doc, peaks)}));
     } catch (error) {
-      replace(plotBox, errorBox(error));
+      if (selected === k) replace(plotBox, errorBox(error));
     }
   };
   draw();
@@ -163,7 +165,9 @@ async function pinsCard(id, results, pins) {
   const pinBox = h('div');
   const barBox = h('div');
   const largest = (p) => Math.max(p.x.max_abs_deflection, p.y.max_abs_deflection);
+  let shown = -1;
   const drawPin = async (p) => {
+    shown = p;
     replace(barBox, barChart({id: 'pin-deflection', title: 'Largest |deflection| per pin (x or y)',
       labels: pins.map((x) => `${x.pin}`), values: pins.map(largest), yLabel: 'max |w| (m)', xLabel: 'pin',
       selected: p, onselect: drawPin}));
@@ -174,11 +178,12 @@ async function pinsCard(id, results, pins) {
       const wanted = [pick('x'), pick('y')].filter(Boolean).join(',');
       const [doc, peaks] = await Promise.all([history(id, 'displacements', wanted),
         envelope(id, results, 'displacements', wanted)]);
+      if (shown !== p) return; // another pin was clicked since
       replace(pinBox, linePlot({id: 'displacements', title: `Deflection of pin ${p} along x and y (${wanted})`,
         series: [...envelopeSeries(peaks), ...seriesOf(doc)], xName: 'time', xLabel: 'time (s)', yLabel: 'w (m)',
         caption: thinned(doc, peaks)}));
     } catch (error) {
-      replace(pinBox, errorBox(error));
+      if (shown === p) replace(pinBox, errorBox(error));
     }
   };
   const container = card('Pins', barBox, pinBox);
