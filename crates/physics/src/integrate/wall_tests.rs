@@ -11,6 +11,18 @@ use crate::loads::BaseAcceleration;
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
 
+/// The test tube clamped at its foot and pinned at its top: held at both ends.
+fn held(elements: usize, modes: usize) -> ModalBasis {
+    ModalBasis::compute(
+        &crate::beam::BeamSpec {
+            top: Support::Pinned,
+            ..default_tube(elements)
+        },
+        modes,
+    )
+    .expect("valid beam")
+}
+
 fn sine(amplitude: f64, frequency: f64, cycles: f64) -> BaseAcceleration {
     BaseAcceleration::Sine {
         amplitude,
@@ -25,14 +37,7 @@ fn sine(amplitude: f64, frequency: f64, cycles: f64) -> BaseAcceleration {
 #[test]
 fn walls_given_the_feet_motion_reproduce_walls_moving_with_the_feet() {
     let cantilever = basis(20, 8);
-    let held = ModalBasis::compute(
-        &crate::beam::BeamSpec {
-            top: Support::Pinned,
-            ..default_tube(20)
-        },
-        8,
-    )
-    .expect("valid beam");
+    let held = held(20, 8);
     for basis in [&cantilever, &held] {
         let mut model = shaken_two_pin_row(basis);
         if basis.support_transport().is_some() {
@@ -177,14 +182,7 @@ fn a_pin_held_at_both_ends_follows_its_moving_top_support_quasi_statically() {
 #[test]
 fn the_energy_balance_closes_with_moving_walls() {
     let cantilever = basis(20, 8);
-    let held = ModalBasis::compute(
-        &crate::beam::BeamSpec {
-            top: Support::Pinned,
-            ..default_tube(20)
-        },
-        8,
-    )
-    .expect("valid beam");
+    let held = held(20, 8);
     for basis in [&cantilever, &held] {
         let mut model = shaken_two_pin_row(basis);
         model.initial_tip_displacements.clear();
@@ -213,14 +211,7 @@ fn the_energy_balance_closes_with_moving_walls() {
 /// Bad wall motions are refused at their fields.
 #[test]
 fn bad_wall_motions_are_refused_at_their_fields() {
-    let held = ModalBasis::compute(
-        &crate::beam::BeamSpec {
-            top: Support::Pinned,
-            ..default_tube(12)
-        },
-        4,
-    )
-    .expect("valid beam");
+    let held = held(12, 4);
     let mut model = shaken_two_pin_row(&held);
     model.initial_tip_displacements.clear();
     model.walls = Some(WallMotion {
