@@ -651,8 +651,50 @@ pub fn parse<T: DeserializeOwned + ToSchema>(inputs: &serde_json::Value) -> Resu
         if let Some(member) = super::misfit::locate(&super::input_schema::schema_of::<T>(), inputs, within) {
             pointer = format!("/inputs{member}");
         }
-        InvalidInputs(vec![FieldError::new(pointer, detail)])
+        InvalidInputs(vec![FieldError::new(pointer, plain(&detail))])
     })
+}
+
+/// serde's type errors in words (`invalid type: string "abc", expected f64` → `must be
+/// a number (got the string "abc")`); any other message as it is.
+pub fn plain(detail: &str) -> String {
+    let Some(rest) = detail
+        .strip_prefix("invalid type: ")
+        .or_else(|| detail.strip_prefix("invalid value: "))
+    else {
+        return detail.to_owned();
+    };
+    let Some((got, expected)) = rest.rsplit_once(", expected ") else {
+        return detail.to_owned();
+    };
+    let want = match expected.trim() {
+        "f64" | "f32" => "a number",
+        "u8" | "u16" | "u32" | "u64" | "usize" => "a whole number, 0 or more",
+        "i8" | "i16" | "i32" | "i64" | "isize" => "a whole number",
+        "a boolean" => "true or false",
+        "a sequence" => "a list",
+        "a map" => "an object",
+        other if other.starts_with("struct ") || other.starts_with("internally tagged enum") => "an object",
+        other => other,
+    };
+    let unquote = |text: &str| text.trim_matches('`').to_owned();
+    let got = if let Some(text) = got.strip_prefix("string ") {
+        format!("the string {text}")
+    } else if let Some(number) = got
+        .strip_prefix("integer ")
+        .or_else(|| got.strip_prefix("floating point "))
+    {
+        unquote(number)
+    } else if let Some(value) = got.strip_prefix("boolean ") {
+        unquote(value)
+    } else {
+        match got {
+            "sequence" => "a list".to_owned(),
+            "map" => "an object".to_owned(),
+            other => other.to_owned(),
+        }
+    };
+    format!("must be {want} (got {got})")
 }
 
 /// The pointer of the first object in `scope` (itself included, depth first) that has a
@@ -669,5 +711,35 @@ fn object_holding(scope: &serde_json::Value, field: &str, at: &str) -> Option<St
             .enumerate()
             .find_map(|(index, child)| object_holding(child, field, &format!("{at}/{index}"))),
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod plain_tests {
+    use serde_json::json;
+
+    use super::parse;
+    use crate::processes::bundle_inputs::BundleInputs;
+
+    fn detail(inputs: serde_json::Value) -> (String, String) {
+        let error = parse::<BundleInputs>(&inputs).expect_err("refused").0.remove(0);
+        (error.pointer, error.detail)
+    }
+
+    /// serde's type errors reach users in words, at the member, with what was given.
+    #[test]
+    fn type_errors_say_what_was_expected_in_words() {
+        let pin = json!({"length": "abc", "young_modulus": 2.1e11, "density": 7800.0,
+                         "section": {"type": "tube", "outer_diameter": 0.01, "inner_diameter": 0.009}});
+        let (pointer, text) = detail(json!({"pin": pin, "pins": 2, "contacts": []}));
+        assert_eq!(pointer, "/inputs/pin/length");
+        assert_eq!(text, r#"must be a number (got the string "abc")"#);
+        let mut pin = pin;
+        pin["length"] = json!(1.0);
+        let (pointer, text) = detail(json!({"pin": pin, "pins": -2, "contacts": []}));
+        assert_eq!(pointer, "/inputs/pins");
+        assert_eq!(text, "must be a whole number, 0 or more (got -2)");
+        let (_, text) = detail(json!({"pin": pin, "pins": 2, "contacts": {}}));
+        assert_eq!(text, "must be a list (got an object)");
     }
 }

@@ -78,6 +78,43 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequestParts<S> for ApiQuery<T> {
         Query::<T>::from_request_parts(parts, state)
             .await
             .map(|Query(value)| Self(value))
-            .map_err(|rejection| Problem::invalid_query(rejection.body_text()).into())
+            .map_err(|rejection| Problem::invalid_query(query_error(&rejection.body_text())).into())
+    }
+}
+
+/// A query-string parse error in words: `limit: invalid digit found in string` →
+/// `limit: must be a whole number`.
+fn query_error(text: &str) -> String {
+    let text = text
+        .strip_prefix("Failed to deserialize query string: ")
+        .unwrap_or(text);
+    let plain = text
+        .replace(
+            "invalid digit found in string",
+            "must be a whole number, 0 or more",
+        )
+        .replace(
+            "cannot parse integer from empty string",
+            "must be a whole number, not empty",
+        )
+        .replace("number too large to fit in target type", "is too large")
+        .replace("invalid float literal", "must be a number");
+    crate::processes::inputs::plain(&plain)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::query_error;
+
+    #[test]
+    fn query_errors_are_in_words() {
+        assert_eq!(
+            query_error("Failed to deserialize query string: limit: invalid digit found in string"),
+            "limit: must be a whole number, 0 or more"
+        );
+        assert_eq!(
+            query_error("damping: invalid float literal"),
+            "damping: must be a number"
+        );
     }
 }
