@@ -118,7 +118,7 @@ pub fn row(output: &str, name: &str, document: &serde_json::Value) -> Option<Col
             let (pin, _, at) = deflection(name, false)?;
             (
                 "m",
-                format!("deflection of p{pin} at {at}, toward the right wall, relative to the wrapper"),
+                format!("deflection of p{pin} at {at}, toward the right wall, relative to the pin feet"),
             )
         }
         _ => return None,
@@ -149,7 +149,7 @@ pub fn hex(output: &str, name: &str, document: &serde_json::Value) -> Option<Col
             (
                 "m",
                 format!(
-                    "deflection of p{pin} along {} at {at}, relative to the wrapper",
+                    "deflection of p{pin} along {} at {at}, relative to the pin feet",
                     axis.unwrap_or('x')
                 ),
             )

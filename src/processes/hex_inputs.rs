@@ -208,9 +208,10 @@ pub struct OffsetInput {
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HexExcitationInput {
-    /// The wrapper's acceleration (m/s²), positive along `direction`. Deflections and
-    /// contact forces are relative to the wrapper, in whose frame each pin feels the
-    /// inertial load −m·a(t) per unit length (opposite to the acceleration).
+    /// The pin feet's acceleration (m/s²), positive along `direction` (and the wrapper's,
+    /// unless given its own). Deflections and contact forces are relative to the feet,
+    /// in whose frame each pin feels the inertial load −m·a(t) per unit length
+    /// (opposite to the acceleration).
     pub base_acceleration: Option<BaseAccelerationInput>,
     /// Direction of `base_acceleration` (degrees, counter-clockwise from +x; 30 is flat
     /// 0's normal); 0 when left out. Only with `base_acceleration`.

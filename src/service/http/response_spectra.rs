@@ -192,8 +192,8 @@ pub struct HistoryResponseSpectrum {
 /// second divided differences of the displacement (`physics::acceleration`), then the
 /// oscillators of `physics::response_spectrum` as for a signal (at rest at the first
 /// acceleration sample, followed one damped period after the last). The histories are in
-/// the wrapper's frame: for a run with a base excitation this is the spectrum of the
-/// motion relative to the wrapper. Only displacement histories (`kind` `displacement` in
+/// the frame of the pin feet: for a run with a base excitation this is the spectrum of
+/// the motion relative to the feet. Only displacement histories (`kind` `displacement` in
 /// the process description) have one: another output is a 404. `series`: the column
 /// (default the first); `damping`, `f_min`, `f_max`, `points`: as for a signal's
 /// spectrum; `format=csv` (or `Accept: text/csv`): `frequency,psa_<damping>...`.
