@@ -355,6 +355,13 @@ pub fn default_tolerance() -> f64 {
     DEFAULT_TOLERANCE
 }
 
+/// The most threads one run may ask for.
+pub const MAX_THREADS: usize = 64;
+
+fn one_thread() -> usize {
+    1
+}
+
 /// Explicit integration settings (every process's `solver` block; each process states
 /// its own defaults for `time_step` and `duration`).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
@@ -389,6 +396,14 @@ pub struct SolverInput {
     #[serde(default)]
     #[schema(default = "step_halving")]
     pub check: CheckInput,
+    /// Threads (count, 1 to 64) the run may use: `hex-bundle-dynamics` shares each step
+    /// between them (its level deflections, closed contacts, and x and y modal updates);
+    /// the row processes' steps are too short to share and run on one. A worker grants
+    /// at most the cores it has free, so a run may get fewer. Results are the same, bit
+    /// for bit, whatever the count.
+    #[serde(default = "one_thread")]
+    #[schema(default = 1, minimum = 1, maximum = 64)]
+    pub threads: usize,
 }
 
 impl Default for SolverInput {
@@ -400,6 +415,7 @@ impl Default for SolverInput {
             duration: None,
             tolerance: default_tolerance(),
             check: CheckInput::default(),
+            threads: 1,
         }
     }
 }
@@ -469,6 +485,7 @@ pub struct SolverSettings {
     pub duration: f64,
     pub tolerance: f64,
     pub check: Check,
+    pub threads: usize,
 }
 
 impl SolverSettings {
@@ -485,6 +502,7 @@ impl SolverSettings {
             output_heights,
             recorded_contacts: None,
             impacts: Default::default(),
+            threads: self.threads,
         }
     }
 }
@@ -509,6 +527,12 @@ pub fn solver(input: &SolverInput, defaults: SolverDefaults, errors: &mut Vec<Fi
             ),
         ));
     }
+    if !(1..=MAX_THREADS).contains(&input.threads) {
+        issues.push(InputIssue::new(
+            "threads",
+            format!("must be 1 to {MAX_THREADS} (got {})", input.threads),
+        ));
+    }
     errors.extend(at("/inputs/solver", issues));
     SolverSettings {
         scheme,
@@ -516,6 +540,7 @@ pub fn solver(input: &SolverInput, defaults: SolverDefaults, errors: &mut Vec<Fi
         duration,
         tolerance: input.tolerance,
         check: input.check.into(),
+        threads: input.threads,
     }
 }
 

@@ -7,7 +7,8 @@
 use std::time::Duration;
 
 use prometheus::{
-    Encoder, HistogramOpts, HistogramVec, IntCounter, IntCounterVec, IntGaugeVec, Opts, Registry, TextEncoder,
+    Encoder, HistogramOpts, HistogramVec, IntCounter, IntCounterVec, IntGauge, IntGaugeVec, Opts, Registry,
+    TextEncoder,
 };
 
 use super::queue::JobStatus;
@@ -21,6 +22,7 @@ pub struct Metrics {
     queue_wait: HistogramVec,
     jobs_rescued: IntCounter,
     jobs_abandoned: IntCounter,
+    threads: IntGauge,
     http_requests: IntCounterVec,
     http_duration: HistogramVec,
 }
@@ -75,6 +77,11 @@ impl Metrics {
             "Running jobs failed after losing their worker too many times.",
         )
         .expect("valid metric");
+        let threads = IntGauge::new(
+            "chocmodal_worker_threads",
+            "Threads the jobs running in this instance compute on (at most its worker slots).",
+        )
+        .expect("valid metric");
         let http_requests = IntCounterVec::new(
             Opts::new(
                 "chocmodal_http_requests_total",
@@ -97,6 +104,7 @@ impl Metrics {
             Box::new(queue_wait.clone()),
             Box::new(jobs_rescued.clone()),
             Box::new(jobs_abandoned.clone()),
+            Box::new(threads.clone()),
             Box::new(http_requests.clone()),
             Box::new(http_duration.clone()),
         ] {
@@ -109,9 +117,15 @@ impl Metrics {
             queue_wait,
             jobs_rescued,
             jobs_abandoned,
+            threads,
             http_requests,
             http_duration,
         }
+    }
+
+    /// A run starts (`delta` > 0) or ends (< 0) on `delta` threads.
+    pub fn add_threads(&self, delta: i64) {
+        self.threads.add(delta);
     }
 
     pub fn observe_job(&self, process: &str, outcome: &str, duration: Duration) {

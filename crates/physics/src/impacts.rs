@@ -279,6 +279,28 @@ impl ImpactLog {
         }
     }
 
+    /// The impacts another thread ended during a step, in their order.
+    pub fn extend(&mut self, impacts: Vec<Impact>) {
+        for impact in impacts {
+            self.push(impact);
+        }
+    }
+}
+
+/// Where an ended impact goes: the run's [`ImpactLog`], or a list a thread keeps for it
+/// ([`ImpactLog::extend`] then takes them in order, so the log is the same whichever
+/// thread ended them).
+pub trait ImpactSink {
+    fn push(&mut self, impact: Impact);
+}
+
+impl ImpactSink for Vec<Impact> {
+    fn push(&mut self, impact: Impact) {
+        Vec::push(self, impact);
+    }
+}
+
+impl ImpactSink for ImpactLog {
     fn push(&mut self, impact: Impact) {
         if self.rows.len() < self.max_rows {
             self.rows.push(impact);
@@ -290,7 +312,9 @@ impl ImpactLog {
             self.kept_peaks += 1;
         }
     }
+}
 
+impl ImpactLog {
     /// The table sorted by start time (then contact), the number of impacts left out,
     /// and the peak-force histograms in `classes` equal classes from 0 to the largest
     /// peak of the run.
@@ -429,7 +453,7 @@ impl ContactImpacts {
     pub fn record(
         &mut self,
         clock: &ImpactClock,
-        log: &mut ImpactLog,
+        log: &mut impl ImpactSink,
         (n, block): (u64, usize),
         force: f64,
         (penetration, previous): (f64, f64),
@@ -457,7 +481,7 @@ impl ContactImpacts {
     fn returns(
         &mut self,
         clock: &ImpactClock,
-        log: &mut ImpactLog,
+        log: &mut impl ImpactSink,
         (n, block): (u64, usize),
         force: f64,
         rise: f64,
@@ -503,7 +527,7 @@ impl ContactImpacts {
     }
 
     /// The impact under way, if any, ends: into its start's block and the log.
-    fn close(&mut self, log: &mut ImpactLog, dt: f64) {
+    fn close(&mut self, log: &mut impl ImpactSink, dt: f64) {
         let Some(done) = self.running.take() else {
             return;
         };

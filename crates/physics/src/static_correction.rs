@@ -402,6 +402,7 @@ mod tests {
             output_interval: None,
             recorded_contacts: None,
             impacts: Default::default(),
+            threads: 1,
             output_heights: vec![1.0],
         }
     }

@@ -1,9 +1,12 @@
 //! Workers: `N` slots that claim jobs from the queue and run them, plus the periodic
 //! maintenance (lease recovery, retention) of the queue.
 //!
-//! Each slot is a small async loop: claim the oldest accepted job, run it (see [`run`]),
-//! repeat; when the queue is empty, sleep until an enqueue wakes it or the poll interval
-//! passes. Shutdown happens in two steps: stop claiming, wait for the running jobs up to
+//! Each slot is a small async loop: take a core, claim the oldest accepted job, run it
+//! (see [`run`]), repeat; when the queue is empty, sleep until an enqueue wakes it or
+//! the poll interval passes. The `N` slots share `N` cores: a run that asks for
+//! several threads (`solver.threads`) gets as many of the free ones, and the other
+//! slots claim nothing until cores are free again, so the runs never use more threads
+//! than the worker has slots. Shutdown happens in two steps: stop claiming, wait for the running jobs up to
 //! a grace period; then cancel what still runs and hand it back to the queue.
 
 pub mod control;
@@ -13,7 +16,7 @@ mod run;
 use std::sync::Arc;
 use std::time::Duration;
 
-use tokio::sync::{Notify, watch};
+use tokio::sync::{Notify, OwnedSemaphorePermit, Semaphore, watch};
 use tokio::task::JoinSet;
 
 pub use control::{RunControl, RunningJobs};
@@ -56,12 +59,13 @@ impl Workers {
         let (stop_claiming, stop_rx) = watch::channel(false);
         let (hand_back, hand_back_rx) = watch::channel(false);
         let instance = instance_id();
+        let cores = Arc::new(Semaphore::new(count));
         let mut tasks = JoinSet::new();
         for slot in 0..count {
             let owner = format!("{instance}/{slot}");
             tasks.spawn(worker_loop(
                 context.clone(),
-                owner,
+                (owner, cores.clone()),
                 stop_rx.clone(),
                 hand_back_rx.clone(),
             ));
@@ -112,9 +116,37 @@ async fn drain(tasks: &mut JoinSet<()>) {
     while tasks.join_next().await.is_some() {}
 }
 
+/// The cores a run holds: the one its slot took, and those it could take besides for
+/// its threads (freed when it ends).
+pub(super) struct Cores {
+    held: Vec<OwnedSemaphorePermit>,
+}
+
+/// How long a run that asks for several threads waits for each core it lacks: an idle
+/// slot holds a core for the moment of its (empty) claim, and every idle slot claims at
+/// once when a job is queued. Cores held by running jobs are not waited for.
+const CORE_WAIT: Duration = Duration::from_millis(200);
+
+impl Cores {
+    /// Adds cores of `all` until `threads` are held, or until none frees within
+    /// [`CORE_WAIT`].
+    async fn take(&mut self, all: &Arc<Semaphore>, threads: usize) {
+        while self.held.len() < threads {
+            match tokio::time::timeout(CORE_WAIT, all.clone().acquire_owned()).await {
+                Ok(Ok(core)) => self.held.push(core),
+                _ => break,
+            }
+        }
+    }
+
+    pub(super) fn count(&self) -> usize {
+        self.held.len()
+    }
+}
+
 async fn worker_loop(
     ctx: Arc<WorkerContext>,
-    owner: String,
+    (owner, cores): (String, Arc<Semaphore>),
     mut stop: watch::Receiver<bool>,
     hand_back: watch::Receiver<bool>,
 ) {
@@ -122,6 +154,14 @@ async fn worker_loop(
         if *stop.borrow() {
             break;
         }
+        // A core first: while runs hold every core, this slot claims nothing.
+        let core = tokio::select! {
+            core = cores.clone().acquire_owned() => match core {
+                Ok(core) => core,
+                Err(_) => break,
+            },
+            changed = stop.changed() => if changed.is_err() { break } else { continue },
+        };
         // Register for wake-ups before looking, so an enqueue right after an empty
         // claim is not missed.
         let wake = ctx.wake.notified();
@@ -129,12 +169,15 @@ async fn worker_loop(
         wake.as_mut().enable();
         match ctx.queue.claim(&owner, ctx.lease).await {
             Ok(Some(job)) => {
-                run::run_job(&ctx, job, hand_back.clone()).await;
+                let mut held = Cores { held: vec![core] };
+                held.take(&cores, run::requested_threads(&job.inputs)).await;
+                run::run_job(&ctx, job, held, hand_back.clone()).await;
                 continue;
             }
             Ok(None) => {}
             Err(error) => tracing::error!(%error, worker = %owner, "claiming a job failed"),
         }
+        drop(core);
         tokio::select! {
             _ = &mut wake => {}
             _ = tokio::time::sleep(ctx.poll_interval) => {}

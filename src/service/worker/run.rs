@@ -13,8 +13,9 @@ use std::time::{Duration, Instant};
 
 use tokio::sync::{oneshot, watch};
 
-use super::WorkerContext;
+use super::{Cores, WorkerContext};
 use crate::problem::{CHOCMODAL_PROBLEMS, Problem};
+use crate::processes::inputs::MAX_THREADS;
 use crate::processes::{RunError, RunOutput};
 use crate::service::queue::{ClaimedJob, Lease};
 use crate::service::signals::SignalReadError;
@@ -27,7 +28,25 @@ const OWNERSHIP_CHECK: Duration = Duration::from_millis(500);
 /// What the compute thread sends back: the run's result, or the panic message.
 type ThreadOutcome = Result<Result<RunOutput, RunError>, String>;
 
-pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back: watch::Receiver<bool>) {
+/// The threads a job's inputs ask for (`solver.threads`, 1 when absent; validated
+/// inputs hold 1 to [`MAX_THREADS`]).
+pub(super) fn requested_threads(inputs: &serde_json::Value) -> usize {
+    inputs
+        .pointer("/solver/threads")
+        .and_then(serde_json::Value::as_u64)
+        .map_or(1, |n| {
+            usize::try_from(n).unwrap_or(MAX_THREADS).clamp(1, MAX_THREADS)
+        })
+}
+
+/// Runs `job` with the threads of `cores` (the process computes inside a thread pool of
+/// that size, whatever it asked for: its results do not depend on it).
+pub(super) async fn run_job(
+    ctx: &WorkerContext,
+    job: ClaimedJob,
+    cores: Cores,
+    mut hand_back: watch::Receiver<bool>,
+) {
     let lease = job.lease.clone();
     let process_id = job.process_id.clone();
     let wait_ms = (job.started_at - job.created_at).max(0) as u64;
@@ -73,14 +92,39 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
             return;
         }
     };
-    tracing::info!(job = %lease.job_id, process = %process_id, attempt = lease.attempt, "job started");
+    let short = lease.job_id[..8.min(lease.job_id.len())].to_owned();
+    let pool = {
+        let short = short.clone();
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(cores.count())
+            .thread_name(move |k| format!("job-{short}-{k}"))
+            .build()
+    };
+    let pool = match pool {
+        Ok(pool) => pool,
+        Err(error) => {
+            tracing::error!(%error, "cannot start a job's threads; handing the job back");
+            record(&lease, "hand back", ctx.queue.hand_back(&lease).await);
+            return;
+        }
+    };
+    tracing::info!(
+        job = %lease.job_id,
+        process = %process_id,
+        attempt = lease.attempt,
+        threads = cores.count(),
+        requested = requested_threads(&job.inputs),
+        "job started"
+    );
     let control = ctx.running.insert(&lease.job_id);
+    let threads = i64::try_from(cores.count()).unwrap_or(i64::MAX);
+    ctx.metrics.add_threads(threads);
 
     let (sender, mut receiver) = oneshot::channel::<ThreadOutcome>();
     let thread_control = control.clone();
     let inputs = job.inputs;
     let spawned = std::thread::Builder::new()
-        .name(format!("job-{}", &lease.job_id[..8.min(lease.job_id.len())]))
+        .name(format!("job-{short}"))
         .spawn(move || {
             let mut progress = |fraction: f64| {
                 thread_control.set_fraction(fraction);
@@ -90,15 +134,18 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
                     ControlFlow::Continue(())
                 }
             };
-            let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| {
-                process.run_with(&inputs, &signals, &mut progress)
-            }))
-            .map_err(|payload| panic_message(payload.as_ref()));
+            let outcome = pool.install(|| {
+                std::panic::catch_unwind(AssertUnwindSafe(|| {
+                    process.run_with(&inputs, &signals, &mut progress)
+                }))
+                .map_err(|payload| panic_message(payload.as_ref()))
+            });
             let _ = sender.send(outcome);
         });
     if let Err(error) = spawned {
         tracing::error!(%error, "cannot start a compute thread; handing the job back");
         ctx.running.remove(&lease.job_id);
+        ctx.metrics.add_threads(-threads);
         record(&lease, "hand back", ctx.queue.hand_back(&lease).await);
         return;
     }
@@ -164,6 +211,8 @@ pub(super) async fn run_job(ctx: &WorkerContext, job: ClaimedJob, mut hand_back:
         }
     };
     ctx.running.remove(&lease.job_id);
+    ctx.metrics.add_threads(-threads);
+    drop(cores);
     let ending = Ending {
         lost,
         handing_back,

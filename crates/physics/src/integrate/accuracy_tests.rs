@@ -110,6 +110,7 @@ impl Row {
             output_interval: Some(1e-3),
             recorded_contacts: None,
             impacts: Default::default(),
+            threads: 1,
             output_heights: vec![self.length],
         }
     }

@@ -134,6 +134,14 @@ impl LevelShapes {
         }
         Self { data, blocks }
     }
+
+    /// Groups of up to [`GROUP`] blocks.
+    pub fn groups(&self) -> usize {
+        self.blocks.div_ceil(GROUP)
+    }
+
+    /// Blocks per group.
+    pub const GROUP_BLOCKS: usize = GROUP;
 }
 
 /// Deflection of every pin at every height of `shapes`, block-major: the vector
@@ -151,18 +159,40 @@ pub(super) fn level_deflections<S: Simd>(
     out: &mut [S::f64s],
     stride: usize,
 ) {
+    level_deflections_of_groups(simd, shapes, (row, stride), q, out, 0..shapes.groups());
+}
+
+/// [`level_deflections`] of the blocks of the groups `groups` only (groups of
+/// [`GROUP`] blocks), `out` starting at the first of them. Each value is the same dot
+/// product, in the same order, whatever the groups: threads that share the groups
+/// compute the deflections a single thread computes, bit for bit.
+#[inline(always)]
+pub(super) fn level_deflections_of_groups<S: Simd>(
+    simd: S,
+    shapes: &LevelShapes,
+    (row, stride): (usize, usize),
+    q: &[f64],
+    out: &mut [S::f64s],
+    groups: std::ops::Range<usize>,
+) {
     let (data, _) = S::as_simd_f64s(&shapes.data);
-    let blocks = shapes.blocks;
+    let blocks = shapes.blocks.min(groups.end * GROUP);
+    let start = groups.start * GROUP;
     let pins = q.len() / row;
-    assert!(data.len() == blocks * row && out.len() >= blocks * stride && pins < stride);
+    assert!(
+        data.len() == shapes.blocks * row
+            && start <= blocks
+            && out.len() >= (blocks - start) * stride
+            && pins < stride
+    );
     let mut p = 0;
     while p < pins {
         let pair = pins - p >= 2;
         let rows = &q[p * row..];
-        let (mut first, mut offset) = (0, 0);
+        let (mut first, mut offset) = (start, start * row);
         while first < blocks {
             let group = GROUP.min(blocks - first);
-            let (shapes, slot) = (&data[offset..], first * stride + 1 + p);
+            let (shapes, slot) = (&data[offset..], (first - start) * stride + 1 + p);
             let at = Destination { out, slot, stride };
             match (group, pair) {
                 (1, false) => accumulate::<S, 1, 1>(simd, rows, row, shapes, at),

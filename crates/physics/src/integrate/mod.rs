@@ -156,6 +156,7 @@ mod kernels;
 mod layout;
 mod model;
 mod plan;
+mod plane_step;
 pub mod quality;
 mod recorder;
 mod state;
@@ -177,3 +178,6 @@ mod impact_tests;
 
 #[cfg(test)]
 mod wall_tests;
+
+#[cfg(test)]
+mod thread_tests;

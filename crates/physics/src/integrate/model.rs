@@ -330,6 +330,11 @@ pub struct Settings {
     pub recorded_contacts: Option<Vec<usize>>,
     /// How impacts are counted, summarised and tabulated.
     pub impacts: ImpactCounting,
+    /// Threads the step may share (at least 1), within the threads of the rayon pool
+    /// the run is called in: the plane's step shares its level deflections, its closed
+    /// contacts and its x and y modal updates; a row's step runs on one. Every result is
+    /// the same, bit for bit, for every count.
+    pub threads: usize,
 }
 
 impl Settings {
@@ -357,6 +362,9 @@ impl Settings {
             ));
         }
         require_positive(&mut issues, "duration", self.duration);
+        if self.threads == 0 {
+            issues.push(InputIssue::new("threads", "must be at least 1"));
+        }
         if let Some(interval) = self.output_interval {
             require_positive(&mut issues, "output_interval", interval);
         }
@@ -448,6 +456,7 @@ mod tests {
             output_heights: vec![1.0, 0.5],
             recorded_contacts: None,
             impacts: Default::default(),
+            threads: 1,
         }
     }
 
@@ -535,6 +544,7 @@ mod tests {
             output_heights: vec![0.5, 1.2],
             recorded_contacts: Some(vec![1, 2, 1]),
             impacts: Default::default(),
+            threads: 1,
         };
         assert_eq!(
             fields(settings.validate(1.0, 2)),

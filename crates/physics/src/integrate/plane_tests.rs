@@ -87,6 +87,7 @@ fn settings(dt: f64, duration: f64) -> Settings {
         output_heights: vec![1.0, 0.8],
         recorded_contacts: None,
         impacts: Default::default(),
+        threads: 1,
     }
 }
 

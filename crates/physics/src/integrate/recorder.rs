@@ -10,7 +10,7 @@ use super::kernels::level_deflections;
 use super::layout::{ContactModel, Layout};
 use super::state::State;
 use super::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme, Settings, Simulation};
-use crate::impacts::{ContactImpacts, ImpactClock, ImpactLog, ImpactStatistics};
+use crate::impacts::{ContactImpacts, ImpactClock, ImpactLog, ImpactSink, ImpactStatistics};
 
 /// Powers of a step (W), integrated over time by the trapezoidal rule.
 #[derive(Debug, Clone, Copy, Default)]
@@ -318,7 +318,7 @@ impl Recorder {
 #[inline(always)]
 pub(super) fn record_closed_contact(
     (stats, impacts): (&mut ContactStatistics, &mut ContactImpacts),
-    (clock, log): (&ImpactClock, &mut ImpactLog),
+    (clock, log): (&ImpactClock, &mut impl ImpactSink),
     (n, block, dt): (u64, usize, f64),
     (penetration, previous): (f64, f64),
     (force, dissipation): (f64, f64),

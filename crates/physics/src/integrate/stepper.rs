@@ -44,6 +44,7 @@ use super::kernels::{
     penetration_rate, penetrations, plane_penetrations, row_axpy,
 };
 use super::layout::{ContactModel, Layout, PlaneContacts};
+use super::plane_step::{self, CLOSED_CHUNK, ClosedPass, Half, LaneOutputs, Loads};
 use super::recorder::{Powers, Recorder, record_closed_contact};
 use super::state::State;
 use super::walls::{WallLayout, WallState};
@@ -95,6 +96,8 @@ pub(super) fn integrate(
 /// One run: what does not change, what the step advances, what is recorded.
 struct Integrator<'m> {
     arch: pulp::Arch,
+    /// Threads the plane's step shares ([`Settings::threads`] within the caller's pool).
+    threads: usize,
     layout: Layout<'m>,
     state: State,
     recorder: Recorder,
@@ -129,6 +132,13 @@ impl<const PLANE: bool> pulp::WithSimd for StepOp<'_, '_, PLANE> {
         match self.operation {
             Operation::Initial => {
                 integrator.contact_forces_and_statistics::<S, PLANE>(simd, 0, false, vectors);
+                if PLANE {
+                    // The contact loads at t = 0 (the walls' transport load is added by
+                    // the caller).
+                    let (halves, loads) =
+                        plane_split(&integrator.layout, &mut integrator.state, (0.0, 0.0), false);
+                    plane_step::update_halves(simd, &loads, halves, None, integrator.threads);
+                }
             }
             // The usual row lengths get a copy of the step where the row length is a
             // constant: every per-row loop is then unrolled, without bounds checks.
@@ -155,6 +165,7 @@ impl<'m> Integrator<'m> {
         let recorder = Recorder::new(&layout, settings);
         let mut integrator = Self {
             arch,
+            threads: settings.threads.clamp(1, rayon::current_num_threads().max(1)),
             layout,
             state,
             recorder,
@@ -208,8 +219,10 @@ impl<'m> Integrator<'m> {
             layout,
             state,
             recorder,
+            threads,
             ..
         } = self;
+        let threads = *threads;
         // The row length from `vectors`, so that it is a constant where `vectors` is.
         let (row, dt) = (vectors * lanes::<S>(), layout.dt);
         let t = n as f64 * dt;
@@ -218,14 +231,19 @@ impl<'m> Integrator<'m> {
             axpy(simd, value, shape, &mut state.force[point.pin * row..][..row]);
         }
         let deflections = S::as_mut_simd_f64s(&mut state.level_deflections).0;
-        level_deflections(
-            simd,
-            &layout.grouped_level_shapes,
-            row,
-            &state.q,
-            deflections,
-            layout.stride,
-        );
+        let shapes = &layout.grouped_level_shapes;
+        if PLANE {
+            plane_step::level_deflections(
+                simd,
+                shapes,
+                (row, layout.stride),
+                &state.q,
+                deflections,
+                (0..shapes.groups(), threads),
+            );
+        } else {
+            level_deflections(simd, shapes, row, &state.q, deflections, layout.stride);
+        }
         // Every contact, in vectors: penetration, its running maximum, a zero force
         // where open, and the list of closed contacts (about one in seven).
         std::mem::swap(&mut state.penetration, &mut state.previous_penetration);
@@ -252,7 +270,7 @@ impl<'m> Integrator<'m> {
                 recorder,
                 count,
                 (n, record),
-                vectors,
+                (vectors, threads),
             );
         }
         let count = penetrations(simd, &layout.contacts, deflections, gaps, contact_state);
@@ -400,6 +418,7 @@ impl<'m> Integrator<'m> {
             layout,
             state,
             recorder,
+            threads,
             ..
         } = self;
         if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
@@ -411,41 +430,40 @@ impl<'m> Integrator<'m> {
             Scheme::Tchamwa { .. } => 0.0,
         };
         let n = vectors;
-        // The transport's inertial load −Γᴾ r joins the contact and point loads.
-        if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
-            wall.add_transport_loads(walls, &mut state.force, (layout.row, layout.model.pins));
-        }
         let coefficients = ModalCoefficients::<S> {
             stiffness: &S::as_simd_f64s(&layout.omega_squared).0[..n],
             damping: &S::as_simd_f64s(&layout.damping).0[..n],
             factor: &S::as_simd_f64s(&layout.implicit_damping_factor).0[..n],
             participation: &S::as_simd_f64s(&layout.participation).0[..n],
         };
-        let (q, v, a, f) = (
-            S::as_simd_f64s(&state.q).0,
-            S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
-            S::as_mut_simd_f64s(&mut state.a[..pins_state]).0,
-            S::as_mut_simd_f64s(&mut state.force).0,
-        );
         // The base excitation's power −a(t) Σ Γ v, per direction in the plane.
         let (modal_damping, mut external) = match (PLANE, &layout.contact_model) {
             (false, _) | (true, ContactModel::Row) => {
+                // The transport's inertial load −Γᴾ r joins the contact and point loads.
+                if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
+                    wall.add_transport_loads(walls, &mut state.force, (layout.row, layout.model.pins));
+                }
+                let (q, v, a, f) = (
+                    S::as_simd_f64s(&state.q).0,
+                    S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
+                    S::as_mut_simd_f64s(&mut state.a[..pins_state]).0,
+                    S::as_mut_simd_f64s(&mut state.force).0,
+                );
                 let base = layout.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
                 let sums = modal_update(simd, &coefficients, base, second_half, (q, v, a, f));
                 (sums.damping_power, -base * sums.participation_velocity)
             }
             (true, ContactModel::Plane(_)) => {
-                let (base_x, base_y) = base_accelerations(layout.model, t);
-                let x_lines = q.len() / 2;
-                let (q_x, q_y) = q.split_at(x_lines);
-                let (v_x, v_y) = v.split_at_mut(x_lines);
-                let (a_x, a_y) = a.split_at_mut(x_lines);
-                let (f_x, f_y) = f.split_at_mut(x_lines);
-                let x = modal_update(simd, &coefficients, base_x, second_half, (q_x, v_x, a_x, f_x));
-                let y = modal_update(simd, &coefficients, base_y, second_half, (q_y, v_y, a_y, f_y));
+                // The contact loads, the transport's inertial load −Γᴾ r, then the
+                // update, of the x lines and of the y lines.
+                let bases = base_accelerations(layout.model, t);
+                let (halves, loads) = plane_split(layout, state, bases, true);
+                let update = Some((&coefficients, second_half));
+                let [x, y] = plane_step::update_halves(simd, &loads, halves, update, *threads)
+                    .map(|sums| sums.expect("an update was asked"));
                 (
                     x.damping_power + y.damping_power,
-                    -base_x * x.participation_velocity - base_y * y.participation_velocity,
+                    -bases.0 * x.participation_velocity - bases.1 * y.participation_velocity,
                 )
             }
         };
@@ -520,6 +538,59 @@ fn transport_outputs(layout: &Layout<'_>, walls: &WallLayout, wall: &WallState, 
     }
 }
 
+/// The plane's state as [`plane_step::update_halves`] takes it: the x and the y lines
+/// (with the base acceleration along each), and the closed contacts' forces (and the
+/// walls, for their transport load, with `walls`).
+fn plane_split<'a>(
+    layout: &'a Layout<'_>,
+    state: &'a mut State,
+    (base_x, base_y): (f64, f64),
+    walls: bool,
+) -> ([Half<'a>; 2], Loads<'a>) {
+    let (contacts, lines) = match &layout.contact_model {
+        ContactModel::Plane(plane) => (&plane.lanes[..], state.q.len()),
+        ContactModel::Row => unreachable!("the plane's step runs on plane models"),
+    };
+    let x = lines / 2;
+    let (q_x, q_y) = state.q.split_at(x);
+    let (v_x, v_y) = state.v[..lines].split_at_mut(x);
+    let (a_x, a_y) = state.a[..lines].split_at_mut(x);
+    let (f_x, f_y) = state.force.split_at_mut(x);
+    let start = x / layout.lanes;
+    let halves = [
+        Half {
+            y: false,
+            start: 0,
+            q: q_x,
+            v: v_x,
+            a: a_x,
+            force: f_x,
+            base: base_x,
+        },
+        Half {
+            y: true,
+            start,
+            q: q_y,
+            v: v_y,
+            a: a_y,
+            force: f_y,
+            base: base_y,
+        },
+    ];
+    let loads = Loads {
+        layout,
+        plane_lanes: contacts,
+        closed: &state.closed[..state.closed_count],
+        forces: &state.contact_force,
+        walls: if walls {
+            layout.walls.as_ref().zip(state.wall.as_ref())
+        } else {
+            None
+        },
+    };
+    (halves, loads)
+}
+
 /// The base acceleration (m/s²) at `t` along x and along y (0 for the row).
 fn base_accelerations(model: &Model<'_>, t: f64) -> (f64, f64) {
     let at = |base: Option<&crate::loads::BaseAcceleration>| base.map_or(0.0, |b| b.at(t));
@@ -527,12 +598,10 @@ fn base_accelerations(model: &Model<'_>, t: f64) -> (f64, f64) {
     (at(model.base_acceleration.as_ref()), at(y))
 }
 
-/// The closed contacts of the plane, after [`plane_penetrations`]: with the dashpot
-/// velocity of each body along x and y, rate_x = ψ·Δṽ_x and rate_y = ψ·Δṽ_y, the
-/// penetration rate is δ̇ = n_x rate_x + n_y rate_y and the sliding velocity
-/// v_t = −n_y rate_x + n_x rate_y (tangent t = (−n_y, n_x)); F = max(0, Kc δ + cc δ̇)
-/// pushes the left body by −F n and the right one by +F n, and the wear work gains
-/// F |v_t| Δt. Returns the contact dissipation power Σ (F − Kc δ) δ̇.
+/// The closed contacts of the plane, after [`plane_penetrations`]: their forces and
+/// statistics ([`ClosedPass`]), shared by up to `threads` threads. Their loads join the
+/// rows in the modal update ([`plane_step::update_halves`]). Returns the contact
+/// dissipation power Σ (F − Kc δ) δ̇.
 #[inline(always)]
 fn plane_contact_forces<S: Simd>(
     simd: S,
@@ -541,80 +610,46 @@ fn plane_contact_forces<S: Simd>(
     recorder: &mut Recorder,
     count: usize,
     (step, record): (u64, bool),
-    vectors: usize,
+    (vectors, threads): (usize, usize),
 ) -> f64 {
-    let (mut dissipation_power, mut wall_power) = (0.0, 0.0);
-    let walls = layout.walls.as_ref().zip(state.wall.as_ref());
-    let (lookahead, wall, n, dt) = (layout.dashpot_lookahead, layout.wall_row, vectors, layout.dt);
-    let shapes = S::as_simd_f64s(&layout.level_shapes).0;
-    let (v, a) = (S::as_simd_f64s(&state.v).0, S::as_simd_f64s(&state.a).0);
-    let loads = S::as_mut_simd_f64s(&mut state.force).0;
-    let lane_contacts = layout.lane_contacts.as_slice();
-    let lanes = lane_contacts.len();
-    let plane_lanes = &plane.lanes[..lanes];
-    let (now, before) = (&state.penetration[..lanes], &state.previous_penetration[..lanes]);
-    let (forces, statistics) = (
-        &mut state.contact_force[..lanes],
-        &mut recorder.statistics[..lanes],
+    let lanes = layout.lane_contacts.len();
+    let pass = ClosedPass {
+        simd,
+        lane_contacts: &layout.lane_contacts,
+        plane_lanes: &plane.lanes[..lanes],
+        shapes: S::as_simd_f64s(&layout.level_shapes).0,
+        v: S::as_simd_f64s(&state.v).0,
+        a: S::as_simd_f64s(&state.a).0,
+        now: &state.penetration[..lanes],
+        before: &state.previous_penetration[..lanes],
+        walls: layout.walls.as_ref().zip(state.wall.as_ref()),
+        clock: &recorder.impact_clock,
+        at: (step, recorder.impact_block, layout.dt),
+        record,
+        lookahead: layout.dashpot_lookahead,
+        vectors,
+    };
+    let out = LaneOutputs {
+        first: 0,
+        forces: &mut state.contact_force[..lanes],
+        statistics: &mut recorder.statistics[..lanes],
+        peaks: &mut recorder.force_peak[..lanes],
+        wear: &mut recorder.wear[..lanes],
+        impacts: &mut recorder.impacts[..lanes],
+    };
+    let partials = &mut state.partials[..count.div_ceil(CLOSED_CHUNK)];
+    pass.run(
+        &state.closed[..count],
+        out,
+        partials,
+        &mut recorder.impact_log,
+        threads,
     );
-    let (peaks, wear) = (&mut recorder.force_peak[..lanes], &mut recorder.wear[..lanes]);
-    let impacts = &mut recorder.impacts[..lanes];
-    let (clock, log) = (&recorder.impact_clock, &mut recorder.impact_log);
-    let at = (step, recorder.impact_block, dt);
-    let closed = &state.closed[..count];
-    for &j in closed {
-        let j = j as usize;
-        let (contact, lane) = (lane_contacts[j], plane_lanes[j]);
-        let (penetration, previous) = (now[j], before[j]);
-        let rows = |offset: usize| (&v[offset..], &a[offset..]);
-        let shape = &shapes[contact.shape..][..n];
-        let mut rate_x = penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead);
-        let mut rate_y = penetration_rate(simd, shape, rows(lane.left_y), rows(lane.right_y), lookahead);
-        let [normal_x, normal_y] = lane.normal;
-        let mut wall_rate = 0.0;
-        if let Some((layout, wall)) = walls {
-            let [x, y] = wall.velocity_of(layout, j);
-            (rate_x, rate_y) = (rate_x + x, rate_y + y);
-            wall_rate = normal_x * x + normal_y * y;
-        }
-        let rate = normal_x * rate_x + normal_y * rate_y;
-        let sliding = normal_x * rate_y - normal_y * rate_x;
-        let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
-        forces[j] = force;
-        let dissipation = (force - contact.stiffness * penetration) * rate;
+    state.closed_count = count;
+    let (mut dissipation_power, mut wall_power) = (0.0, 0.0);
+    for [dissipation, wall] in partials.iter() {
         dissipation_power += dissipation;
-        wall_power += force * wall_rate;
-        if record {
-            if force > peaks[j] {
-                peaks[j] = force;
-            }
-            if contact.active {
-                record_closed_contact(
-                    (&mut statistics[j], &mut impacts[j]),
-                    (clock, &mut *log),
-                    at,
-                    (penetration, previous),
-                    (force, dissipation),
-                );
-            }
-            wear[j] += force * sliding.abs() * dt;
-        }
-    }
-    for &j in closed {
-        let j = j as usize;
-        let (contact, lane, force) = (lane_contacts[j], plane_lanes[j], forces[j]);
-        if force != 0.0 {
-            let shape = &shapes[contact.shape..][..n];
-            let [normal_x, normal_y] = lane.normal;
-            if contact.left != wall {
-                row_axpy(simd, -force * normal_x, shape, &mut loads[contact.left..]);
-                row_axpy(simd, -force * normal_y, shape, &mut loads[lane.left_y..]);
-            }
-            if contact.right != wall {
-                row_axpy(simd, force * normal_x, shape, &mut loads[contact.right..]);
-                row_axpy(simd, force * normal_y, shape, &mut loads[lane.right_y..]);
-            }
-        }
+        wall_power += wall;
     }
     if let Some(wall) = &mut state.wall {
         wall.power = wall_power;

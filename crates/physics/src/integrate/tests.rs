@@ -39,6 +39,7 @@ pub(super) fn settings(scheme: Scheme, dt: f64, duration: f64) -> Settings {
         output_interval: None,
         recorded_contacts: None,
         impacts: Default::default(),
+        threads: 1,
         output_heights: vec![1.0],
     }
 }

@@ -151,12 +151,19 @@ impl WallState {
     /// Adds the transport's inertial load −Γᴾ r to every line's loads (`force`, lines of
     /// `row`, the x lines of the `pins` first), with a transport.
     pub fn add_transport_loads(&self, layout: &WallLayout, force: &mut [f64], (row, pins): (usize, usize)) {
+        let (x, y) = force.split_at_mut((pins * row).min(force.len()));
+        self.add_transport_load(layout, x, row, 0);
+        self.add_transport_load(layout, y, row, 1);
+    }
+
+    /// [`WallState::add_transport_loads`] of the lines `force` (all x lines, `direction`
+    /// 0, or all y lines, 1).
+    pub fn add_transport_load(&self, layout: &WallLayout, force: &mut [f64], row: usize, direction: usize) {
         let Some(transport) = &layout.transport_participation else {
             return;
         };
-        let [rx, ry] = self.transport_of(self.acceleration);
-        for (line, loads) in force.chunks_exact_mut(row).enumerate() {
-            let r = if line < pins { rx } else { ry };
+        let r = self.transport_of(self.acceleration)[direction];
+        for loads in force.chunks_exact_mut(row) {
             for (f, psi) in loads.iter_mut().zip(transport) {
                 *f -= psi * r;
             }

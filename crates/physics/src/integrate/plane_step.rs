@@ -1,0 +1,337 @@
+//! The plane's step shared between threads ([`super::Settings::threads`]), and the same
+//! code on one thread: three parts of the step split, each so that every number is
+//! computed by the same operations in the same order whatever the split, so the results
+//! are the same, bit for bit, for every thread count.
+//!
+//! 1. The level deflections ([`level_deflections`]): the groups of blocks of levels are
+//!    split; each deflection is its own dot product.
+//! 2. The closed contacts ([`ClosedPass`]): the list of closed lanes is cut into chunks
+//!    of [`CLOSED_CHUNK`], each with its own dissipation and wall-power sums, added in
+//!    chunk order; the chunks are split between threads, which write disjoint lanes. The
+//!    impacts a thread ends wait in a list and join the log in lane order.
+//! 3. The loads and the modal update ([`update_half`]): the x lines and the y lines.
+//!    Each half adds its share of every closed contact's force (so each row receives
+//!    the same additions in the same order as on one thread), the walls' transport load,
+//!    then updates its modes.
+//!
+//! The work is forked on the rayon pool the run is called in (`rayon::join`), at most
+//! `threads` ways; each piece re-enters the SIMD context of the step
+//! (`Simd::vectorize`), as a closure run on another thread is compiled without it.
+
+use pulp::Simd;
+
+use super::ContactStatistics;
+use super::kernels::{
+    LevelShapes, ModalCoefficients, UpdateSums, level_deflections_of_groups, modal_update, penetration_rate,
+    row_axpy,
+};
+use super::layout::{LaneContact, Layout, PlaneLane};
+use super::recorder::record_closed_contact;
+use super::walls::{WallLayout, WallState};
+use crate::impacts::{ContactImpacts, Impact, ImpactClock, ImpactSink};
+
+/// Closed contacts per chunk of the contact pass: each chunk has its own sums.
+pub(super) const CLOSED_CHUNK: usize = 64;
+
+/// The deflection of every line at every level ([`super::kernels::level_deflections`]),
+/// the groups of blocks shared by up to `threads` threads.
+pub(super) fn level_deflections<S: Simd>(
+    simd: S,
+    shapes: &LevelShapes,
+    (row, stride): (usize, usize),
+    q: &[f64],
+    out: &mut [S::f64s],
+    (groups, threads): (std::ops::Range<usize>, usize),
+) {
+    if threads <= 1 || groups.len() <= 1 {
+        simd.vectorize(
+            #[inline(always)]
+            || level_deflections_of_groups(simd, shapes, (row, stride), q, out, groups),
+        );
+        return;
+    }
+    let middle = groups.start + groups.len() / 2;
+    let (first, second) = out.split_at_mut((middle - groups.start) * LevelShapes::GROUP_BLOCKS * stride);
+    let shares = (threads / 2, threads - threads / 2);
+    rayon::join(
+        || {
+            level_deflections(
+                simd,
+                shapes,
+                (row, stride),
+                q,
+                first,
+                (groups.start..middle, shares.0),
+            )
+        },
+        || {
+            level_deflections(
+                simd,
+                shapes,
+                (row, stride),
+                q,
+                second,
+                (middle..groups.end, shares.1),
+            )
+        },
+    );
+}
+
+/// What every closed contact of the plane reads.
+pub(super) struct ClosedPass<'a, S: Simd> {
+    pub simd: S,
+    pub lane_contacts: &'a [LaneContact],
+    pub plane_lanes: &'a [PlaneLane],
+    /// ψ at every level, and the dashpot rows v and a of every line (walls' row last).
+    pub shapes: &'a [S::f64s],
+    pub v: &'a [S::f64s],
+    pub a: &'a [S::f64s],
+    /// Per lane, the penetration now and a step ago.
+    pub now: &'a [f64],
+    pub before: &'a [f64],
+    pub walls: Option<(&'a WallLayout, &'a WallState)>,
+    pub clock: &'a ImpactClock,
+    /// Step, impact block, Δt.
+    pub at: (u64, usize, f64),
+    pub record: bool,
+    pub lookahead: f64,
+    /// The row length in vectors.
+    pub vectors: usize,
+}
+
+/// What the pass writes per lane, for the lanes from `first` on.
+pub(super) struct LaneOutputs<'a> {
+    pub first: usize,
+    pub forces: &'a mut [f64],
+    pub statistics: &'a mut [ContactStatistics],
+    pub peaks: &'a mut [f64],
+    pub wear: &'a mut [f64],
+    pub impacts: &'a mut [ContactImpacts],
+}
+
+impl<'a> LaneOutputs<'a> {
+    /// The lanes before `lane`, and those from it on.
+    fn split_at(self, lane: usize) -> (Self, Self) {
+        let at = lane - self.first;
+        let (forces, forces_after) = self.forces.split_at_mut(at);
+        let (statistics, statistics_after) = self.statistics.split_at_mut(at);
+        let (peaks, peaks_after) = self.peaks.split_at_mut(at);
+        let (wear, wear_after) = self.wear.split_at_mut(at);
+        let (impacts, impacts_after) = self.impacts.split_at_mut(at);
+        (
+            Self {
+                first: self.first,
+                forces,
+                statistics,
+                peaks,
+                wear,
+                impacts,
+            },
+            Self {
+                first: lane,
+                forces: forces_after,
+                statistics: statistics_after,
+                peaks: peaks_after,
+                wear: wear_after,
+                impacts: impacts_after,
+            },
+        )
+    }
+}
+
+impl<S: Simd> ClosedPass<'_, S> {
+    /// The closed lanes `closed` (ascending), in chunks of [`CLOSED_CHUNK`] whose
+    /// [dissipation power, walls' power] go to `partials` (one per chunk), shared by up
+    /// to `threads` threads; the impacts they end go to `log`, in lane order.
+    pub fn run(
+        &self,
+        closed: &[u32],
+        mut out: LaneOutputs<'_>,
+        partials: &mut [[f64; 2]],
+        log: &mut (impl ImpactSink + Send),
+        threads: usize,
+    ) {
+        if threads <= 1 || partials.len() <= 1 {
+            self.simd.vectorize(
+                #[inline(always)]
+                || {
+                    for (chunk, partial) in closed.chunks(CLOSED_CHUNK).zip(partials.iter_mut()) {
+                        *partial = self.chunk(chunk, &mut out, log);
+                    }
+                },
+            );
+            return;
+        }
+        let middle = partials.len() / 2;
+        let (closed_first, closed_second) = closed.split_at(middle * CLOSED_CHUNK);
+        let (out_first, out_second) = out.split_at(closed_second[0] as usize);
+        let (partials_first, partials_second) = partials.split_at_mut(middle);
+        let mut later: Vec<Impact> = Vec::new();
+        let shares = (threads / 2, threads - threads / 2);
+        rayon::join(
+            || self.run(closed_first, out_first, partials_first, log, shares.0),
+            || self.run(closed_second, out_second, partials_second, &mut later, shares.1),
+        );
+        for impact in later {
+            log.push(impact);
+        }
+    }
+
+    /// One chunk: with the dashpot velocity of each body along x and y, rate_x = ψ·Δṽ_x
+    /// and rate_y = ψ·Δṽ_y, the penetration rate is δ̇ = n_x rate_x + n_y rate_y and the
+    /// sliding velocity v_t = −n_y rate_x + n_x rate_y (tangent t = (−n_y, n_x));
+    /// F = max(0, Kc δ + cc δ̇), and the wear work gains F |v_t| Δt. Returns the chunk's
+    /// dissipation power Σ (F − Kc δ) δ̇ and walls' power Σ F n·ḋ_wall.
+    #[inline(always)]
+    fn chunk(&self, closed: &[u32], out: &mut LaneOutputs<'_>, log: &mut impl ImpactSink) -> [f64; 2] {
+        let (simd, n, lookahead) = (self.simd, self.vectors, self.lookahead);
+        let (v, a, shapes) = (self.v, self.a, self.shapes);
+        let (mut dissipation_power, mut wall_power) = (0.0, 0.0);
+        let first = out.first;
+        for &j in closed {
+            let j = j as usize;
+            let (contact, lane) = (self.lane_contacts[j], self.plane_lanes[j]);
+            let (penetration, previous) = (self.now[j], self.before[j]);
+            let rows = |offset: usize| (&v[offset..], &a[offset..]);
+            let shape = &shapes[contact.shape..][..n];
+            let mut rate_x =
+                penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead);
+            let mut rate_y = penetration_rate(simd, shape, rows(lane.left_y), rows(lane.right_y), lookahead);
+            let [normal_x, normal_y] = lane.normal;
+            let mut wall_rate = 0.0;
+            if let Some((layout, wall)) = self.walls {
+                let [x, y] = wall.velocity_of(layout, j);
+                (rate_x, rate_y) = (rate_x + x, rate_y + y);
+                wall_rate = normal_x * x + normal_y * y;
+            }
+            let rate = normal_x * rate_x + normal_y * rate_y;
+            let sliding = normal_x * rate_y - normal_y * rate_x;
+            let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
+            let k = j - first;
+            out.forces[k] = force;
+            let dissipation = (force - contact.stiffness * penetration) * rate;
+            dissipation_power += dissipation;
+            wall_power += force * wall_rate;
+            if self.record {
+                if force > out.peaks[k] {
+                    out.peaks[k] = force;
+                }
+                if contact.active {
+                    record_closed_contact(
+                        (&mut out.statistics[k], &mut out.impacts[k]),
+                        (self.clock, &mut *log),
+                        self.at,
+                        (penetration, previous),
+                        (force, dissipation),
+                    );
+                }
+                out.wear[k] += force * sliding.abs() * self.at.2;
+            }
+        }
+        [dissipation_power, wall_power]
+    }
+}
+
+/// The x lines (`y` false) or the y lines of the state, from vector `start` on.
+pub(super) struct Half<'a> {
+    pub y: bool,
+    /// Offset (in vectors) of the half's first row in the whole state.
+    pub start: usize,
+    pub q: &'a [f64],
+    pub v: &'a mut [f64],
+    pub a: &'a mut [f64],
+    pub force: &'a mut [f64],
+    /// The base acceleration along the half's direction (m/s²).
+    pub base: f64,
+}
+
+/// What both halves read: the closed contacts and their forces, the walls.
+pub(super) struct Loads<'a> {
+    pub layout: &'a Layout<'a>,
+    pub plane_lanes: &'a [PlaneLane],
+    pub closed: &'a [u32],
+    pub forces: &'a [f64],
+    pub walls: Option<(&'a WallLayout, &'a WallState)>,
+}
+
+/// Both halves' contact loads (and the walls' transport loads); with `update`, their
+/// modal update with `second_half` too, returning the x and the y sums. Up to
+/// `threads` threads (two at most: one per half).
+pub(super) fn update_halves<S: Simd>(
+    simd: S,
+    loads: &Loads<'_>,
+    halves: [Half<'_>; 2],
+    update: Option<(&ModalCoefficients<'_, S>, f64)>,
+    threads: usize,
+) -> [Option<UpdateSums>; 2] {
+    let [x, y] = halves;
+    if threads <= 1 {
+        return [
+            update_half(simd, loads, x, update),
+            update_half(simd, loads, y, update),
+        ];
+    }
+    let (x, y) = rayon::join(
+        || update_half(simd, loads, x, update),
+        || update_half(simd, loads, y, update),
+    );
+    [x, y]
+}
+
+/// One half: every closed contact's force along the half's direction added to the rows
+/// of its bodies (−F n to the left one, +F n to the right one), the walls' transport
+/// load, and the modal update.
+fn update_half<S: Simd>(
+    simd: S,
+    loads: &Loads<'_>,
+    half: Half<'_>,
+    update: Option<(&ModalCoefficients<'_, S>, f64)>,
+) -> Option<UpdateSums> {
+    simd.vectorize(
+        #[inline(always)]
+        || {
+            let layout = loads.layout;
+            let (n, wall) = (layout.row / super::kernels::lanes::<S>(), layout.wall_row);
+            let shapes = S::as_simd_f64s(&layout.level_shapes).0;
+            let rows = S::as_mut_simd_f64s(half.force).0;
+            for &j in loads.closed {
+                let j = j as usize;
+                let force = loads.forces[j];
+                if force == 0.0 {
+                    continue;
+                }
+                let (contact, lane) = (layout.lane_contacts[j], loads.plane_lanes[j]);
+                let shape = &shapes[contact.shape..][..n];
+                let [normal_x, normal_y] = lane.normal;
+                let (left, right, normal) = if half.y {
+                    (lane.left_y, lane.right_y, normal_y)
+                } else {
+                    (contact.left, contact.right, normal_x)
+                };
+                if contact.left != wall {
+                    row_axpy(simd, -force * normal, shape, &mut rows[left - half.start..]);
+                }
+                if contact.right != wall {
+                    row_axpy(simd, force * normal, shape, &mut rows[right - half.start..]);
+                }
+            }
+            if let Some((walls, wall)) = loads.walls {
+                wall.add_transport_load(walls, half.force, layout.row, usize::from(half.y));
+            }
+            update.map(|(coefficients, second_half)| {
+                modal_update(
+                    simd,
+                    coefficients,
+                    half.base,
+                    second_half,
+                    (
+                        S::as_simd_f64s(half.q).0,
+                        S::as_mut_simd_f64s(half.v).0,
+                        S::as_mut_simd_f64s(half.a).0,
+                        S::as_mut_simd_f64s(half.force).0,
+                    ),
+                )
+            })
+        },
+    )
+}

@@ -1,0 +1,135 @@
+//! Threads inside one run ([`Settings::threads`]): the plane's step shared by 2 or 3
+//! threads gives the run of one thread bit for bit (histories, statistics, impacts,
+//! wear, energy), with many contacts closed at once (several chunks of the contact
+//! pass), walls that move on their own and a point force.
+
+use std::ops::ControlFlow;
+
+use super::*;
+use crate::beam::tests::default_tube;
+use crate::contact::{Body, Contact};
+use crate::loads::{BaseAcceleration, PointForce, Table};
+use crate::modal::ModalBasis;
+
+/// 37 pins on a hexagonal lattice, 24 levels turning by 60° as a wire-wrapped bundle's
+/// do; one contact in three without a gap, the others with small gaps; neighbours
+/// released toward each other.
+fn bundle(basis: &ModalBasis) -> Model<'_> {
+    let rings = 3i64;
+    let mut pins = Vec::new();
+    for q in -rings..=rings {
+        for r in (-rings).max(-q - rings)..=rings.min(-q + rings) {
+            pins.push((q, r));
+        }
+    }
+    let index = |at: (i64, i64)| pins.iter().position(|p| *p == at);
+    let s3 = 3f64.sqrt() / 2.0;
+    let directions = [
+        ((1, 0), [1.0, 0.0]),
+        ((0, 1), [0.5, s3]),
+        ((-1, 1), [-0.5, s3]),
+        ((-1, 0), [-1.0, 0.0]),
+        ((0, -1), [-0.5, -s3]),
+        ((1, -1), [0.5, -s3]),
+    ];
+    let (mut contacts, mut normals) = (Vec::new(), Vec::new());
+    let levels = 24;
+    for level in 0..levels {
+        let height = 0.1 + 0.85 * level as f64 / levels as f64;
+        let ((dq, dr), normal) = directions[level % 6];
+        for (p, &(q, r)) in pins.iter().enumerate() {
+            let right = index((q + dq, r + dr)).map_or(Body::Wall, Body::Pin);
+            let gap = if (p + level) % 3 == 0 {
+                0.0
+            } else {
+                1e-5 * (1.0 + (p % 5) as f64 / 5.0)
+            };
+            contacts.push(Contact {
+                left: Body::Pin(p),
+                right,
+                height,
+                gap,
+                stiffness: 1e6,
+                damping: 10.0,
+            });
+            normals.push(normal);
+        }
+    }
+    let shake = |amplitude: f64, duration: f64| Some(BaseAcceleration::HalfSine { amplitude, duration });
+    Model {
+        basis,
+        pins: pins.len(),
+        damping_ratios: vec![0.01; basis.modes()],
+        contacts,
+        initial_tip_displacements: (0..pins.len())
+            .map(|p| if p % 2 == 0 { 2e-4 } else { -2e-4 })
+            .collect(),
+        base_acceleration: shake(30.0, 0.004),
+        point_forces: vec![PointForce {
+            pin: 5,
+            height: 0.7,
+            force: Table {
+                time: vec![0.0, 0.002, 0.004],
+                values: vec![0.0, 3.0, 0.0],
+            },
+        }],
+        walls: Some(WallMotion::rigid(shake(-20.0, 0.003), shake(10.0, 0.005))),
+        plane: Some(Plane {
+            normals,
+            base_acceleration_y: shake(-20.0, 0.004),
+        }),
+    }
+}
+
+fn settings(threads: usize) -> Settings {
+    Settings {
+        scheme: crate::stability::Scheme::CentralDifference,
+        time_step: TimeStep::Auto,
+        tolerance: DEFAULT_TOLERANCE,
+        check: Check::None,
+        duration: 0.01,
+        output_interval: Some(5e-4),
+        output_heights: vec![0.5, 1.0],
+        recorded_contacts: None,
+        impacts: Default::default(),
+        threads,
+    }
+}
+
+/// The run of `model` with `threads` threads asked, in a pool of `pool` threads.
+fn run(model: &Model<'_>, threads: usize, pool: usize) -> Simulation {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(pool)
+        .build()
+        .expect("a thread pool");
+    pool.install(|| {
+        Plan::new(model, &settings(threads))
+            .expect("a valid model")
+            .run(&mut |_| ControlFlow::Continue(()))
+            .expect("runs")
+            .simulation
+    })
+}
+
+#[test]
+fn results_are_the_same_bit_for_bit_for_every_thread_count() {
+    let basis = ModalBasis::compute(&default_tube(20), 6).expect("valid beam");
+    let model = bundle(&basis);
+    let one = run(&model, 1, 1);
+    // The run is worth sharing: more than two chunks of closed contacts at a time on
+    // average, and impacts.
+    let closed = one.contact_statistics.iter().map(|s| s.contact_time).sum::<f64>() / 0.01;
+    assert!(
+        closed > 2.0 * plane_step::CLOSED_CHUNK as f64,
+        "{closed} contacts closed on average"
+    );
+    assert!(one.contact_statistics.iter().map(|s| s.impacts).sum::<u64>() > 100);
+    assert!(one.energy.relative_residual() < 1e-2, "{:?}", one.energy);
+    for (threads, pool) in [(2, 2), (3, 3), (2, 1), (8, 2)] {
+        let shared = run(&model, threads, pool);
+        assert!(
+            shared == one,
+            "{threads} threads in a pool of {pool} differ from one thread"
+        );
+    }
+}
