@@ -5,7 +5,9 @@
 //! `sum` is n(n+1)/2) and records a history `signal` with a sine `value` column and a
 //! `square` column (step²), with optional one-sample spikes. It can be told to fail
 //! deterministically or to panic at a given step, and it validates its inputs with JSON
-//! pointers like the real processes. A [`Probe`] shared with the test records what ran.
+//! pointers like the real processes. It takes `solver.threads` as the real processes do
+//! and records the threads its worker gave it. A [`Probe`] shared with the test records
+//! what ran.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -29,6 +31,8 @@ pub struct Probe {
     pub cancelled_at: Mutex<Option<Instant>>,
     /// Step counts of the runs started, in order.
     pub runs: Mutex<Vec<u64>>,
+    /// Threads of the pool each run started in, in order.
+    pub threads: Mutex<Vec<usize>>,
 }
 
 impl Probe {
@@ -57,7 +61,7 @@ fn parse(inputs: &Value) -> Result<Inputs, InvalidInputs> {
     for key in object.keys() {
         if !matches!(
             key.as_str(),
-            "steps" | "step_ms" | "busy" | "fail_at" | "panic_at" | "spikes"
+            "steps" | "step_ms" | "busy" | "fail_at" | "panic_at" | "spikes" | "solver"
         ) {
             errors.push(FieldError::new(format!("/inputs/{key}"), "unknown input"));
         }
@@ -167,6 +171,11 @@ impl Process for CountSteps {
         let inputs = parse(inputs)?;
         self.probe.started.fetch_add(1, Ordering::SeqCst);
         self.probe.runs.lock().unwrap().push(inputs.steps);
+        self.probe
+            .threads
+            .lock()
+            .unwrap()
+            .push(rayon::current_num_threads());
         let step = Duration::from_secs_f64(inputs.step_ms / 1000.0);
         let (mut time, mut value, mut square) = (Vec::new(), Vec::new(), Vec::new());
         let mut sum: u64 = 0;

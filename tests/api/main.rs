@@ -36,5 +36,6 @@ mod signals;
 mod spectra;
 mod sweeps;
 mod tenants;
+mod threads;
 mod units;
 mod warnings;

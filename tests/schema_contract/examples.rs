@@ -39,7 +39,7 @@ fn explicit_beam(length: f64) -> Value {
 /// A fixed step with the Tchamwa scheme, and every other member of `solver`.
 fn tchamwa(duration: f64) -> Value {
     json!({"scheme": "tchamwa", "phi": 1.1, "time_step": 1e-6, "duration": duration,
-           "tolerance": 1e-3, "check": "step_halving"})
+           "tolerance": 1e-3, "check": "step_halving", "threads": 2})
 }
 
 /// One base acceleration of each type.
@@ -70,7 +70,7 @@ pub fn cantilever() -> Vec<Value> {
                "contact": {"rk": 1.0, "gap": 0.0, "damping": 0.0},
                "release": {"tip_displacement": 0.001},
                "solver": {"scheme": "central_difference", "time_step": 1e-5, "duration": 0.04,
-                          "tolerance": 1e-3, "check": "step_halving"},
+                          "tolerance": 1e-3, "check": "step_halving", "threads": 2},
                "reference": {"modes": 6},
                "output": {"interval": 1e-4, "blocks": 2,
                           "impacts": {"force_threshold": 0.0, "rest_time": 0.0, "classes": 10,

@@ -1,0 +1,137 @@
+//! Threads inside one run (`solver.threads`): a worker's slots share as many cores as
+//! there are slots. A run gets the free cores it asks for (and no more), the other slots
+//! claim nothing while it holds them, and the results do not depend on the count.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use chocmodal::processes::hex_bundle_dynamics::HexBundleDynamics;
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use crate::dashboard::execute;
+use crate::helpers::{Backend, TestApp, on_both_backends, spawn_app_on, spawn_app_with_processes};
+
+on_both_backends!(
+    a_run_gets_the_cores_it_asks_for_and_the_other_slots_wait,
+    a_run_gets_only_the_free_cores
+);
+
+const WITHIN: Duration = Duration::from_secs(30);
+
+/// The `chocmodal_worker_threads` gauge of `/metrics`.
+async fn worker_threads(app: &TestApp) -> i64 {
+    let text = app.get("/metrics").await.text().await.unwrap();
+    text.lines()
+        .find_map(|line| line.strip_prefix("chocmodal_worker_threads "))
+        .and_then(|value| value.trim().parse().ok())
+        .expect("the gauge is exported")
+}
+
+/// Waits until `count` runs have started computing (a job is `running` from its claim,
+/// a moment before).
+async fn started(app: &TestApp, count: usize) {
+    for _ in 0..600 {
+        if app.probe.started() >= count {
+            return;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    panic!("{count} runs did not start within 30 s");
+}
+
+/// Two slots, so two cores: a run asking for two takes both. A job queued meanwhile
+/// stays queued although a slot is idle, and runs (on one thread) once the first is
+/// dismissed.
+async fn a_run_gets_the_cores_it_asks_for_and_the_other_slots_wait(backend: Backend) {
+    let app = spawn_app_on(backend, |config| config.workers = 2).await;
+    // Minutes of work unless dismissed.
+    let wide = app
+        .submit(json!({"steps": 100000, "step_ms": 1, "solver": {"threads": 2}}))
+        .await;
+    app.wait_for(&wide, &["running"], WITHIN).await;
+    started(&app, 1).await;
+    assert_eq!(*app.probe.threads.lock().unwrap(), [2]);
+    assert_eq!(worker_threads(&app).await, 2);
+
+    let narrow = app.submit(json!({"steps": 2})).await;
+    // Far longer than an idle slot takes to claim (an enqueue wakes it at once).
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    assert_eq!(app.status(&narrow).await["status"], "accepted", "no core is free");
+    assert_eq!(app.probe.started(), 1);
+
+    assert_eq!(
+        app.delete(&format!("/jobs/{wide}")).await.status(),
+        StatusCode::OK
+    );
+    assert_eq!(app.wait_until_finished(&narrow).await["status"], "successful");
+    assert_eq!(*app.probe.threads.lock().unwrap(), [2, 1]);
+    // Every core is handed back.
+    let mut threads = worker_threads(&app).await;
+    for _ in 0..100 {
+        if threads == 0 {
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+        threads = worker_threads(&app).await;
+    }
+    assert_eq!(threads, 0);
+}
+
+/// A run asking for more threads than there are free cores runs on those it gets.
+async fn a_run_gets_only_the_free_cores(backend: Backend) {
+    let app = spawn_app_on(backend, |config| config.workers = 2).await;
+    let long = app.submit(json!({"steps": 100000, "step_ms": 1})).await;
+    app.wait_for(&long, &["running"], WITHIN).await;
+    started(&app, 1).await;
+    let wide = app.submit(json!({"steps": 2, "solver": {"threads": 8}})).await;
+    assert_eq!(app.wait_until_finished(&wide).await["status"], "successful");
+    assert_eq!(*app.probe.threads.lock().unwrap(), [1, 1]);
+    assert_eq!(
+        app.delete(&format!("/jobs/{long}")).await.status(),
+        StatusCode::OK
+    );
+}
+
+/// A 19-pin bundle rattling against its neighbours and the wrapper.
+fn bundle(threads: usize) -> Value {
+    json!({"inputs": {
+        "pin": {"length": 0.6, "young_modulus": 2.1e11, "density": 7800.0,
+                "section": {"type": "tube", "outer_diameter": 0.0097, "inner_diameter": 0.0085},
+                "added_mass_per_length": 0.6, "elements": 24, "modes": 4, "static_correction": "none"},
+        "bundle": {"rings": 2, "pitch": 0.0107, "wire_diameter": 0.001, "wire_lead": 0.15,
+                   "wrapper_flat_to_flat": 0.0492},
+        "contact": {"stiffness": 2e6, "damping": 20.0},
+        "gaps": {"type": "uniform", "pin_pin": 1e-5, "pin_wall": 2e-5},
+        "excitation": {"base_acceleration": {"type": "half_sine", "amplitude": 80.0, "duration": 0.01},
+                       "direction": 10.0},
+        "solver": {"duration": 0.02, "check": "none", "threads": threads},
+        "output": {"interval": 1e-3, "contacts": {"type": "all"}}
+    }})
+}
+
+/// The hex bundle on one and on two threads: the same results document (but for the
+/// links to its histories) and histories, byte for byte.
+#[tokio::test]
+async fn a_hex_bundle_gives_the_same_results_on_one_and_two_threads() {
+    let app = spawn_app_with_processes(vec![Arc::new(HexBundleDynamics)], |config| config.workers = 2).await;
+    let mut documents = Vec::new();
+    for threads in [1, 2] {
+        let job = execute(&app, "hex-bundle-dynamics", &bundle(threads)).await;
+        let status = app.wait_until_finished(&job).await;
+        assert_eq!(status["status"], "successful", "{status}");
+        let mut results = app.get_json(&format!("/jobs/{job}/results")).await;
+        // The links to the histories name the job.
+        results.as_object_mut().unwrap().remove("outputs");
+        let forces = app
+            .get(&format!("/jobs/{job}/results/contact_forces"))
+            .await
+            .text()
+            .await
+            .unwrap();
+        documents.push((results, forces));
+    }
+    let impacts = documents[0].0["impacts"].as_u64().unwrap();
+    assert!(impacts > 0, "the bundle rattles");
+    assert!(documents[0] == documents[1], "one and two threads differ");
+}
