@@ -123,8 +123,16 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
         ControlFlow::Continue(())
     };
     let signals = record_files(&inputs, &body_directory(&args.body));
-    let output = process
-        .run_with(&inputs, &signals, &mut progress)
+    // The run computes on a pool of this machine's cores (it uses as many as its
+    // `solver.threads` asks): from inside the pool, a step shared between threads forks
+    // and joins there, without waking this thread at every step.
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(cores)
+        .build()
+        .map_err(|e| CliFailure::Failed(format!("cannot start the run's threads: {e}")))?;
+    let output = pool
+        .install(|| process.run_with(&inputs, &signals, &mut progress))
         .map_err(|e| match e {
             RunError::Invalid(invalid) => CliFailure::Problem(Problem::invalid_inputs(&invalid)),
             other => CliFailure::Failed(other.to_string()),

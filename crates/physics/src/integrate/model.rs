@@ -333,7 +333,9 @@ pub struct Settings {
     /// Threads the step may share (at least 1), within the threads of the rayon pool
     /// the run is called in: the plane's step shares its level deflections, its closed
     /// contacts and its x and y modal updates; a row's step runs on one. Every result is
-    /// the same, bit for bit, for every count.
+    /// the same, bit for bit, for every count. Call the run from inside the pool
+    /// (`ThreadPool::install`): a thread outside it hands every fork to the pool and
+    /// waits, two thread wake-ups per fork, three forks a step.
     pub threads: usize,
 }
 
