@@ -263,6 +263,7 @@ impl Simulation for HexBundleDynamics {
         },
         impact_report::TABLE_OUTPUT,
     ];
+    const SHARES_STEPS: bool = true;
 
     type Inputs = HexInputs;
     type Results = HexResults;

@@ -362,6 +362,17 @@ fn one_thread() -> usize {
     1
 }
 
+/// The threads `inputs` ask for (`solver.threads`, 1 when absent; validated inputs hold
+/// 1 to [`MAX_THREADS`]).
+pub fn requested_threads(inputs: &serde_json::Value) -> usize {
+    inputs
+        .pointer("/solver/threads")
+        .and_then(serde_json::Value::as_u64)
+        .map_or(1, |n| {
+            usize::try_from(n).unwrap_or(MAX_THREADS).clamp(1, MAX_THREADS)
+        })
+}
+
 /// Explicit integration settings (every process's `solver` block; each process states
 /// its own defaults for `time_step` and `duration`).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
@@ -400,7 +411,7 @@ pub struct SolverInput {
     /// between them (its level deflections, closed contacts, and x and y modal updates);
     /// the row processes' steps are too short to share and run on one. A worker grants
     /// at most the cores it has free, so a run may get fewer. Results are the same, bit
-    /// for bit, whatever the count.
+    /// for bit, whatever the count. It pays on cores nobody else uses.
     #[serde(default = "one_thread")]
     #[schema(default = 1, minimum = 1, maximum = 64)]
     pub threads: usize,

@@ -222,6 +222,12 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     /// the errors start with `/inputs`. Accepted inputs come with their plausibility
     /// warnings.
     fn validate(&self, inputs: &serde_json::Value) -> Result<Validated, InvalidInputs>;
+    /// The threads a run of `inputs` can use (a worker grants it up to that many of its
+    /// free cores and runs it in a pool of those). Default: 1.
+    fn threads(&self, inputs: &serde_json::Value) -> usize {
+        let _ = inputs;
+        1
+    }
     /// Runs the computation on inputs that passed [`Process::validate`].
     fn run(&self, inputs: &serde_json::Value, progress: &mut ProgressFn<'_>) -> Result<RunOutput, RunError>;
     /// [`Process::validate`], the stored signals the inputs refer to (`{"type":

@@ -80,6 +80,9 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
     const DESCRIPTION: &'static str;
     /// The histories a run writes.
     const HISTORIES: &'static [HistoryOutput];
+    /// Whether a run shares its steps between the threads `solver.threads` asks for
+    /// (a worker then grants it up to that many cores; otherwise one).
+    const SHARES_STEPS: bool = false;
 
     /// The `inputs` object of an execution request (unknown fields refused).
     type Inputs: DeserializeOwned + ToSchema;
@@ -152,6 +155,14 @@ struct Document<'a, R> {
 impl<S: Simulation> Process for S {
     fn id(&self) -> &'static str {
         S::ID
+    }
+
+    fn threads(&self, inputs: &serde_json::Value) -> usize {
+        if S::SHARES_STEPS {
+            super::inputs::requested_threads(inputs)
+        } else {
+            1
+        }
     }
 
     fn title(&self) -> &'static str {

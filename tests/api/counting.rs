@@ -141,6 +141,11 @@ impl Process for CountSteps {
         "Counts steps, slowly if asked; a test process."
     }
 
+    /// As a process that shares its steps: what `solver.threads` asks.
+    fn threads(&self, inputs: &Value) -> usize {
+        chocmodal::processes::inputs::requested_threads(inputs)
+    }
+
     fn inputs_description(&self) -> Value {
         json!({"steps": {"title": "Steps", "description": "number of steps", "schema": {"type": "integer", "minimum": 1}}})
     }

@@ -135,3 +135,17 @@ async fn a_hex_bundle_gives_the_same_results_on_one_and_two_threads() {
     assert!(impacts > 0, "the bundle rattles");
     assert!(documents[0] == documents[1], "one and two threads differ");
 }
+
+/// Only the hex bundle shares its steps: a row process asking for threads is granted one
+/// core, not cores it would leave idle.
+#[test]
+fn only_processes_that_share_their_steps_are_granted_threads() {
+    use chocmodal::processes::Process;
+    use chocmodal::processes::bundle_dynamics::BundleDynamics;
+    use chocmodal::processes::cantilever_impact::CantileverImpact;
+    let asking = |threads: u64| json!({"solver": {"threads": threads}});
+    assert_eq!(HexBundleDynamics.threads(&asking(4)), 4);
+    assert_eq!(HexBundleDynamics.threads(&json!({})), 1);
+    assert_eq!(BundleDynamics.threads(&asking(4)), 1);
+    assert_eq!(CantileverImpact.threads(&asking(4)), 1);
+}

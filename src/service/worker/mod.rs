@@ -170,7 +170,11 @@ async fn worker_loop(
         match ctx.queue.claim(&owner, ctx.lease).await {
             Ok(Some(job)) => {
                 let mut held = Cores { held: vec![core] };
-                held.take(&cores, run::requested_threads(&job.inputs)).await;
+                let usable = ctx
+                    .registry
+                    .get(&job.process_id)
+                    .map_or(1, |p| p.threads(&job.inputs));
+                held.take(&cores, usable).await;
                 run::run_job(&ctx, job, held, hand_back.clone()).await;
                 continue;
             }

@@ -15,7 +15,6 @@ use tokio::sync::{oneshot, watch};
 
 use super::{Cores, WorkerContext};
 use crate::problem::{CHOCMODAL_PROBLEMS, Problem};
-use crate::processes::inputs::MAX_THREADS;
 use crate::processes::{RunError, RunOutput};
 use crate::service::queue::{ClaimedJob, Lease};
 use crate::service::signals::SignalReadError;
@@ -27,17 +26,6 @@ const OWNERSHIP_CHECK: Duration = Duration::from_millis(500);
 
 /// What the compute thread sends back: the run's result, or the panic message.
 type ThreadOutcome = Result<Result<RunOutput, RunError>, String>;
-
-/// The threads a job's inputs ask for (`solver.threads`, 1 when absent; validated
-/// inputs hold 1 to [`MAX_THREADS`]).
-pub(super) fn requested_threads(inputs: &serde_json::Value) -> usize {
-    inputs
-        .pointer("/solver/threads")
-        .and_then(serde_json::Value::as_u64)
-        .map_or(1, |n| {
-            usize::try_from(n).unwrap_or(MAX_THREADS).clamp(1, MAX_THREADS)
-        })
-}
 
 /// Runs `job` with the threads of `cores` (the process computes inside a thread pool of
 /// that size, whatever it asked for: its results do not depend on it).
@@ -113,7 +101,7 @@ pub(super) async fn run_job(
         process = %process_id,
         attempt = lease.attempt,
         threads = cores.count(),
-        requested = requested_threads(&job.inputs),
+        usable = process.threads(&job.inputs),
         "job started"
     );
     let control = ctx.running.insert(&lease.job_id);
