@@ -1,7 +1,8 @@
 //! Point forces and tip releases of `hex-bundle-dynamics` as the process reads them: a
 //! load along θ lands on the pin's x and y lines as cos θ and sin θ (exactly 0 and ±1
 //! along the axes), a release on its two lines, every bad value is refused at its
-//! pointer with the bound it broke, and a force or a release counts as excitation.
+//! pointer with the bound it broke, a force or a release counts as excitation, and the
+//! `auto` step resolves a force's samples.
 
 use serde_json::{Value, json};
 
@@ -222,4 +223,28 @@ fn a_point_force_or_a_release_excites_the_bundle() {
     let mut released = inputs();
     released["initial"] = json!({"tip_displacements": [{"pin": 6, "x": 0.0, "y": 1e-3}]});
     assert!(excites(&released));
+}
+
+/// The `auto` step resolves a point force's table: sampled every 2 µs, it sets a step
+/// of at most 2 µs (the row's rule), the quality report naming the excitation.
+#[test]
+fn the_auto_step_resolves_a_point_forces_samples() {
+    let mut inputs = inputs();
+    inputs["solver"] = json!({"duration": 1e-3, "check": "none"});
+    inputs["output"] = json!({"interval": 1e-4});
+    let time: Vec<f64> = (0..=50).map(|k| k as f64 * 2e-6).collect();
+    let force: Vec<f64> = time.iter().map(|t| 1e5 * t).collect();
+    inputs["excitation"] = json!({"point_forces": [
+        {"pin": 3, "height": 0.3, "direction": 200.0, "time": time, "force": force}]});
+    let output = HexBundleDynamics
+        .run(&inputs, &mut |_| std::ops::ControlFlow::Continue(()))
+        .expect("runs");
+    let document = &output.document;
+    let step = document["time_step"].as_f64().unwrap();
+    assert!(step <= 2e-6, "time step {step:e} s");
+    assert_eq!(
+        document["quality"]["time_step_limited_by"], "excitation",
+        "{}",
+        document["quality"]
+    );
 }
