@@ -115,6 +115,8 @@ fn pointer_of(inputs: &BundleInputs, path: &str, pins_refused: bool) -> Option<S
                 },
             }
         }
+        // The row's line p is pin p, which the request names.
+        ("point_forces", Some(k), "line") => format!("/inputs/excitation/point_forces/{k}/pin"),
         ("point_forces", Some(k), rest) => {
             model_check::join(&format!("/inputs/excitation/point_forces/{k}"), rest)
         }

@@ -607,9 +607,10 @@ pub struct PointForceInput {
 }
 
 impl PointForceInput {
+    /// The force on the pin's line (a row has one line per pin, line p for pin p).
     pub fn physics(&self) -> PointForce {
         PointForce {
-            pin: self.pin,
+            line: self.pin,
             height: self.height,
             force: Table {
                 time: self.time.clone(),

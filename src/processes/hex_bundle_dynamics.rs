@@ -2,8 +2,9 @@
 //! pins on one shared modal basis, bending along x and y) in its wrapper tube, built from
 //! a dozen numbers (`physics::hex`): each wire touches a neighbour's clad or the wrapper
 //! once every H/12, each contact with its normal in the transverse plane. Shaken by the
-//! wrapper in any horizontal direction. Statistics for every contact, full force
-//! histories for a selection.
+//! wrapper in any horizontal direction, pushed by point forces or released from bent
+//! shapes (`hex_loads`). Statistics for every contact, full force histories for a
+//! selection.
 
 use serde::Serialize;
 use utoipa::ToSchema;
@@ -11,6 +12,7 @@ use utoipa::ToSchema;
 use super::basis_report::BasisReport;
 use super::bundle_dynamics::{PeakDeflectionResult, PeakForce};
 use super::hex_inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
+use super::hex_loads::{self, PlaneLoads};
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::inputs::{self, SolverDefaults, at};
 use super::report::{EnergyReport, QualityReport};
@@ -37,6 +39,7 @@ pub struct Plan {
     normals: Vec<[f64; 2]>,
     excitation: (Option<BaseAcceleration>, Option<BaseAcceleration>),
     walls: Option<WallMotion>,
+    loads: PlaneLoads,
     basis: ModalBasis,
     settings: Settings,
     step: StepSize,
@@ -49,13 +52,15 @@ impl Plan {
             self.bundle.pin_count(),
             (&self.contacts, &self.normals),
             (&self.excitation, &self.walls),
+            &self.loads,
             &self.basis,
         )
     }
 }
 
 /// The bundle as the integrator sees it: the wire pin is the contact's left body, the
-/// touched clad (or the wall) its right body, the normal from left to right.
+/// touched clad (or the wall) its right body, the normal from left to right; releases
+/// and point forces on the pins' x and y lines.
 fn plane_model<'a>(
     inputs: &HexInputs,
     pins: usize,
@@ -64,6 +69,7 @@ fn plane_model<'a>(
         &(Option<BaseAcceleration>, Option<BaseAcceleration>),
         &Option<WallMotion>,
     ),
+    loads: &PlaneLoads,
     basis: &'a ModalBasis,
 ) -> Model<'a> {
     Model {
@@ -71,9 +77,9 @@ fn plane_model<'a>(
         pins,
         damping_ratios: inputs.pin.damping_ratios_for(basis.modes()),
         contacts: contacts.to_vec(),
-        initial_tip_displacements: Vec::new(),
+        initial_tip_displacements: loads.initial_tip_displacements.clone(),
         base_acceleration: x.clone(),
-        point_forces: Vec::new(),
+        point_forces: loads.point_forces.clone(),
         walls: walls.clone(),
         plane: Some(Plane {
             normals: normals.to_vec(),
@@ -231,7 +237,8 @@ impl Simulation for HexBundleDynamics {
     const DESCRIPTION: &'static str = "Builds a wire-wrapped hexagonal bundle (7 to 271 identical pins, one shared modal basis \
          bending along x and y) in its wrapper from a dozen numbers: each spacer wire touches a \
          neighbour's clad or the wrapper once every H/12, with its normal in the transverse plane. \
-         Integrates it under a base acceleration in any horizontal direction with penalty contacts. \
+         Integrates it under a base acceleration in any horizontal direction, point forces and tip \
+         releases with penalty contacts. \
          Returns every contact with its statistics (peak force, impacts, contact time, impulse, wear \
          work rate), per-pin extremes, the energy balance, force histories of a selection of \
          contacts and the pins' deflection histories.";
@@ -306,6 +313,7 @@ impl Simulation for HexBundleDynamics {
         );
         let excitation = excitation(&inputs.excitation, &mut errors);
         let walls = wrapper_motion(&inputs.excitation, &excitation, &mut errors);
+        let loads = hex_loads::plane_loads(&inputs, &mut errors);
         let solver = inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
         inputs::check_output_interval(inputs.output.interval, &mut errors);
         let counting = impact_report::counting(inputs.output.impacts.as_ref(), inputs.output.blocks);
@@ -369,6 +377,7 @@ impl Simulation for HexBundleDynamics {
             bundle.pin_count(),
             (&contacts, &normals),
             (&excitation, &walls),
+            &loads,
             &basis,
         );
         // The pins' supports the wrapper's motion cannot carry (a pin held by its top
@@ -393,6 +402,7 @@ impl Simulation for HexBundleDynamics {
             normals,
             excitation,
             walls,
+            loads,
             basis,
             settings,
             step,

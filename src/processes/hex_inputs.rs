@@ -10,6 +10,7 @@ use serde::Deserialize;
 use utoipa::ToSchema;
 
 use super::bundle_inputs::{BaseAccelerationInput, DistributionInput};
+use super::hex_loads::{HexInitialInput, HexPointForceInput};
 use super::impact_report::ImpactsInput;
 use super::input_schema::NonNegativeNumber;
 use super::inputs::{BeamInput, SectionInput, SolverInput};
@@ -39,7 +40,13 @@ pub struct HexInputs {
     pub closures: Vec<HexClosureInput>,
     /// Every pin moved toward one flat (a bundle pressed against the wrapper), applied last.
     pub offset: Option<OffsetInput>,
-    /// The wrapper's acceleration in the transverse plane.
+    /// The state at t = 0: pins released from bent shapes; all at rest and straight when
+    /// left out.
+    #[serde(default)]
+    #[schema(default = json!({}))]
+    pub initial: HexInitialInput,
+    /// The feet's and the wrapper's acceleration in the transverse plane, and point
+    /// forces on pins.
     #[serde(default)]
     #[schema(default = json!({}))]
     pub excitation: HexExcitationInput,
@@ -204,7 +211,7 @@ pub struct OffsetInput {
 
 /// Acceleration of every pin foot in the transverse plane (one signal along `direction`,
 /// or two components), and of the wrapper, which moves with the feet unless given its
-/// own (`wrapper_acceleration…`). Results are relative to the feet.
+/// own (`wrapper_acceleration…`); point forces on pins. Results are relative to the feet.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HexExcitationInput {
@@ -233,6 +240,10 @@ pub struct HexExcitationInput {
     pub wrapper_acceleration_x: Option<BaseAccelerationInput>,
     /// Along y (m/s²), instead of `wrapper_acceleration`.
     pub wrapper_acceleration_y: Option<BaseAccelerationInput>,
+    /// Force histories at a height of a pin, each along its own direction (N).
+    #[serde(default)]
+    #[schema(default = json!([]))]
+    pub point_forces: Vec<HexPointForceInput>,
 }
 
 impl HexExcitationInput {

@@ -15,6 +15,8 @@ pub mod columns;
 pub mod cost;
 pub mod hex_bundle_dynamics;
 pub mod hex_inputs;
+/// Point forces and tip releases of `hex-bundle-dynamics`, per deflection line.
+pub mod hex_loads;
 pub mod impact_report;
 pub mod input_schema;
 pub mod inputs;

@@ -19,6 +19,7 @@ mod dismissal;
 mod earthquakes;
 mod errors;
 mod execution;
+mod hex_loads;
 mod impacts;
 mod limits;
 mod listing;

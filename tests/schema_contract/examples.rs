@@ -171,7 +171,7 @@ fn hex_example(gaps: Value, excitation: Value, selection: Value) -> Value {
 
 /// `hex-bundle-dynamics`: each gap state, closures by rings and by sectors, an offset,
 /// every base acceleration along a direction and as each component, each contact
-/// selection, each section and scheme.
+/// selection, each section and scheme; a release and point forces alone.
 pub fn hex() -> Vec<Value> {
     let layout = HexLayout {
         rings: 1,
@@ -224,7 +224,15 @@ pub fn hex() -> Vec<Value> {
     );
     explicit_section["pin"] = explicit_beam(PIN_LENGTH);
     explicit_section["solver"] = tchamwa(0.005);
-    let mut examples = vec![first, explicit_section];
+    // Moved by loads alone: the centre pin released along 45°, point forces along a
+    // direction and along x (the default).
+    let mut loaded = hex_example(gap_states[0].clone(), json!({}), selections[4].clone());
+    loaded["initial"] = json!({"tip_displacements": [{"pin": 0, "x": 2e-4, "y": 2e-4}]});
+    loaded["excitation"] = json!({"point_forces": [
+        {"pin": 1, "height": PIN_LENGTH, "direction": 120.0, "time": [0.0, 0.002, 0.004],
+         "force": [0.0, 2.0, 0.0]},
+        {"pin": 4, "height": 0.5 * PIN_LENGTH, "time": [0.0, 0.003], "force": [1.0, 0.0]}]});
+    let mut examples = vec![first, explicit_section, loaded];
     for (k, base) in bases.iter().enumerate() {
         examples.push(hex_example(
             gap_states[k % gap_states.len()].clone(),

@@ -201,11 +201,13 @@ impl Table {
     }
 }
 
-/// A force history applied at a height of one pin, in the direction of positive
-/// deflection (N).
+/// A force history applied at a height of one pin along one of its deflection lines, in
+/// the direction of positive deflection (N).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointForce {
-    pub pin: usize,
+    /// The deflection line loaded (`Model::lines`): pin p is line p in a row; in the
+    /// plane, pin p along x is line p and along y line pins + p.
+    pub line: usize,
     /// Height from the foot (m).
     pub height: f64,
     pub force: Table,

@@ -426,7 +426,7 @@ mod tests {
             walls: None,
             plane: None,
             point_forces: vec![PointForce {
-                pin: 0,
+                line: 0,
                 height: 1.0,
                 force: Table {
                     time: vec![0.0, 10.0],

@@ -15,8 +15,9 @@
 //! the right one by +F n on the modes of its x and y lines. The relative sliding
 //! velocity is v_t = t·(u̇_L − u̇_R), t = (−n_y, n_x), and the wear work ∫ F |v_t| dt is
 //! accumulated per contact at every step ([`Simulation::wear_work`]). The base
-//! acceleration has one component per direction (the y one in [`Plane`]); the initial
-//! tip displacements and the point forces act along x. Every per-pin output
+//! acceleration has one component per direction (the y one in [`Plane`]); each initial
+//! tip displacement and each point force acts on one line (a release or a force along
+//! an angle θ is two: cos θ on line p, sin θ on line pins + p). Every per-pin output
 //! (deflections, peaks, extremes) is indexed by line. The row runs on its own kernels:
 //! the plane costs it nothing.
 //!
@@ -172,6 +173,9 @@ mod accuracy_tests;
 
 #[cfg(test)]
 mod plane_tests;
+
+#[cfg(test)]
+mod plane_load_tests;
 
 #[cfg(test)]
 mod impact_tests;

@@ -25,12 +25,13 @@ pub struct Model<'a> {
     /// Modal damping ratio ξᵢ of each mode (length = modes).
     pub damping_ratios: Vec<f64>,
     pub contacts: Vec<Contact>,
-    /// Release of each pin from its static tip-load shape with this tip deflection (m);
-    /// empty means all at rest.
+    /// Release of each deflection line ([`Model::lines`]: one per pin in a row; in the
+    /// plane the x lines, then the y lines) from its static tip-load shape with this tip
+    /// deflection (m); empty means all at rest.
     pub initial_tip_displacements: Vec<f64>,
     /// Base acceleration (m/s²); along x in the plane.
     pub base_acceleration: Option<BaseAcceleration>,
-    /// Point forces; along x in the plane.
+    /// Point forces, each on one deflection line (along x or y in the plane).
     pub point_forces: Vec<PointForce>,
     /// `None`: the row (every pin bends along x only, every contact normal is +x).
     /// `Some`: every pin bends along x and y with the same modal basis.
@@ -86,9 +87,10 @@ impl WallMotion {
 
 /// Pins bending in the transverse plane (x, y), each direction on the same basis.
 ///
-/// Initial tip displacements and point forces act along x; the base acceleration has
-/// an x component (`Model::base_acceleration`) and a y component
-/// (`base_acceleration_y`).
+/// Initial tip displacements and point forces act on a line each: pin p's along x is line
+/// p, along y line pins + p (a release or a force along an angle is its two
+/// components); the base acceleration has an x component (`Model::base_acceleration`)
+/// and a y component (`base_acceleration_y`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plane {
     /// Per contact (same order as `Model::contacts`): unit normal (x, y) pointing from
@@ -144,12 +146,13 @@ impl Model<'_> {
     /// at least one pin; one finite, non-negative damping ratio per mode of the basis;
     /// contacts between existing, different bodies, within the pin, with valid gap,
     /// stiffness and damping ([`Contact::validate`]); one finite initial tip deflection
-    /// per pin or none, and none but zeros without a free top (no tip-load shape to
-    /// release from); a valid excitation; point forces on existing pins, within the pin,
-    /// with valid tables; in the plane, [`Plane::validate`].
+    /// per deflection line or none, and none but zeros without a free top (no tip-load
+    /// shape to release from); a valid excitation; point forces on existing lines,
+    /// within the pin, with valid tables; in the plane, [`Plane::validate`].
     pub fn validate(&self) -> Vec<InputIssue> {
         let mut issues = Vec::new();
         let (pins, modes, length) = (self.pins, self.basis.modes(), self.basis.length());
+        let lines = self.lines();
         if pins == 0 {
             issues.push(InputIssue::new("pins", "a row needs at least one pin"));
         }
@@ -180,10 +183,14 @@ impl Model<'_> {
         }
         for (k, point) in self.point_forces.iter().enumerate() {
             let prefix = format!("point_forces/{k}");
-            if point.pin >= pins {
+            if point.line >= lines {
                 issues.push(InputIssue::new(
-                    format!("{prefix}/pin"),
-                    format!("pin {} does not exist (the row has {pins})", point.pin),
+                    format!("{prefix}/line"),
+                    format!(
+                        "line {} does not exist: the model has {lines} deflection lines ({})",
+                        point.line,
+                        self.lines_per_pin()
+                    ),
                 ));
             }
             if !(point.height.is_finite() && (0.0..=length).contains(&point.height)) {
@@ -268,22 +275,30 @@ impl Model<'_> {
         }
     }
 
+    /// How the lines follow from the pins, in words (for messages).
+    fn lines_per_pin(&self) -> &'static str {
+        match self.plane {
+            None => "one per pin",
+            Some(_) => "two per pin: the x lines, then the y lines",
+        }
+    }
+
     fn validate_release(&self, issues: &mut Vec<InputIssue>) {
-        let tips = &self.initial_tip_displacements;
-        if !tips.is_empty() && tips.len() != self.pins {
+        let (tips, lines) = (&self.initial_tip_displacements, self.lines());
+        if !tips.is_empty() && tips.len() != lines {
             issues.push(InputIssue::new(
                 "initial_tip_displacements",
                 format!(
-                    "needs one value per pin ({}) or none, got {}",
-                    self.pins,
+                    "needs one value per deflection line ({lines}, {}) or none, got {}",
+                    self.lines_per_pin(),
                     tips.len()
                 ),
             ));
         }
-        for (p, tip) in tips.iter().enumerate() {
+        for (line, tip) in tips.iter().enumerate() {
             if !tip.is_finite() {
                 issues.push(InputIssue::new(
-                    format!("initial_tip_displacements/{p}"),
+                    format!("initial_tip_displacements/{line}"),
                     "must be a finite number",
                 ));
             }
@@ -435,7 +450,7 @@ mod tests {
                 duration: 0.01,
             }),
             point_forces: vec![PointForce {
-                pin: 1,
+                line: 1,
                 height: 0.7,
                 force: Table {
                     time: vec![0.0, 0.01],
@@ -487,7 +502,7 @@ mod tests {
             amplitude: 5.0,
             duration: 0.0,
         });
-        model.point_forces[0].pin = 2;
+        model.point_forces[0].line = 2;
         model.point_forces[0].height = -0.1;
         model.point_forces[0].force.time = vec![0.0, 0.0];
         assert_eq!(
@@ -502,7 +517,7 @@ mod tests {
                 "initial_tip_displacements",
                 "initial_tip_displacements/0",
                 "base_acceleration/duration",
-                "point_forces/0/pin",
+                "point_forces/0/line",
                 "point_forces/0/height",
                 "point_forces/0/time/1",
             ]

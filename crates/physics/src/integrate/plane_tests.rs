@@ -295,7 +295,8 @@ fn triangle(basis: &ModalBasis) -> Model<'_> {
         pins: 3,
         damping_ratios: vec![0.02; basis.modes()],
         contacts,
-        initial_tip_displacements: vec![2e-4, 0.0, -1e-4],
+        // Along x (lines 0..3); the y lines 3..6 start straight.
+        initial_tip_displacements: vec![2e-4, 0.0, -1e-4, 0.0, 0.0, 0.0],
         base_acceleration: Some(BaseAcceleration::HalfSine {
             amplitude: 15.0,
             duration: 0.01,
@@ -377,7 +378,7 @@ fn a_contact_between_two_pins_exchanges_equal_and_opposite_impulses() {
         pins: 2,
         damping_ratios: vec![0.01; basis.modes()],
         contacts: vec![contact(1.0, 2e-5), contact(0.7, 1e-5)],
-        initial_tip_displacements: vec![-3e-4, 3e-4],
+        initial_tip_displacements: vec![-3e-4, 3e-4, 0.0, 0.0],
         base_acceleration: None,
         point_forces: vec![],
         walls: None,
@@ -610,11 +611,11 @@ fn the_planes_critical_step_matches_brute_force_divergence() {
             stiffness: 1e6,
             damping: 0.0,
         }],
-        initial_tip_displacements: vec![0.0],
+        initial_tip_displacements: vec![0.0, 0.0],
         base_acceleration: None,
         // Toward the wall: δ = n·(0 − u) = −0.6 u_x − 0.8 u_y > 0 for u_x < 0.
         point_forces: vec![crate::loads::PointForce {
-            pin: 0,
+            line: 0,
             height: 1.0,
             force: crate::loads::Table {
                 time: vec![0.0, 10.0],
@@ -705,9 +706,13 @@ fn large_plane_speed() {
         pins: pins.len(),
         damping_ratios: vec![0.01; basis.modes()],
         contacts,
-        // Neighbours released apart (along x), so that pairs collide.
-        initial_tip_displacements: (0..pins.len())
-            .map(|p| if p % 2 == 0 { 2e-4 } else { -2e-4 })
+        // Neighbours released apart (along x: lines 0..pins), so that pairs collide.
+        initial_tip_displacements: (0..2 * pins.len())
+            .map(|line| match line {
+                line if line >= pins.len() => 0.0,
+                line if line % 2 == 0 => 2e-4,
+                _ => -2e-4,
+            })
             .collect(),
         base_acceleration: Some(BaseAcceleration::HalfSine {
             amplitude: 30.0,

@@ -40,8 +40,8 @@ pub(super) struct State {
 
 impl State {
     /// At rest, or released from the static tip-load shape with the model's initial tip
-    /// deflections (along x in the plane: the x lines come first); contacts open and no
-    /// load yet.
+    /// deflections, one per line (in the plane the x lines, then the y lines); contacts
+    /// open and no load yet.
     pub fn new(layout: &Layout<'_>) -> Self {
         let (model, row, lines) = (layout.model, layout.row, layout.lines);
         let mut q = vec![0.0; lines * row];

@@ -228,7 +228,7 @@ impl<'m> Integrator<'m> {
         let t = n as f64 * dt;
         for (point, shape) in layout.model.point_forces.iter().zip(&layout.point_force_shapes) {
             let value = point.force.at(t);
-            axpy(simd, value, shape, &mut state.force[point.pin * row..][..row]);
+            axpy(simd, value, shape, &mut state.force[point.line * row..][..row]);
         }
         let deflections = S::as_mut_simd_f64s(&mut state.level_deflections).0;
         let shapes = &layout.grouped_level_shapes;
@@ -468,7 +468,7 @@ impl<'m> Integrator<'m> {
             }
         };
         for (point, shape) in layout.model.point_forces.iter().zip(&layout.point_force_shapes) {
-            let velocity = kernels::dot(simd, shape, &state.v[point.pin * layout.row..][..layout.row]);
+            let velocity = kernels::dot(simd, shape, &state.v[point.line * layout.row..][..layout.row]);
             external += point.force.at(t) * velocity;
         }
         if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {

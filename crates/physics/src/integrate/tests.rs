@@ -197,7 +197,7 @@ fn critical_step_matches_brute_force_divergence() {
     model.contacts = vec![tip_wall(1e6, 0.0, 0.0)];
     // Push toward the wall (negative deflection) so the contact stays closed.
     model.point_forces = vec![PointForce {
-        pin: 0,
+        line: 0,
         height: 1.0,
         force: Table {
             time: vec![0.0, 10.0],
@@ -323,7 +323,7 @@ fn this_cpus_simd_level_and_the_scalar_fallback_agree() {
             });
         }
         model.point_forces.push(PointForce {
-            pin: 1,
+            line: 1,
             height: 0.9,
             force: Table {
                 time: vec![0.0, 0.005, 1.0],

@@ -92,6 +92,7 @@ pub const EXAMPLES: &[Example] = &[
     example!("bundle-earthquake.json", Some("bundle-dynamics")),
     example!("sdnl104c.json", Some("bundle-dynamics")),
     example!("hex217.json", Some("hex-bundle-dynamics")),
+    example!("hex7-loads.json", Some("hex-bundle-dynamics")),
     example!("sweep-calibration.json", None),
     example!("sweep-gaps.json", None),
     example!("sweep-static-correction.json", None),
