@@ -155,8 +155,9 @@ fn the_physics_crate_depends_on_numerics_only_and_does_no_io() {
             dependencies.insert(line.split(['=', ' ', '.']).next().unwrap_or_default().to_owned());
         }
     }
-    // utoipa: optional (feature `schema`), the report types' OpenAPI schemas.
-    let allowed: BTreeSet<String> = ["faer", "rustfft", "pulp", "serde", "thiserror", "utoipa"]
+    // utoipa: optional (feature `schema`), the report types' OpenAPI schemas. rayon:
+    // fork-join of a step shared between threads, on the caller's pool (no IO).
+    let allowed: BTreeSet<String> = ["faer", "rustfft", "pulp", "rayon", "serde", "thiserror", "utoipa"]
         .into_iter()
         .map(String::from)
         .collect();

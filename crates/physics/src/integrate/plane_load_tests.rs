@@ -61,6 +61,7 @@ fn settings(dt: f64, duration: f64) -> Settings {
         output_heights: vec![1.0, 0.7],
         recorded_contacts: None,
         impacts: Default::default(),
+        threads: 1,
     }
 }
 

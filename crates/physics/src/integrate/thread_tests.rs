@@ -61,18 +61,22 @@ fn bundle(basis: &ModalBasis) -> Model<'_> {
         pins: pins.len(),
         damping_ratios: vec![0.01; basis.modes()],
         contacts,
-        initial_tip_displacements: (0..pins.len())
-            .map(|p| if p % 2 == 0 { 2e-4 } else { -2e-4 })
+        // Along x then along y (one value per line).
+        initial_tip_displacements: (0..2 * pins.len())
+            .map(|p| if p % 2 == 0 { 2e-4 } else { -1e-4 })
             .collect(),
         base_acceleration: shake(30.0, 0.004),
-        point_forces: vec![PointForce {
-            pin: 5,
-            height: 0.7,
-            force: Table {
-                time: vec![0.0, 0.002, 0.004],
-                values: vec![0.0, 3.0, 0.0],
-            },
-        }],
+        // On pin 5 along x and on pin 8 along y.
+        point_forces: [5, pins.len() + 8]
+            .map(|line| PointForce {
+                line,
+                height: 0.7,
+                force: Table {
+                    time: vec![0.0, 0.002, 0.004],
+                    values: vec![0.0, 3.0, 0.0],
+                },
+            })
+            .to_vec(),
         walls: Some(WallMotion::rigid(shake(-20.0, 0.003), shake(10.0, 0.005))),
         plane: Some(Plane {
             normals,
