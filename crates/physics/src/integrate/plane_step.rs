@@ -1,15 +1,15 @@
-//! The plane's step shared between threads ([`super::Settings::threads`]), and the same
-//! code on one thread: three parts of the step split, each so that every number is
-//! computed by the same operations in the same order whatever the split, so the results
-//! are the same, bit for bit, for every thread count.
+//! The plane's step shared between threads ([`super::Settings::threads`] > 1); on one
+//! thread the stepper runs its own inlined copy. Three parts of the step are split, each
+//! so that every number is computed by the same operations in the same order as on one
+//! thread, so the results are the same, bit for bit, for every thread count.
 //!
 //! 1. The level deflections ([`level_deflections`]): the groups of blocks of levels are
 //!    split; each deflection is its own dot product.
-//! 2. The closed contacts ([`ClosedPass`]): the list of closed lanes is cut into chunks
-//!    of [`CLOSED_CHUNK`], each with its own dissipation and wall-power sums, added in
-//!    chunk order; the chunks are split between threads, which write disjoint lanes. The
-//!    impacts a thread ends wait in a list and join the log in lane order.
-//! 3. The loads and the modal update ([`update_half`]): the x lines and the y lines.
+//! 2. The closed contacts ([`ClosedPass`]): the list of closed lanes is split into
+//!    chunks of [`CLOSED_CHUNK`]; threads write disjoint lanes, each lane's powers
+//!    included, which the stepper then sums in the order of the list, as on one thread.
+//!    The impacts a thread ends wait in a list and join the log in lane order.
+//! 3. The loads and the modal update ([`update_halves`]): the x lines and the y lines.
 //!    Each half adds its share of every closed contact's force (so each row receives
 //!    the same additions in the same order as on one thread), the walls' transport load,
 //!    then updates its modes.
@@ -102,6 +102,8 @@ pub(super) struct ClosedPass<'a, S: Simd> {
 /// What the pass writes per lane, for the lanes from `first` on.
 pub(super) struct LaneOutputs<'a> {
     pub first: usize,
+    /// Dissipation power (F − Kc δ) δ̇ and walls' power F n·ḋ_wall.
+    pub powers: &'a mut [[f64; 2]],
     pub forces: &'a mut [f64],
     pub statistics: &'a mut [ContactStatistics],
     pub peaks: &'a mut [f64],
@@ -113,6 +115,7 @@ impl<'a> LaneOutputs<'a> {
     /// The lanes before `lane`, and those from it on.
     fn split_at(self, lane: usize) -> (Self, Self) {
         let at = lane - self.first;
+        let (powers, powers_after) = self.powers.split_at_mut(at);
         let (forces, forces_after) = self.forces.split_at_mut(at);
         let (statistics, statistics_after) = self.statistics.split_at_mut(at);
         let (peaks, peaks_after) = self.peaks.split_at_mut(at);
@@ -121,6 +124,7 @@ impl<'a> LaneOutputs<'a> {
         (
             Self {
                 first: self.first,
+                powers,
                 forces,
                 statistics,
                 peaks,
@@ -129,6 +133,7 @@ impl<'a> LaneOutputs<'a> {
             },
             Self {
                 first: lane,
+                powers: powers_after,
                 forces: forces_after,
                 statistics: statistics_after,
                 peaks: peaks_after,
@@ -140,53 +145,47 @@ impl<'a> LaneOutputs<'a> {
 }
 
 impl<S: Simd> ClosedPass<'_, S> {
-    /// The closed lanes `closed` (ascending), in chunks of [`CLOSED_CHUNK`] whose
-    /// [dissipation power, walls' power] go to `partials` (one per chunk), shared by up
-    /// to `threads` threads; the impacts they end go to `log`, in lane order.
+    /// The closed lanes `closed` (ascending), split into chunks of [`CLOSED_CHUNK`]
+    /// shared by up to `threads` threads (each writes its own lanes); the impacts they
+    /// end go to `log`, in lane order.
     pub fn run(
         &self,
         closed: &[u32],
         mut out: LaneOutputs<'_>,
-        partials: &mut [[f64; 2]],
         log: &mut (impl ImpactSink + Send),
         threads: usize,
     ) {
-        if threads <= 1 || partials.len() <= 1 {
+        let chunks = closed.len().div_ceil(CLOSED_CHUNK);
+        if threads <= 1 || chunks <= 1 {
             self.simd.vectorize(
                 #[inline(always)]
-                || {
-                    for (chunk, partial) in closed.chunks(CLOSED_CHUNK).zip(partials.iter_mut()) {
-                        *partial = self.chunk(chunk, &mut out, log);
-                    }
-                },
+                || self.lanes(closed, &mut out, log),
             );
             return;
         }
-        let middle = partials.len() / 2;
-        let (closed_first, closed_second) = closed.split_at(middle * CLOSED_CHUNK);
+        let (closed_first, closed_second) = closed.split_at(chunks / 2 * CLOSED_CHUNK);
         let (out_first, out_second) = out.split_at(closed_second[0] as usize);
-        let (partials_first, partials_second) = partials.split_at_mut(middle);
         let mut later: Vec<Impact> = Vec::new();
         let shares = (threads / 2, threads - threads / 2);
         rayon::join(
-            || self.run(closed_first, out_first, partials_first, log, shares.0),
-            || self.run(closed_second, out_second, partials_second, &mut later, shares.1),
+            || self.run(closed_first, out_first, log, shares.0),
+            || self.run(closed_second, out_second, &mut later, shares.1),
         );
         for impact in later {
             log.push(impact);
         }
     }
 
-    /// One chunk: with the dashpot velocity of each body along x and y, rate_x = ψ·Δṽ_x
-    /// and rate_y = ψ·Δṽ_y, the penetration rate is δ̇ = n_x rate_x + n_y rate_y and the
+    /// The lanes `closed`, as `plane_contact_forces` in the stepper computes them: with
+    /// the dashpot velocity of each body along x and y, rate_x = ψ·Δṽ_x and
+    /// rate_y = ψ·Δṽ_y, the penetration rate is δ̇ = n_x rate_x + n_y rate_y and the
     /// sliding velocity v_t = −n_y rate_x + n_x rate_y (tangent t = (−n_y, n_x));
-    /// F = max(0, Kc δ + cc δ̇), and the wear work gains F |v_t| Δt. Returns the chunk's
-    /// dissipation power Σ (F − Kc δ) δ̇ and walls' power Σ F n·ḋ_wall.
+    /// F = max(0, Kc δ + cc δ̇), and the wear work gains F |v_t| Δt; each lane's
+    /// dissipation power (F − Kc δ) δ̇ and walls' power F n·ḋ_wall are stored.
     #[inline(always)]
-    fn chunk(&self, closed: &[u32], out: &mut LaneOutputs<'_>, log: &mut impl ImpactSink) -> [f64; 2] {
+    fn lanes(&self, closed: &[u32], out: &mut LaneOutputs<'_>, log: &mut impl ImpactSink) {
         let (simd, n, lookahead) = (self.simd, self.vectors, self.lookahead);
         let (v, a, shapes) = (self.v, self.a, self.shapes);
-        let (mut dissipation_power, mut wall_power) = (0.0, 0.0);
         let first = out.first;
         for &j in closed {
             let j = j as usize;
@@ -210,8 +209,7 @@ impl<S: Simd> ClosedPass<'_, S> {
             let k = j - first;
             out.forces[k] = force;
             let dissipation = (force - contact.stiffness * penetration) * rate;
-            dissipation_power += dissipation;
-            wall_power += force * wall_rate;
+            out.powers[k] = [dissipation, force * wall_rate];
             if self.record {
                 if force > out.peaks[k] {
                     out.peaks[k] = force;
@@ -228,7 +226,6 @@ impl<S: Simd> ClosedPass<'_, S> {
                 out.wear[k] += force * sliding.abs() * self.at.2;
             }
         }
-        [dissipation_power, wall_power]
     }
 }
 

@@ -30,10 +30,10 @@ pub(super) struct State {
     /// and the groups holding them.
     pub closed: Vec<u32>,
     pub closed_groups: Vec<u64>,
-    /// Lanes in `closed` this step (the plane's), and per chunk of them their
-    /// dissipation and walls' powers ([`super::plane_step::ClosedPass`]).
+    /// Lanes in `closed` this step, and per lane its dissipation and walls' powers (the
+    /// plane's step shared between threads, [`super::plane_step::ClosedPass`]).
     pub closed_count: usize,
-    pub partials: Vec<[f64; 2]>,
+    pub lane_powers: Vec<[f64; 2]>,
     /// The walls, when they have their own motion.
     pub wall: Option<WallState>,
 }
@@ -66,7 +66,7 @@ impl State {
             closed: vec![0; lanes],
             closed_groups: vec![0; groups.div_ceil(64)],
             closed_count: 0,
-            partials: vec![[0.0; 2]; lanes.div_ceil(super::plane_step::CLOSED_CHUNK)],
+            lane_powers: vec![[0.0; 2]; lanes],
             wall: layout.walls.as_ref().map(|walls| WallState::new(walls, model)),
         }
     }

@@ -44,7 +44,7 @@ use super::kernels::{
     penetration_rate, penetrations, plane_penetrations, row_axpy,
 };
 use super::layout::{ContactModel, Layout, PlaneContacts};
-use super::plane_step::{self, CLOSED_CHUNK, ClosedPass, Half, LaneOutputs, Loads};
+use super::plane_step::{self, ClosedPass, Half, LaneOutputs, Loads};
 use super::recorder::{Powers, Recorder, record_closed_contact};
 use super::state::State;
 use super::walls::{WallLayout, WallState};
@@ -132,7 +132,7 @@ impl<const PLANE: bool> pulp::WithSimd for StepOp<'_, '_, PLANE> {
         match self.operation {
             Operation::Initial => {
                 integrator.contact_forces_and_statistics::<S, PLANE>(simd, 0, false, vectors);
-                if PLANE {
+                if PLANE && integrator.threads > 1 {
                     // The contact loads at t = 0 (the walls' transport load is added by
                     // the caller).
                     let (halves, loads) =
@@ -232,7 +232,7 @@ impl<'m> Integrator<'m> {
         }
         let deflections = S::as_mut_simd_f64s(&mut state.level_deflections).0;
         let shapes = &layout.grouped_level_shapes;
-        if PLANE {
+        if PLANE && threads > 1 {
             plane_step::level_deflections(
                 simd,
                 shapes,
@@ -263,6 +263,17 @@ impl<'m> Integrator<'m> {
                 gaps,
                 contact_state,
             );
+            if threads > 1 {
+                return shared_plane_contact_forces(
+                    simd,
+                    (layout, plane),
+                    state,
+                    recorder,
+                    count,
+                    (n, record),
+                    (vectors, threads),
+                );
+            }
             return plane_contact_forces(
                 simd,
                 (layout, plane),
@@ -270,7 +281,7 @@ impl<'m> Integrator<'m> {
                 recorder,
                 count,
                 (n, record),
-                (vectors, threads),
+                vectors,
             );
         }
         let count = penetrations(simd, &layout.contacts, deflections, gaps, contact_state);
@@ -436,13 +447,15 @@ impl<'m> Integrator<'m> {
             factor: &S::as_simd_f64s(&layout.implicit_damping_factor).0[..n],
             participation: &S::as_simd_f64s(&layout.participation).0[..n],
         };
+        // A step shared between threads adds the closed contacts' loads with the update.
+        let shared = PLANE && *threads > 1;
+        // The transport's inertial load −Γᴾ r joins the contact and point loads.
+        if let (false, Some(walls), Some(wall)) = (shared, &layout.walls, &state.wall) {
+            wall.add_transport_loads(walls, &mut state.force, (layout.row, layout.model.pins));
+        }
         // The base excitation's power −a(t) Σ Γ v, per direction in the plane.
         let (modal_damping, mut external) = match (PLANE, &layout.contact_model) {
             (false, _) | (true, ContactModel::Row) => {
-                // The transport's inertial load −Γᴾ r joins the contact and point loads.
-                if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
-                    wall.add_transport_loads(walls, &mut state.force, (layout.row, layout.model.pins));
-                }
                 let (q, v, a, f) = (
                     S::as_simd_f64s(&state.q).0,
                     S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
@@ -453,9 +466,30 @@ impl<'m> Integrator<'m> {
                 let sums = modal_update(simd, &coefficients, base, second_half, (q, v, a, f));
                 (sums.damping_power, -base * sums.participation_velocity)
             }
+            (true, ContactModel::Plane(_)) if !shared => {
+                let (base_x, base_y) = base_accelerations(layout.model, t);
+                let (q, v, a, f) = (
+                    S::as_simd_f64s(&state.q).0,
+                    S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
+                    S::as_mut_simd_f64s(&mut state.a[..pins_state]).0,
+                    S::as_mut_simd_f64s(&mut state.force).0,
+                );
+                let x_lines = q.len() / 2;
+                let (q_x, q_y) = q.split_at(x_lines);
+                let (v_x, v_y) = v.split_at_mut(x_lines);
+                let (a_x, a_y) = a.split_at_mut(x_lines);
+                let (f_x, f_y) = f.split_at_mut(x_lines);
+                let x = modal_update(simd, &coefficients, base_x, second_half, (q_x, v_x, a_x, f_x));
+                let y = modal_update(simd, &coefficients, base_y, second_half, (q_y, v_y, a_y, f_y));
+                (
+                    x.damping_power + y.damping_power,
+                    -base_x * x.participation_velocity - base_y * y.participation_velocity,
+                )
+            }
             (true, ContactModel::Plane(_)) => {
                 // The contact loads, the transport's inertial load −Γᴾ r, then the
-                // update, of the x lines and of the y lines.
+                // update, of the x lines and of the y lines: the additions each row
+                // receives, in the order the step on one thread makes them.
                 let bases = base_accelerations(layout.model, t);
                 let (halves, loads) = plane_split(layout, state, bases, true);
                 let update = Some((&coefficients, second_half));
@@ -598,12 +632,106 @@ fn base_accelerations(model: &Model<'_>, t: f64) -> (f64, f64) {
     (at(model.base_acceleration.as_ref()), at(y))
 }
 
-/// The closed contacts of the plane, after [`plane_penetrations`]: their forces and
-/// statistics ([`ClosedPass`]), shared by up to `threads` threads. Their loads join the
-/// rows in the modal update ([`plane_step::update_halves`]). Returns the contact
-/// dissipation power Σ (F − Kc δ) δ̇.
+/// The closed contacts of the plane, after [`plane_penetrations`]: with the dashpot
+/// velocity of each body along x and y, rate_x = ψ·Δṽ_x and rate_y = ψ·Δṽ_y, the
+/// penetration rate is δ̇ = n_x rate_x + n_y rate_y and the sliding velocity
+/// v_t = −n_y rate_x + n_x rate_y (tangent t = (−n_y, n_x)); F = max(0, Kc δ + cc δ̇)
+/// pushes the left body by −F n and the right one by +F n, and the wear work gains
+/// F |v_t| Δt. Returns the contact dissipation power Σ (F − Kc δ) δ̇.
 #[inline(always)]
 fn plane_contact_forces<S: Simd>(
+    simd: S,
+    (layout, plane): (&Layout<'_>, &PlaneContacts),
+    state: &mut State,
+    recorder: &mut Recorder,
+    count: usize,
+    (step, record): (u64, bool),
+    vectors: usize,
+) -> f64 {
+    let (mut dissipation_power, mut wall_power) = (0.0, 0.0);
+    let walls = layout.walls.as_ref().zip(state.wall.as_ref());
+    let (lookahead, wall, n, dt) = (layout.dashpot_lookahead, layout.wall_row, vectors, layout.dt);
+    let shapes = S::as_simd_f64s(&layout.level_shapes).0;
+    let (v, a) = (S::as_simd_f64s(&state.v).0, S::as_simd_f64s(&state.a).0);
+    let loads = S::as_mut_simd_f64s(&mut state.force).0;
+    let lane_contacts = layout.lane_contacts.as_slice();
+    let lanes = lane_contacts.len();
+    let plane_lanes = &plane.lanes[..lanes];
+    let (now, before) = (&state.penetration[..lanes], &state.previous_penetration[..lanes]);
+    let (forces, statistics) = (
+        &mut state.contact_force[..lanes],
+        &mut recorder.statistics[..lanes],
+    );
+    let (peaks, wear) = (&mut recorder.force_peak[..lanes], &mut recorder.wear[..lanes]);
+    let impacts = &mut recorder.impacts[..lanes];
+    let (clock, log) = (&recorder.impact_clock, &mut recorder.impact_log);
+    let at = (step, recorder.impact_block, dt);
+    let closed = &state.closed[..count];
+    for &j in closed {
+        let j = j as usize;
+        let (contact, lane) = (lane_contacts[j], plane_lanes[j]);
+        let (penetration, previous) = (now[j], before[j]);
+        let rows = |offset: usize| (&v[offset..], &a[offset..]);
+        let shape = &shapes[contact.shape..][..n];
+        let mut rate_x = penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead);
+        let mut rate_y = penetration_rate(simd, shape, rows(lane.left_y), rows(lane.right_y), lookahead);
+        let [normal_x, normal_y] = lane.normal;
+        let mut wall_rate = 0.0;
+        if let Some((layout, wall)) = walls {
+            let [x, y] = wall.velocity_of(layout, j);
+            (rate_x, rate_y) = (rate_x + x, rate_y + y);
+            wall_rate = normal_x * x + normal_y * y;
+        }
+        let rate = normal_x * rate_x + normal_y * rate_y;
+        let sliding = normal_x * rate_y - normal_y * rate_x;
+        let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
+        forces[j] = force;
+        let dissipation = (force - contact.stiffness * penetration) * rate;
+        dissipation_power += dissipation;
+        wall_power += force * wall_rate;
+        if record {
+            if force > peaks[j] {
+                peaks[j] = force;
+            }
+            if contact.active {
+                record_closed_contact(
+                    (&mut statistics[j], &mut impacts[j]),
+                    (clock, &mut *log),
+                    at,
+                    (penetration, previous),
+                    (force, dissipation),
+                );
+            }
+            wear[j] += force * sliding.abs() * dt;
+        }
+    }
+    for &j in closed {
+        let j = j as usize;
+        let (contact, lane, force) = (lane_contacts[j], plane_lanes[j], forces[j]);
+        if force != 0.0 {
+            let shape = &shapes[contact.shape..][..n];
+            let [normal_x, normal_y] = lane.normal;
+            if contact.left != wall {
+                row_axpy(simd, -force * normal_x, shape, &mut loads[contact.left..]);
+                row_axpy(simd, -force * normal_y, shape, &mut loads[lane.left_y..]);
+            }
+            if contact.right != wall {
+                row_axpy(simd, force * normal_x, shape, &mut loads[contact.right..]);
+                row_axpy(simd, force * normal_y, shape, &mut loads[lane.right_y..]);
+            }
+        }
+    }
+    if let Some(wall) = &mut state.wall {
+        wall.power = wall_power;
+    }
+    dissipation_power
+}
+
+/// [`plane_contact_forces`] shared by `threads` threads ([`ClosedPass`]), but for the
+/// loads, which join the rows in the modal update ([`plane_step::update_halves`]).
+/// Every lane's powers are stored, then summed in the order of the closed lanes, as
+/// [`plane_contact_forces`] sums them.
+fn shared_plane_contact_forces<S: Simd>(
     simd: S,
     (layout, plane): (&Layout<'_>, &PlaneContacts),
     state: &mut State,
@@ -631,23 +759,19 @@ fn plane_contact_forces<S: Simd>(
     };
     let out = LaneOutputs {
         first: 0,
+        powers: &mut state.lane_powers[..lanes],
         forces: &mut state.contact_force[..lanes],
         statistics: &mut recorder.statistics[..lanes],
         peaks: &mut recorder.force_peak[..lanes],
         wear: &mut recorder.wear[..lanes],
         impacts: &mut recorder.impacts[..lanes],
     };
-    let partials = &mut state.partials[..count.div_ceil(CLOSED_CHUNK)];
-    pass.run(
-        &state.closed[..count],
-        out,
-        partials,
-        &mut recorder.impact_log,
-        threads,
-    );
+    let closed = &state.closed[..count];
+    pass.run(closed, out, &mut recorder.impact_log, threads);
     state.closed_count = count;
     let (mut dissipation_power, mut wall_power) = (0.0, 0.0);
-    for [dissipation, wall] in partials.iter() {
+    for &j in closed {
+        let [dissipation, wall] = state.lane_powers[j as usize];
         dissipation_power += dissipation;
         wall_power += wall;
     }
