@@ -266,30 +266,9 @@ pub struct ImpactLog {
     kept_peaks: usize,
 }
 
-impl ImpactLog {
-    /// For `contacts` contacts, as `counting` says (rows kept, histogram classes).
-    pub fn new(contacts: usize, counting: &ImpactCounting) -> Self {
-        Self {
-            max_rows: counting.max_rows,
-            classes: counting.classes.max(1),
-            rows: Vec::new(),
-            untabulated: 0,
-            peaks: vec![Vec::new(); contacts],
-            kept_peaks: 0,
-        }
-    }
-
-    /// The impacts another thread ended during a step, in their order.
-    pub fn extend(&mut self, impacts: Vec<Impact>) {
-        for impact in impacts {
-            self.push(impact);
-        }
-    }
-}
-
 /// Where an ended impact goes: the run's [`ImpactLog`], or a list a thread keeps for it
-/// ([`ImpactLog::extend`] then takes them in order, so the log is the same whichever
-/// thread ended them).
+/// (pushed to the log afterwards, in order, so the log is the same whichever thread
+/// ended them).
 pub trait ImpactSink {
     fn push(&mut self, impact: Impact);
 }
@@ -315,6 +294,18 @@ impl ImpactSink for ImpactLog {
 }
 
 impl ImpactLog {
+    /// For `contacts` contacts, as `counting` says (rows kept, histogram classes).
+    pub fn new(contacts: usize, counting: &ImpactCounting) -> Self {
+        Self {
+            max_rows: counting.max_rows,
+            classes: counting.classes.max(1),
+            rows: Vec::new(),
+            untabulated: 0,
+            peaks: vec![Vec::new(); contacts],
+            kept_peaks: 0,
+        }
+    }
+
     /// The table sorted by start time (then contact), the number of impacts left out,
     /// and the peak-force histograms in `classes` equal classes from 0 to the largest
     /// peak of the run.

@@ -11,12 +11,12 @@
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
+use super::plane_tests::{assert_close, run};
 use super::*;
 use crate::beam::tests::default_tube;
 use crate::contact::{Body, Contact};
 use crate::loads::{PointForce, Table};
 use crate::modal::ModalBasis;
-use crate::stability::Scheme;
 
 fn basis() -> ModalBasis {
     ModalBasis::compute(&default_tube(20), 6).expect("valid beam")
@@ -50,32 +50,12 @@ fn lone_pin(basis: &ModalBasis, plane: bool) -> Model<'_> {
     }
 }
 
+/// The plane tests' settings, with the loads' height among the outputs.
 fn settings(dt: f64, duration: f64) -> Settings {
     Settings {
-        scheme: Scheme::CentralDifference,
-        time_step: TimeStep::Fixed(dt),
-        tolerance: DEFAULT_TOLERANCE,
-        check: Check::None,
-        duration,
-        output_interval: Some(1e-4),
         output_heights: vec![1.0, 0.7],
-        recorded_contacts: None,
-        impacts: Default::default(),
-        threads: 1,
+        ..super::plane_tests::settings(dt, duration)
     }
-}
-
-fn run(model: &Model<'_>, settings: &Settings) -> Simulation {
-    simulate(model, settings, &mut |_| ControlFlow::Continue(())).expect("run succeeds")
-}
-
-/// |a − b| ≤ tolerance × scale, with a message that prints both.
-#[track_caller]
-fn assert_close(what: &str, measured: f64, expected: f64, tolerance: f64, scale: f64) {
-    assert!(
-        (measured - expected).abs() <= tolerance * scale,
-        "{what}: measured {measured:e}, expected {expected:e} (tolerance {tolerance:e} × {scale:e})"
-    );
 }
 
 /// The plane's two lines at every output height and sample are (cos θ u, sin θ u), u the

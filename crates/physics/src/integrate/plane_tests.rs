@@ -76,7 +76,7 @@ fn turned_row<'a>(basis: &'a ModalBasis, amplitude: f64, theta: f64) -> Model<'a
     model
 }
 
-fn settings(dt: f64, duration: f64) -> Settings {
+pub(super) fn settings(dt: f64, duration: f64) -> Settings {
     Settings {
         scheme: Scheme::CentralDifference,
         time_step: TimeStep::Fixed(dt),
@@ -91,13 +91,13 @@ fn settings(dt: f64, duration: f64) -> Settings {
     }
 }
 
-fn run(model: &Model<'_>, settings: &Settings) -> Simulation {
+pub(super) fn run(model: &Model<'_>, settings: &Settings) -> Simulation {
     simulate(model, settings, &mut |_| ControlFlow::Continue(())).expect("run succeeds")
 }
 
 /// |a − b| ≤ tolerance × scale, with a message that prints both.
 #[track_caller]
-fn assert_close(what: &str, measured: f64, expected: f64, tolerance: f64, scale: f64) {
+pub(super) fn assert_close(what: &str, measured: f64, expected: f64, tolerance: f64, scale: f64) {
     assert!(
         (measured - expected).abs() <= tolerance * scale,
         "{what}: measured {measured:e}, expected {expected:e} (tolerance {tolerance:e} × {scale:e})"
