@@ -1,9 +1,9 @@
 //! What a results document says about its own accuracy, put in the words users see
 //! wherever they look: the job's status message, the CLI's warning, a sweep's counts.
 //!
-//! Every process writes `quality.verdict` (`good`, `doubtful`, `poor`) and
+//! Every process writes `quality.verdict` (`good`, `unchecked`, `doubtful`, `poor`) and
 //! `quality.reasons` (sentences) into its results document. A `good` result needs no
-//! note; a `doubtful` or `poor` one carries its verdict and reasons everywhere, while
+//! note; any other carries its verdict and reasons everywhere, while
 //! the job itself stays `successful` (the numbers exist, they are just not to be trusted
 //! blindly). A leaf module: the worker, the reuse of results, the CLI and the sweep
 //! aggregates all read the verdict the same way.
@@ -23,9 +23,9 @@ pub fn verdict_of(document: &Value) -> Option<Verdict> {
     parse_verdict(document.pointer("/quality/verdict")?.as_str()?)
 }
 
-/// `good`, `doubtful` or `poor` as a [`Verdict`].
+/// `good`, `unchecked`, `doubtful` or `poor` as a [`Verdict`].
 pub fn parse_verdict(name: &str) -> Option<Verdict> {
-    [Verdict::Good, Verdict::Doubtful, Verdict::Poor]
+    Verdict::ALL
         .into_iter()
         .find(|verdict| verdict.as_str() == name)
 }
@@ -118,7 +118,7 @@ mod tests {
 
     #[test]
     fn verdict_names_parse_back_and_unknown_ones_do_not() {
-        for verdict in [Verdict::Good, Verdict::Doubtful, Verdict::Poor] {
+        for verdict in Verdict::ALL {
             assert_eq!(parse_verdict(verdict.as_str()), Some(verdict));
         }
         assert_eq!(parse_verdict("excellent"), None);

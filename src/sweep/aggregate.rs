@@ -40,7 +40,7 @@ pub const COST_AXES: [(&str, bool); 3] = [
     ("/beam/elements", false),
 ];
 
-/// Metric column of a run's quality verdict (`good`, `doubtful`, `poor`).
+/// Metric column of a run's quality verdict (`good`, `unchecked`, `doubtful`, `poor`).
 pub const VERDICT: &str = "quality.verdict";
 
 /// The aggregates of a sweep's results (`aggregates` of its results document); which
@@ -64,6 +64,9 @@ pub struct VerdictCounts {
     /// Successful runs with a verdict.
     pub runs: usize,
     pub good: usize,
+    /// Within the tolerance by every measure taken, the step's error not measured
+    /// (`solver.check: "none"`, the usual setting of a sweep).
+    pub unchecked: usize,
     pub doubtful: usize,
     pub poor: usize,
 }
@@ -73,6 +76,7 @@ impl VerdictCounts {
         self.runs += 1;
         match verdict {
             Verdict::Good => self.good += 1,
+            Verdict::Unchecked => self.unchecked += 1,
             Verdict::Doubtful => self.doubtful += 1,
             Verdict::Poor => self.poor += 1,
         }
@@ -388,25 +392,27 @@ mod tests {
                 record(2, "successful", 1e-4, Some("poor")),
                 record(3, "successful", 1e-4, Some("poor")),
                 record(4, "failed", 1e-4, None),
+                record(5, "successful", 1e-4, Some("unchecked")),
             ],
         );
         let counts = quality_counts(&table, &axes).unwrap();
-        let expected = |runs, good, doubtful, poor| VerdictCounts {
+        let expected = |runs, good, unchecked, doubtful, poor| VerdictCounts {
             runs,
             good,
+            unchecked,
             doubtful,
             poor,
         };
-        assert_eq!(counts.total, expected(4, 1, 1, 2));
+        assert_eq!(counts.total, expected(5, 1, 1, 1, 2));
         let values = &counts.by_axis[0].values;
         assert_eq!(values.len(), 2, "{values:?}");
         assert_eq!(
             (values[0].value.clone(), values[0].counts.clone()),
-            (json!(1e-5), expected(2, 1, 1, 0))
+            (json!(1e-5), expected(2, 1, 0, 1, 0))
         );
         assert_eq!(
             (values[1].value.clone(), values[1].counts.clone()),
-            (json!(1e-4), expected(2, 0, 0, 2))
+            (json!(1e-4), expected(3, 0, 1, 0, 2))
         );
         let document = serde_json::to_value(&counts).unwrap();
         assert_eq!(document["poor"], 2);

@@ -13,6 +13,7 @@ pub mod accelerogram;
 pub mod beam;
 pub mod bundle;
 pub mod contact;
+pub mod discretisation;
 /// Wire-wrapped hexagonal bundle geometry: lattice, wrapper, wire-helix contacts, gap states.
 pub mod hex;
 /// Impact counting, per-impact tables and statistics (code_aster `POST_DYNA_MODA_T`).

@@ -44,6 +44,8 @@ pub struct StaticCorrection {
 /// Truncated, mass-normalized modal basis of one beam.
 #[derive(Debug, Clone)]
 pub struct ModalBasis {
+    /// The beam as described, mesh included (the probes refine it).
+    spec: BeamSpec,
     model: BeamModel,
     /// Number m of eigenmodes; the basis holds them first, then the pseudo-modes.
     eigenmodes: usize,
@@ -179,6 +181,7 @@ impl ModalBasis {
             .collect();
 
         let mut basis = Self {
+            spec: spec.clone(),
             model,
             eigenmodes: modes,
             correction,
@@ -218,6 +221,7 @@ impl ModalBasis {
     pub fn without_static_correction(&self) -> Self {
         let (m, dofs) = (self.eigenmodes, self.model.dof_count());
         let mut basis = Self {
+            spec: self.spec.clone(),
             model: self.model.clone(),
             eigenmodes: m,
             correction: None,
@@ -255,6 +259,11 @@ impl ModalBasis {
     /// Beam length L (m).
     pub fn length(&self) -> f64 {
         self.model.length
+    }
+
+    /// The beam the basis was computed for, its mesh included.
+    pub fn spec(&self) -> &BeamSpec {
+        &self.spec
     }
 
     /// The finite-element model the basis was computed on.

@@ -186,8 +186,8 @@ pub struct SweepResults {
     /// min, max, q05, q50, q95 of every numeric column but seeds over the successful runs) or
     /// `calibration` (grids with `comparison.f_err`: validity map, cheapest valid
     /// `/solver/time_step`, `/beam/modes`, `/beam/elements`); and `quality` when the
-    /// runs carry a verdict: `{"runs", "good", "doubtful", "poor", "by_axis": [{"axis",
-    /// "values": [{"value", "runs", "good", "doubtful", "poor"}]}]}`, counts of the
+    /// runs carry a verdict: `{"runs", "good", "unchecked", "doubtful", "poor", "by_axis": [{"axis",
+    /// "values": [{"value", "runs", "good", "unchecked", "doubtful", "poor"}]}]}`, counts of the
     /// successful runs in total and per value of each list axis.
     #[schema(value_type = Object)]
     pub aggregates: serde_json::Value,

@@ -108,7 +108,13 @@ impl<'a> Plan<'a> {
                 ))
             }
         };
-        let quality = quality::assess(&simulation, step, settings.tolerance, step_halving);
+        let basis = crate::discretisation::assess(model).map_err(|e| {
+            SimulationError::InvalidModel(vec![InputIssue::new(
+                "modes",
+                format!("the impact probes of the basis and the mesh failed: {e}"),
+            )])
+        })?;
+        let quality = quality::assess(&simulation, step, settings.tolerance, step_halving, &basis);
         Ok(Assessed { simulation, quality })
     }
 

@@ -27,6 +27,7 @@
 
 use super::Simulation;
 use super::step_size::{StepSize, scheme_order};
+use crate::discretisation::{BasisErrors, ProbeError};
 use crate::stability::Scheme;
 
 /// Peaks are held to this multiple of the tolerance (1 % at the default 10⁻³).
@@ -61,6 +62,9 @@ pub enum Verdict {
     Doubtful,
     /// Do not use the numbers: some measure is far outside the tolerance.
     Poor,
+    /// Within the tolerance by every measure taken, but some discretisation error was
+    /// not measured (no step-halving check): not proven good.
+    Unchecked,
 }
 
 impl Verdict {
@@ -69,8 +73,12 @@ impl Verdict {
             Verdict::Good => "good",
             Verdict::Doubtful => "doubtful",
             Verdict::Poor => "poor",
+            Verdict::Unchecked => "unchecked",
         }
     }
+
+    /// Every verdict, from the best to the worst.
+    pub const ALL: [Verdict; 4] = [Verdict::Good, Verdict::Unchecked, Verdict::Doubtful, Verdict::Poor];
 }
 
 /// The step-halving check: the whole run repeated at half the step.
@@ -121,10 +129,22 @@ pub struct Quality {
     pub time_step_limited_by: super::step_size::StepLimit,
     /// The run repeated at Δt/2 (`solver.check: "step_halving"`); null with `"none"`.
     pub step_halving: Option<StepHalving>,
-    /// `good`: within the tolerance by every measure; `doubtful`: some measure outside it,
-    /// none by far; `poor`: do not use the numbers (energy residual > 10 × tolerance, an
+    /// The error of the peak contact force due to the modal basis (truncation, and the
+    /// static correction when there is one): the impact probe on the basis against the
+    /// complete basis of the same mesh, at the contact where it differs most.
+    pub modal_truncation: ProbeError,
+    /// The error of the peak contact force due to the element mesh: the impact probe on
+    /// the complete basis of the mesh against a mesh twice as fine.
+    pub mesh: ProbeError,
+    /// `good`: every discretisation error (step, modes, mesh) measured and within the
+    /// tolerance; `unchecked`: within it by every measure taken, but the step's error was
+    /// not measured (`solver.check: "none"`); `doubtful`: some measure outside it, none
+    /// by far; `poor`: do not use the numbers (energy residual > 10 × tolerance, an
     /// estimated peak error > 20 × tolerance, or fewer than 8 steps per contact period).
-    #[cfg_attr(feature = "schema", schema(value_type = String, pattern = "^(good|doubtful|poor)$"))]
+    #[cfg_attr(
+        feature = "schema",
+        schema(value_type = String, pattern = "^(good|unchecked|doubtful|poor)$")
+    )]
     pub verdict: Verdict,
     /// One sentence per measure outside the tolerance (empty when `good`).
     pub reasons: Vec<String>,
@@ -204,6 +224,7 @@ pub(super) fn assess(
     step: &StepSize,
     tolerance: f64,
     step_halving: Option<StepHalving>,
+    basis: &BasisErrors,
 ) -> Quality {
     let energy_residual = simulation.energy.relative_residual();
     let steps_per_period = step.steps_per_fastest_period();
@@ -269,12 +290,41 @@ pub(super) fn assess(
     if !reasons.is_empty() && step.limited_by == super::step_size::StepLimit::Given {
         reasons.push("use time_step \"auto\" (it picks the step for the tolerance)".to_owned());
     }
+    for (what, advice, probe) in [
+        (
+            "modal basis",
+            "add modes (or keep the static correction)",
+            &basis.modal_truncation,
+        ),
+        ("element mesh", "add elements", &basis.mesh),
+    ] {
+        let error = probe.estimated_peak_force_error;
+        if error > peak_tolerance {
+            poor |= error > POOR_FACTOR * peak_tolerance;
+            let at = probe
+                .height
+                .map(|z| format!(" at the contact at {} m", crate::number(z)))
+                .unwrap_or_default();
+            reasons.push(format!(
+                "the {what} puts the peak contact force off by an estimated {}{at} (tolerance {}): {advice}",
+                percent(error),
+                percent(peak_tolerance)
+            ));
+        }
+    }
     let verdict = if poor {
         Verdict::Poor
-    } else if reasons.is_empty() {
-        Verdict::Good
-    } else {
+    } else if !reasons.is_empty() {
         Verdict::Doubtful
+    } else if step_halving.is_none() {
+        reasons.push(
+            "the time step's error of the peaks was not measured (solver.check \"none\"): \
+             run with \"step_halving\" to prove the result"
+                .to_owned(),
+        );
+        Verdict::Unchecked
+    } else {
+        Verdict::Good
     };
     Quality {
         energy_residual,
@@ -283,6 +333,8 @@ pub(super) fn assess(
         tolerance,
         time_step_limited_by: step.limited_by,
         step_halving,
+        modal_truncation: basis.modal_truncation,
+        mesh: basis.mesh,
         verdict,
         reasons,
     }

@@ -90,6 +90,7 @@ pub const EXAMPLES: &[Example] = &[
     example!("bundle-minimal-table.json", Some("bundle-dynamics")),
     example!("bundle-haversine.json", Some("bundle-dynamics")),
     example!("bundle-earthquake.json", Some("bundle-dynamics")),
+    example!("bundle-row12-shock.json", Some("bundle-dynamics")),
     example!("sdnl104c.json", Some("bundle-dynamics")),
     example!("hex217.json", Some("hex-bundle-dynamics")),
     example!("hex7-loads.json", Some("hex-bundle-dynamics")),

@@ -141,7 +141,8 @@ function downloadsCard(id, results) {
 
 /** What each verdict tells the user. */
 const VERDICT_MEANING = {
-  good: 'within the tolerance by every measure',
+  good: 'every discretisation error (step, modes, mesh) measured and within the tolerance',
+  unchecked: 'within the tolerance by every measure taken, but the time step\'s error was not measured: not proven',
   doubtful: 'outside the tolerance by some measure: check before relying on these numbers',
   poor: 'do not use these numbers: some measure is far outside the tolerance',
 };
@@ -173,7 +174,16 @@ function qualityCard(results) {
         ? `peak force ${percent(check.peak_force_change)}, peak displacement ${percent(check.peak_displacement_change)}, ` +
           `impacts ${percent(check.impact_count_change)} (cost ×${fmt(check.relative_cost, 3)})`
         : 'not run (solver.check "none")'],
+      ['modal basis', probeText(q.modal_truncation)],
+      ['element mesh', probeText(q.mesh)],
     ], {'data-quality-measures': ''}));
+}
+
+/** An impact probe's estimate: the peak force error and the contact where it is largest. */
+function probeText(probe) {
+  if (!probe) return '–';
+  const at = Number.isFinite(probe.height) ? ` (worst at the contact at ${fmt(probe.height, 4)} m)` : '';
+  return `estimated peak force error ${fmt(100 * probe.estimated_peak_force_error, 3)} %${at}`;
 }
 
 /**

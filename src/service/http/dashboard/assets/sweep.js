@@ -109,10 +109,11 @@ function qualityCard(quality) {
   const counts = (c) => [
     h('td', {}, fmt(c.runs)),
     h('td', {}, c.good ? h('span', {class: 'badge good'}, `${c.good} good`) : '0'),
+    h('td', {}, c.unchecked ? h('span', {class: 'badge unchecked'}, `${c.unchecked} unchecked`) : '0'),
     h('td', {}, c.doubtful ? h('span', {class: 'badge doubtful'}, `${c.doubtful} doubtful`) : '0'),
     h('td', {'data-poor': c.poor}, c.poor ? h('span', {class: 'badge poor'}, `${c.poor} poor`) : '0'),
   ];
-  const head = h('thead', {}, h('tr', {}, ['axis', 'value', 'runs', 'good', 'doubtful', 'poor'].map((t) => h('th', {}, t))));
+  const head = h('thead', {}, h('tr', {}, ['axis', 'value', 'runs', 'good', 'unchecked', 'doubtful', 'poor'].map((t) => h('th', {}, t))));
   const rows = [h('tr', {'data-quality-total': ''}, h('th', {}, 'all runs'), h('td'), counts(quality))];
   for (const axis of quality.by_axis || []) {
     for (const entry of axis.values) {

@@ -1,0 +1,160 @@
+//! The impact probe against closed forms and convergence: a one-mode basis is a mass on
+//! a spring in series with the contact (peak k/λ, λ² = ω² + kψ²); the complete basis of
+//! a mesh is the probe's exact value for that mesh, so the basis error vanishes there;
+//! truncation makes the beam too stiff (peaks too high) and the error falls as modes
+//! are added, faster with the static correction; the mesh error falls with the mesh.
+
+use super::*;
+use crate::beam::{Section, Support};
+
+/// A fuel-pin-like tube, 1.5 m, 8.5/7.4 mm (the row).
+fn pin(elements: usize) -> BeamSpec {
+    BeamSpec {
+        length: 1.5,
+        young_modulus: 1.0e11,
+        density: 6550.0,
+        section: Section::Tube {
+            outer_diameter: 0.0085,
+            inner_diameter: 0.0074,
+        },
+        added_mass_per_length: 0.4,
+        elements,
+        foot: Support::Clamped,
+        top: Support::Free,
+    }
+}
+
+fn contact(height: f64, stiffness: f64) -> ProbeContact {
+    ProbeContact { height, stiffness }
+}
+
+/// One mode: q̈ + (ω² + kψ²) q = 0, q̇₀ = 1/ψ, δ = ψq = sin(λt)/λ: the peak force is k/λ
+/// at t = π/(2λ).
+#[test]
+fn one_mode_probe_is_a_spring_in_series_with_the_modal_mass() {
+    let spec = pin(20);
+    let basis = ModalBasis::compute(&spec, 1).unwrap();
+    for (height, k) in [(1.5, 3e6), (0.75, 1e5), (0.3, 1e7)] {
+        let psi = basis.deflection_at(height)[0];
+        let omega = basis.angular_frequencies()[0];
+        let expected = k / (omega * omega + k * psi * psi).sqrt();
+        let measured = first_impact_peak(&basis, contact(height, k)).unwrap();
+        assert!(
+            (measured - expected).abs() < 1e-9 * expected,
+            "z = {height}, k = {k}: peak {measured} N·s/m, expected k/λ = {expected}"
+        );
+    }
+}
+
+/// A height at the clamped foot does not move in the first mode: no probe there.
+#[test]
+fn a_contact_at_a_fixed_support_is_not_probed() {
+    let spec = pin(20);
+    let basis = ModalBasis::compute(&spec, 5).unwrap();
+    assert_eq!(first_impact_peak(&basis, contact(0.0, 3e6)), None);
+}
+
+/// On its own complete basis the probe has no truncation error, and truncated bases are
+/// too stiff: their peaks are above the complete basis's, by less as modes are added.
+#[test]
+fn truncated_bases_overestimate_the_peak_and_converge_to_the_complete_basis() {
+    let spec = pin(40);
+    let heights = [0.45, 0.9, 1.5];
+    let k = 6e6;
+    let complete = probe(&spec, &complete_basis(&spec).unwrap(), &heights.map(|z| contact(z, k))).unwrap();
+    for p in &complete {
+        assert!(p.basis_error < 1e-9, "complete basis at z = {}: error {}", p.contact.height, p.basis_error);
+    }
+    for &z in &heights {
+        let mut previous = f64::INFINITY;
+        for modes in [3, 6, 12, 24] {
+            let basis = ModalBasis::compute(&spec, modes).unwrap();
+            let p = probe(&spec, &basis, &[contact(z, k)]).unwrap()[0];
+            assert!(
+                p.basis_peak > p.mesh_peak * (1.0 - 1e-9),
+                "{modes} modes at z = {z}: truncated peak {} below the complete {}",
+                p.basis_peak,
+                p.mesh_peak
+            );
+            assert!(
+                p.basis_error < previous,
+                "{modes} modes at z = {z}: error {} did not fall (was {previous})",
+                p.basis_error
+            );
+            previous = p.basis_error;
+        }
+    }
+}
+
+/// The static correction restores the static flexibility at the contact: at the same
+/// number of modes its probe error is below the modes alone (not far below on a
+/// slender pin against a stiff contact: there the dropped modes' dynamics, which no
+/// static shape carries, dominate; docs/accuracy.md).
+#[test]
+fn the_static_correction_cuts_the_truncation_error() {
+    let spec = pin(40);
+    for (z, k) in [(1.5, 3e6), (0.9, 6e6), (0.45, 1e7)] {
+        let plain = ModalBasis::compute(&spec, 10).unwrap();
+        let corrected = ModalBasis::compute_with_static_correction(&spec, 10, &[z]).unwrap();
+        let e_plain = probe(&spec, &plain, &[contact(z, k)]).unwrap()[0].basis_error;
+        let e_corrected = probe(&spec, &corrected, &[contact(z, k)]).unwrap()[0].basis_error;
+        assert!(
+            e_corrected < 0.9 * e_plain,
+            "z = {z}, k = {k}: corrected error {e_corrected}, modes alone {e_plain}"
+        );
+    }
+}
+
+/// The mesh error falls as the mesh is refined, and once the mesh resolves the impact it
+/// falls faster than h² (cubic Hermite elements: eigenvalues converge as h⁴). Coarse
+/// meshes are not yet in that regime (measured: 36 %, 15 %, 0.6 % at 10, 20, 40
+/// elements).
+#[test]
+fn the_mesh_error_falls_with_the_element_size() {
+    let k = 6e6;
+    let errors: Vec<f64> = [10, 20, 40, 80]
+        .iter()
+        .map(|&elements| {
+            let spec = pin(elements);
+            let basis = complete_basis(&spec).unwrap();
+            // 0.9 m is a node of every mesh (0.9 = 6 × 0.15).
+            probe(&spec, &basis, &[contact(0.9, k)]).unwrap()[0].mesh_error
+        })
+        .collect();
+    for pair in errors.windows(2) {
+        assert!(pair[1] < pair[0], "mesh errors {errors:?} do not fall");
+    }
+    let order = (errors[2] / errors[3]).log2();
+    assert!(order > 2.0, "mesh errors {errors:?}: observed order {order} between 40 and 80 elements");
+}
+
+/// The secular-equation terms against a dense eigensolver of A = Ω² + kψψᵀ: same
+/// closed-contact frequencies and weights, and the weights sum to the unit approach rate.
+#[test]
+fn secular_roots_match_a_dense_eigensolver() {
+    use faer::{Mat, Side};
+    let spec = pin(20);
+    let basis = ModalBasis::compute_with_static_correction(&spec, 8, &[0.6, 1.2]).unwrap();
+    let (z, k) = (1.2, 4e6);
+    let psi = basis.deflection_at(z);
+    let omega = basis.angular_frequencies();
+    let n = psi.len();
+    let a = Mat::from_fn(n, n, |i, j| if i == j { omega[i] * omega[i] } else { 0.0 } + k * psi[i] * psi[j]);
+    let eigen = a.self_adjoint_eigen(Side::Lower).unwrap();
+    let mut dense: Vec<(f64, f64)> = (0..n)
+        .map(|j| {
+            let v = eigen.U().col(j);
+            let psi_v: f64 = (0..n).map(|i| psi[i] * v[i]).sum();
+            (psi_v * v[0] / psi[0], eigen.S().column_vector()[j].sqrt())
+        })
+        .collect();
+    dense.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let secular = closed_contact_terms(omega, &psi, k).unwrap();
+    assert_eq!(secular.len(), n);
+    let sum: f64 = secular.iter().map(|t| t.0).sum();
+    assert!((sum - 1.0).abs() < 1e-9, "weights sum to {sum}, expected 1");
+    for ((c, l), (cd, ld)) in secular.iter().zip(&dense) {
+        assert!((l - ld).abs() < 1e-9 * ld, "frequency {l} vs dense {ld}");
+        assert!((c - cd).abs() < 1e-7, "weight {c} vs dense {cd}");
+    }
+}
