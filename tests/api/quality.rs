@@ -75,6 +75,15 @@ async fn a_poor_or_doubtful_job_stays_successful_and_its_message_gives_the_verdi
     let app = spawn_app_with_shipped_processes_on(backend).await;
     let (status, auto) = run(&app, &cantilever(None)).await;
     let verdict = auto["quality"]["verdict"].as_str().unwrap();
+    // Without the step-halving check the step's error is not measured: never `good`.
+    assert_ne!(verdict, "good", "{}", auto["quality"]);
+    if verdict == "unchecked" {
+        assert!(
+            reasons(&auto).iter().any(|r| r.contains("solver.check")),
+            "an unchecked verdict says what was not checked: {}",
+            auto["quality"]
+        );
+    }
     let expected = match verdict {
         "good" => "finished".to_owned(),
         other => format!("finished; quality {other}: {}", reasons(&auto).join("; ")),

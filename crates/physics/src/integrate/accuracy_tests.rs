@@ -273,11 +273,39 @@ fn auto_peaks_are_within_one_percent_of_the_limit_and_the_check_estimates_the_er
                 "{name}: estimate {estimate:.2e}, true {error:.2e}"
             );
         }
-        assert_eq!(
-            assessed.quality.verdict,
-            Verdict::Good,
+        // The step is judged good; the verdict as a whole also covers the basis and the
+        // mesh of these rows (10 modes, no correction, 30 elements), which the impact
+        // probes judge (`crate::discretisation`), not the step.
+        let step_reasons: Vec<&String> = assessed
+            .quality
+            .reasons
+            .iter()
+            .filter(|r| !r.contains("modal basis") && !r.contains("element mesh"))
+            .collect();
+        assert!(step_reasons.is_empty(), "{name}: {step_reasons:?}");
+        if assessed.quality.reasons.is_empty() {
+            assert_eq!(assessed.quality.verdict, Verdict::Good, "{name}");
+        }
+    }
+}
+
+/// Without the step-halving check the step's error is not measured: the same run is
+/// `unchecked` where the checked one is `good`, and never `good`.
+#[test]
+fn a_run_without_the_check_is_never_good() {
+    let (name, row) = realistic_rows().remove(0);
+    let row = shock_window(row);
+    let basis = row.basis();
+    let model = row.model(&basis);
+    let checked = run_at(&model, &row, TimeStep::Auto, Check::StepHalving);
+    let unchecked = run_at(&model, &row, TimeStep::Auto, Check::None);
+    assert_ne!(unchecked.quality.verdict, Verdict::Good, "{name}: {:?}", unchecked.quality);
+    if checked.quality.verdict == Verdict::Good {
+        assert_eq!(unchecked.quality.verdict, Verdict::Unchecked, "{name}: {:?}", unchecked.quality);
+        assert!(
+            unchecked.quality.reasons.iter().any(|r| r.contains("solver.check")),
             "{name}: {:?}",
-            assessed.quality.reasons
+            unchecked.quality.reasons
         );
     }
 }

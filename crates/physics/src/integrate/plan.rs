@@ -108,7 +108,8 @@ impl<'a> Plan<'a> {
                 ))
             }
         };
-        let basis = crate::discretisation::assess(model).map_err(|e| {
+        let peaks: Vec<f64> = simulation.contact_statistics.iter().map(|s| s.max_force).collect();
+        let basis = crate::discretisation::assess(model, &peaks).map_err(|e| {
             SimulationError::InvalidModel(vec![InputIssue::new(
                 "modes",
                 format!("the impact probes of the basis and the mesh failed: {e}"),
