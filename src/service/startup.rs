@@ -61,7 +61,7 @@ impl Engine {
     /// Opens the database and recovers the jobs whose lease expired (a previous run of
     /// this or another process died).
     async fn open(config: &ServiceConfig) -> Result<Self, StartupError> {
-        let database = Database::open(&config.database, config.database_connections)
+        let database = Database::open_limited(&config.database, config.database_connections, config.max_database_bytes)
             .await
             .map_err(|source| StartupError::Database {
                 database: config.database.to_string(),
