@@ -77,7 +77,7 @@ impl Engine {
             max_attempts: config.max_attempts,
             retention: config.retention,
         };
-        maintenance.run_once().await?;
+        maintenance.run_at_start().await?;
         Ok(Self {
             queue,
             metrics,

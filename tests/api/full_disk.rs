@@ -28,7 +28,9 @@ use reqwest::{Response, StatusCode};
 use serde_json::{Value, json};
 use tempfile::TempDir;
 
-use crate::helpers::{TestApp, TestStore, assert_problem, spawn_app_in};
+use crate::helpers::{Backend, TestApp, TestStore, assert_problem, on_both_backends, spawn_app_in, spawn_app_on};
+
+on_both_backends!(answers_of_201_and_204_are_durable_across_a_restart);
 
 /// Size of the mounted file system (MiB).
 const TMPFS_MIB: u64 = 24;
@@ -146,11 +148,11 @@ impl Disk {
                 Filler::File(path)
             }
             Self::PageLimit(_) => {
-                // Large fillers first, then small ones: what is left is less than a small
-                // signal's pages.
+                // Large fillers first, then smaller ones: what is left is less than a
+                // small signal's pages (about 8 KB).
                 let mut fillers = Vec::new();
-                for (samples, seed0) in [(40_000, 1000u64), (1_000, 2000)] {
-                    for seed in seed0..seed0 + 200 {
+                for (samples, seed0) in [(200_000, 1000u64), (20_000, 2000), (1_000, 3000)] {
+                    for seed in seed0..seed0 + 40 {
                         let response = app.post_signal(noise_csv(samples, seed), "text/csv", "").await;
                         match response.status() {
                             StatusCode::CREATED => {
@@ -297,7 +299,7 @@ async fn survives_a_full_disk(disk: Disk) {
     app.wait_until_finished(&early_job).await;
     // A job whose results (a 20 000-row history) are written while the disk is full.
     let long_steps = 20_000;
-    let long_job = app.submit(json!({"steps": long_steps, "step_ms": 0.4})).await;
+    let long_job = app.submit(json!({"steps": long_steps, "step_ms": 0.5})).await;
     app.wait_for(&long_job, &["running"], Duration::from_secs(10)).await;
 
     let filler = disk.fill(&app).await;
@@ -421,5 +423,39 @@ async fn survives_a_full_disk(disk: Disk) {
         long_steps as usize + 1,
         "the held history landed whole"
     );
+    app.stop().await;
+}
+
+/// On either backend, the writes that return rows (a signal's `INSERT ... RETURNING`,
+/// a deletion's `DELETE ... RETURNING`, a claim's `UPDATE ... RETURNING`) run in explicit
+/// transactions: what was answered `201`/`204` (and a claimed job's run) is there after
+/// a restart, what was refused is not, and pooled connections come back usable.
+async fn answers_of_201_and_204_are_durable_across_a_restart(backend: Backend) {
+    let app = spawn_app_on(backend, |_| {}).await;
+    let kept = app.upload_signal(noise_csv(200, 7), "text/csv", "").await["id"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    let deleted = app.upload_signal(noise_csv(200, 8), "text/csv", "").await["id"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    assert_eq!(app.delete(&format!("/signals/{deleted}")).await.status(), StatusCode::NO_CONTENT);
+    // A refused upload (a 422) leaves nothing behind, and the connection it used is
+    // clean: the next writes go through at once.
+    let refused = app.post_signal("time,acceleration\n0,1\n0,2\n", "text/csv", "").await;
+    assert_eq!(refused.status(), StatusCode::UNPROCESSABLE_ENTITY);
+    let job = app.submit(json!({"steps": 5})).await;
+    let finished = app.wait_until_finished(&job).await;
+    assert_eq!(finished["status"], "successful", "{finished}");
+    let store = app.stop().await;
+    let app = crate::helpers::spawn_app_in(store, |_| {}).await;
+    assert_eq!(
+        ids_of(&app, "/signals", "signals", "id").await,
+        [kept].into_iter().collect::<BTreeSet<_>>()
+    );
+    assert_eq!(app.get(&format!("/signals/{deleted}")).await.status(), StatusCode::NOT_FOUND);
+    let results = app.get_json(&format!("/jobs/{job}/results")).await;
+    assert_eq!(results["sum"], expected_sum(5));
     app.stop().await;
 }

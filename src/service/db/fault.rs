@@ -48,7 +48,7 @@ impl StorageFault {
                         _ => None,
                     }
                 } else {
-                    match code.as_ref() {
+                    match &*code {
                         "53100" => Some(Self::Full(FullCause::PostgresDiskFull)),
                         "58030" if database.message().contains("No space left") => {
                             Some(Self::Full(FullCause::Enospc))

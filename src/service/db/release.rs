@@ -19,7 +19,7 @@
 
 use futures_util::future::BoxFuture;
 use sqlx::pool::PoolConnectionMetadata;
-use sqlx::{Connection, Executor, PgConnection, SqliteConnection};
+use sqlx::{Connection, PgConnection, SqliteConnection};
 
 /// `after_release` of the SQLite pool: `Ok(true)` keeps the connection, `Ok(false)`
 /// closes it.
@@ -30,11 +30,11 @@ pub fn sqlite_after_release(
     Box::pin(async move {
         // Runs after any rollback the dropped `Transaction` queued (one command queue);
         // fails when the connection is in a transaction, whoever opened it.
-        if let Err(error) = connection.execute("BEGIN").await {
+        if let Err(error) = sqlx::query("BEGIN").execute(&mut *connection).await {
             tracing::warn!(%error, "a released SQLite connection is inside a transaction: closing it");
             return Ok(false);
         }
-        if let Err(error) = connection.execute("ROLLBACK").await {
+        if let Err(error) = sqlx::query("ROLLBACK").execute(&mut *connection).await {
             tracing::warn!(%error, "cannot end the probe transaction: closing the connection");
             return Ok(false);
         }
@@ -52,12 +52,9 @@ pub fn postgres_after_release(
     connection: &mut PgConnection,
     _meta: PoolConnectionMetadata,
 ) -> BoxFuture<'_, Result<bool, sqlx::Error>> {
+    // sqlx counts a dropped transaction's queued `ROLLBACK` at once (the pool then pings
+    // the connection, which sends it): the counter is current here.
     Box::pin(async move {
-        // Sends any queued rollback and waits for the server's answer.
-        if let Err(error) = connection.execute("SELECT 1").await {
-            tracing::warn!(%error, "a released PostgreSQL connection failed: closing it");
-            return Ok(false);
-        }
         if connection.is_in_transaction() {
             tracing::warn!("a released PostgreSQL connection is inside a transaction: closing it");
             return Ok(false);

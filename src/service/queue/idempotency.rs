@@ -260,7 +260,7 @@ macro_rules! idempotency_store {
                     .bind(key.as_str())
                     .fetch_optional(&mut *self)
                     .await?;
-                row.map(|(kind, request_hash, resource_id)| {
+                row.map(|(kind, request_hash, resource_id)| -> Result<StoredKey, sqlx::Error> {
                     let kind = Kind::parse(&kind).ok_or_else(|| sqlx::Error::ColumnDecode {
                         index: "kind".into(),
                         source: format!("unknown idempotency key kind `{kind}`").into(),

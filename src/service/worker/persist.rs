@@ -87,7 +87,7 @@ fn is_transient(error: &sqlx::Error) -> bool {
             // SQLite SQLITE_BUSY (5) and SQLITE_LOCKED (6) with their extended codes;
             // PostgreSQL serialization failure, deadlock, and connection failures.
             code.parse::<i32>().is_ok_and(|code| matches!(code & 0xff, 5 | 6))
-                || matches!(code.as_ref(), "40001" | "40P01")
+                || matches!(&*code, "40001" | "40P01")
                 || code.starts_with("08")
         }
         _ => false,

@@ -194,7 +194,10 @@ pub(super) async fn run_job(
                         lost = true;
                         control.cancel();
                     }
-                    Err(error) => tracing::warn!(job = %lease.job_id, %error, "heartbeat failed"),
+                    Err(error) => {
+                        ctx.metrics.storage().check(&error, "heartbeat");
+                        tracing::warn!(job = %lease.job_id, %error, "heartbeat failed")
+                    }
                 }
             }
         }
