@@ -278,7 +278,8 @@ impl ServiceConfig {
             .unwrap_or_else(|| DatabaseUrl::Sqlite(args.data_dir.join(SQLITE_FILE)));
         Self {
             database_connections: args.database_connections.max(2),
-            max_database_bytes: (args.max_database_mib > 0).then(|| args.max_database_mib.saturating_mul(1 << 20)),
+            max_database_bytes: (args.max_database_mib > 0)
+                .then(|| args.max_database_mib.saturating_mul(1 << 20)),
             workers: args.workers.unwrap_or_else(default_workers),
             retention: (args.retention_days > 0)
                 .then(|| Duration::from_secs(u64::from(args.retention_days) * 86_400)),

@@ -89,6 +89,8 @@ impl StorageHealth {
 
     fn lock(&self) -> std::sync::MutexGuard<'_, Option<Failure>> {
         // A panic while holding this lock leaves a plain value behind: keep using it.
-        self.last_failure.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+        self.last_failure
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 }

@@ -28,7 +28,9 @@ use reqwest::{Response, StatusCode};
 use serde_json::{Value, json};
 use tempfile::TempDir;
 
-use crate::helpers::{Backend, TestApp, TestStore, assert_problem, on_both_backends, spawn_app_in, spawn_app_on};
+use crate::helpers::{
+    Backend, TestApp, TestStore, assert_problem, on_both_backends, spawn_app_in, spawn_app_on,
+};
 
 on_both_backends!(answers_of_201_and_204_are_durable_across_a_restart);
 
@@ -99,7 +101,9 @@ impl Disk {
         if prefer_mount {
             match Tmpfs::mount(TMPFS_MIB) {
                 Ok(tmpfs) => return Self::Tmpfs(tmpfs),
-                Err(why) => eprintln!("full-disk test: {why}; capping the database with max_page_count instead"),
+                Err(why) => {
+                    eprintln!("full-disk test: {why}; capping the database with max_page_count instead")
+                }
             }
         }
         Self::PageLimit(TempDir::new().unwrap())
@@ -130,7 +134,10 @@ impl Disk {
                 // An empty WAL: every write from now on needs new space (a WAL that was
                 // reset after a checkpoint would take writes into its old frames).
                 let pool = app.queue.database().as_sqlite().unwrap();
-                sqlx::query("PRAGMA wal_checkpoint(TRUNCATE)").execute(pool).await.unwrap();
+                sqlx::query("PRAGMA wal_checkpoint(TRUNCATE)")
+                    .execute(pool)
+                    .await
+                    .unwrap();
                 let path = tmpfs.path().join("filler");
                 let mut file = std::fs::File::create(&path).unwrap();
                 let chunk = vec![0u8; 64 << 10];
@@ -160,7 +167,9 @@ impl Disk {
                                 fillers.push(body["id"].as_str().unwrap().to_owned());
                             }
                             StatusCode::INSUFFICIENT_STORAGE => break,
-                            other => panic!("filling: unexpected {other}: {}", response.text().await.unwrap()),
+                            other => {
+                                panic!("filling: unexpected {other}: {}", response.text().await.unwrap())
+                            }
                         }
                     }
                 }
@@ -186,11 +195,15 @@ impl Disk {
 /// `samples` samples of pseudo-random noise at 100 Hz (incompressible: every sample
 /// costs its 8 bytes in the store).
 fn noise_csv(samples: usize, seed: u64) -> String {
-    let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     let mut csv = String::with_capacity(samples * 28);
     csv.push_str("time,acceleration\n");
     for k in 0..samples {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         let value = (state >> 11) as f64 / (1u64 << 53) as f64 * 20.0 - 10.0;
         csv.push_str(&format!("{},{value}\n", k as f64 * 0.01));
     }
@@ -218,7 +231,10 @@ async fn outcome(response: Response, expected: StatusCode, what: &str) -> Outcom
         return Outcome::Accepted(Some(id));
     }
     assert!(
-        matches!(status, StatusCode::INSUFFICIENT_STORAGE | StatusCode::SERVICE_UNAVAILABLE),
+        matches!(
+            status,
+            StatusCode::INSUFFICIENT_STORAGE | StatusCode::SERVICE_UNAVAILABLE
+        ),
         "{what}: a refused write is 507 or 503, got {status}: {}",
         response.text().await.unwrap_or_default()
     );
@@ -236,7 +252,9 @@ async fn outcome(response: Response, expected: StatusCode, what: &str) -> Outcom
     let problem = assert_problem(response, status, suffix).await;
     let detail = problem["detail"].as_str().unwrap();
     assert!(
-        ["SQLITE_FULL", "ENOSPC", "I/O error"].iter().any(|cause| detail.contains(cause)),
+        ["SQLITE_FULL", "ENOSPC", "I/O error"]
+            .iter()
+            .any(|cause| detail.contains(cause)),
         "{what}: the problem names its cause: {detail}"
     );
     Outcome::Refused
@@ -247,7 +265,8 @@ async fn failed_writes(app: &TestApp, during: &str) -> f64 {
     let text = app.get("/metrics").await.text().await.unwrap();
     text.lines()
         .filter(|line| {
-            line.starts_with("chocmodal_failed_writes_total{") && line.contains(&format!("during=\"{during}\""))
+            line.starts_with("chocmodal_failed_writes_total{")
+                && line.contains(&format!("during=\"{during}\""))
         })
         .filter_map(|line| line.rsplit(' ').next()?.parse::<f64>().ok())
         .sum()
@@ -300,7 +319,8 @@ async fn survives_a_full_disk(disk: Disk) {
     // A job whose results (a 20 000-row history) are written while the disk is full.
     let long_steps = 20_000;
     let long_job = app.submit(json!({"steps": long_steps, "step_ms": 0.5})).await;
-    app.wait_for(&long_job, &["running"], Duration::from_secs(10)).await;
+    app.wait_for(&long_job, &["running"], Duration::from_secs(10))
+        .await;
 
     let filler = disk.fill(&app).await;
 
@@ -309,7 +329,9 @@ async fn survives_a_full_disk(disk: Disk) {
     let mut accepted_jobs = Vec::new();
     let mut refused = 0;
     for seed in 0..4 {
-        let response = app.post_signal(noise_csv(20_000, 100 + seed), "text/csv", "").await;
+        let response = app
+            .post_signal(noise_csv(20_000, 100 + seed), "text/csv", "")
+            .await;
         match outcome(response, StatusCode::CREATED, "signal upload").await {
             Outcome::Accepted(id) => accepted_signals.push(id.unwrap()),
             Outcome::Refused => refused += 1,
@@ -323,23 +345,43 @@ async fn survives_a_full_disk(disk: Disk) {
         }
     }
     let deleted = matches!(
-        outcome(app.delete(&format!("/signals/{doomed}")).await, StatusCode::NO_CONTENT, "signal deletion").await,
+        outcome(
+            app.delete(&format!("/signals/{doomed}")).await,
+            StatusCode::NO_CONTENT,
+            "signal deletion"
+        )
+        .await,
         Outcome::Accepted(_)
     );
-    assert!(refused > 0, "the full disk refused no write: the test did not fill it");
+    assert!(
+        refused > 0,
+        "the full disk refused no write: the test did not fill it"
+    );
 
     // Reads keep working, and the service says it cannot write.
-    assert_eq!(app.get(&format!("/signals/{kept}")).await.status(), StatusCode::OK);
-    assert_eq!(app.get(&format!("/jobs/{early_job}/results")).await.status(), StatusCode::OK);
+    assert_eq!(
+        app.get(&format!("/signals/{kept}")).await.status(),
+        StatusCode::OK
+    );
+    assert_eq!(
+        app.get(&format!("/jobs/{early_job}/results")).await.status(),
+        StatusCode::OK
+    );
     let readiness = app.get("/readyz").await;
     assert!(
-        matches!(readiness.status(), StatusCode::INSUFFICIENT_STORAGE | StatusCode::SERVICE_UNAVAILABLE),
+        matches!(
+            readiness.status(),
+            StatusCode::INSUFFICIENT_STORAGE | StatusCode::SERVICE_UNAVAILABLE
+        ),
         "/readyz while writes are refused: {}",
         readiness.status()
     );
     assert!(readiness.headers().contains_key("retry-after"));
     let health = app.get_json("/healthz").await;
-    assert_eq!(health["status"], "ok", "a full disk is no reason to restart: {health}");
+    assert_eq!(
+        health["status"], "ok",
+        "a full disk is no reason to restart: {health}"
+    );
     assert_eq!(health["writable"], false, "{health}");
     assert!(health["storage_fault"].is_string(), "{health}");
     assert!(failed_writes(&app, "request").await >= 1.0);
@@ -387,7 +429,11 @@ async fn survives_a_full_disk(disk: Disk) {
     // Every accepted job reads the same from every pooled connection, again and again.
     for _ in 0..10 {
         for job in accepted_jobs.iter().chain([&after_job, &long_job]) {
-            assert_eq!(app.get(&format!("/jobs/{job}")).await.status(), StatusCode::OK, "job {job}");
+            assert_eq!(
+                app.get(&format!("/jobs/{job}")).await.status(),
+                StatusCode::OK,
+                "job {job}"
+            );
         }
     }
 
@@ -405,7 +451,10 @@ async fn survives_a_full_disk(disk: Disk) {
         "stored signals after the restart"
     );
     if deleted {
-        assert_eq!(app.get(&format!("/signals/{doomed}")).await.status(), StatusCode::NOT_FOUND);
+        assert_eq!(
+            app.get(&format!("/signals/{doomed}")).await.status(),
+            StatusCode::NOT_FOUND
+        );
     }
     let mut jobs: BTreeSet<String> = [early_job, long_job.clone(), after_job].into_iter().collect();
     jobs.extend(accepted_jobs);
@@ -416,7 +465,9 @@ async fn survives_a_full_disk(disk: Disk) {
     );
     let results = app.get_json(&format!("/jobs/{long_job}/results")).await;
     assert_eq!(results["sum"], expected_sum(long_steps), "{results}");
-    let history = app.get(&format!("/jobs/{long_job}/results/signal?format=csv")).await;
+    let history = app
+        .get(&format!("/jobs/{long_job}/results/signal?format=csv"))
+        .await;
     assert_eq!(history.status(), StatusCode::OK);
     assert_eq!(
         history.text().await.unwrap().lines().count(),
@@ -440,10 +491,15 @@ async fn answers_of_201_and_204_are_durable_across_a_restart(backend: Backend) {
         .as_str()
         .unwrap()
         .to_owned();
-    assert_eq!(app.delete(&format!("/signals/{deleted}")).await.status(), StatusCode::NO_CONTENT);
+    assert_eq!(
+        app.delete(&format!("/signals/{deleted}")).await.status(),
+        StatusCode::NO_CONTENT
+    );
     // A refused upload (a 422) leaves nothing behind, and the connection it used is
     // clean: the next writes go through at once.
-    let refused = app.post_signal("time,acceleration\n0,1\n0,2\n", "text/csv", "").await;
+    let refused = app
+        .post_signal("time,acceleration\n0,1\n0,2\n", "text/csv", "")
+        .await;
     assert_eq!(refused.status(), StatusCode::UNPROCESSABLE_ENTITY);
     let job = app.submit(json!({"steps": 5})).await;
     let finished = app.wait_until_finished(&job).await;
@@ -454,7 +510,10 @@ async fn answers_of_201_and_204_are_durable_across_a_restart(backend: Backend) {
         ids_of(&app, "/signals", "signals", "id").await,
         [kept].into_iter().collect::<BTreeSet<_>>()
     );
-    assert_eq!(app.get(&format!("/signals/{deleted}")).await.status(), StatusCode::NOT_FOUND);
+    assert_eq!(
+        app.get(&format!("/signals/{deleted}")).await.status(),
+        StatusCode::NOT_FOUND
+    );
     let results = app.get_json(&format!("/jobs/{job}/results")).await;
     assert_eq!(results["sum"], expected_sum(5));
     app.stop().await;

@@ -71,7 +71,16 @@ async fn job_ids(app: &TestApp) -> Vec<String> {
 
 async fn a_retried_submission_with_the_same_key_creates_one_job(backend: Backend) {
     let app = spawn_app_on(backend, |_| {}).await;
-    let first = answer(execute_with_key(&app, "order-17", r#"{"inputs": {"steps": 3, "step_ms": 1}}"#, None).await).await;
+    let first = answer(
+        execute_with_key(
+            &app,
+            "order-17",
+            r#"{"inputs": {"steps": 3, "step_ms": 1}}"#,
+            None,
+        )
+        .await,
+    )
+    .await;
     assert_eq!(first.status, StatusCode::CREATED, "{}", first.body);
     assert!(!first.replayed);
     let id = first.body["jobID"].as_str().unwrap().to_owned();
@@ -79,12 +88,17 @@ async fn a_retried_submission_with_the_same_key_creates_one_job(backend: Backend
 
     // The same request (members in another order, other spacing) after the first ran.
     app.wait_until_finished(&id).await;
-    let retry = answer(execute_with_key(&app, "order-17", r#"{"inputs":{"step_ms":1,"steps":3}}"#, None).await).await;
+    let retry =
+        answer(execute_with_key(&app, "order-17", r#"{"inputs":{"step_ms":1,"steps":3}}"#, None).await).await;
     assert_eq!(retry.status, StatusCode::CREATED, "{}", retry.body);
     assert!(retry.replayed, "a replay says so");
     assert_eq!(retry.body["jobID"], id.as_str(), "{}", retry.body);
     assert_eq!(retry.location, first.location);
-    assert_eq!(retry.body["status"], "successful", "the job as it is now: {}", retry.body);
+    assert_eq!(
+        retry.body["status"], "successful",
+        "the job as it is now: {}",
+        retry.body
+    );
     assert_eq!(job_ids(&app).await, vec![id.clone()], "one job, not two");
     assert_eq!(app.probe.started(), 1, "it ran once");
 
@@ -92,11 +106,23 @@ async fn a_retried_submission_with_the_same_key_creates_one_job(backend: Backend
     let other = execute_with_key(&app, "order-17", r#"{"inputs": {"steps": 4}}"#, None).await;
     let problem = assert_problem(other, StatusCode::UNPROCESSABLE_ENTITY, "/idempotency-key-reused").await;
     let detail = problem["detail"].as_str().unwrap();
-    assert!(detail.contains("Idempotency-Key") && detail.contains("order-17") && detail.contains(&id), "{detail}");
+    assert!(
+        detail.contains("Idempotency-Key") && detail.contains("order-17") && detail.contains(&id),
+        "{detail}"
+    );
     assert_eq!(job_ids(&app).await.len(), 1);
 
     // Another key: another job.
-    let fresh = answer(execute_with_key(&app, "order-18", r#"{"inputs": {"steps": 3, "step_ms": 1}}"#, None).await).await;
+    let fresh = answer(
+        execute_with_key(
+            &app,
+            "order-18",
+            r#"{"inputs": {"steps": 3, "step_ms": 1}}"#,
+            None,
+        )
+        .await,
+    )
+    .await;
     assert_eq!(fresh.status, StatusCode::CREATED);
     assert_ne!(fresh.body["jobID"], id.as_str());
     assert_eq!(job_ids(&app).await.len(), 2);
@@ -104,7 +130,10 @@ async fn a_retried_submission_with_the_same_key_creates_one_job(backend: Backend
     // A malformed key is a 400 naming the header.
     let bad = execute_with_key(&app, "two words", r#"{"inputs": {"steps": 3}}"#, None).await;
     let problem = assert_problem(bad, StatusCode::BAD_REQUEST, "/invalid-header").await;
-    assert!(problem["detail"].as_str().unwrap().contains("Idempotency-Key"), "{problem}");
+    assert!(
+        problem["detail"].as_str().unwrap().contains("Idempotency-Key"),
+        "{problem}"
+    );
     assert_eq!(job_ids(&app).await.len(), 2);
 }
 
@@ -160,10 +189,20 @@ async fn a_retried_sweep_with_the_same_key_creates_one_sweep(backend: Backend) {
     let mut other = body;
     other["axes"][0]["values"] = json!([1, 2]);
     let refused = post(other).await.unwrap();
-    assert_problem(refused, StatusCode::UNPROCESSABLE_ENTITY, "/idempotency-key-reused").await;
+    assert_problem(
+        refused,
+        StatusCode::UNPROCESSABLE_ENTITY,
+        "/idempotency-key-reused",
+    )
+    .await;
     // A job submission may not reuse a sweep's key either.
     let crossed = execute_with_key(&app, "sweep-1", r#"{"inputs": {"steps": 1}}"#, None).await;
-    let problem = assert_problem(crossed, StatusCode::UNPROCESSABLE_ENTITY, "/idempotency-key-reused").await;
+    let problem = assert_problem(
+        crossed,
+        StatusCode::UNPROCESSABLE_ENTITY,
+        "/idempotency-key-reused",
+    )
+    .await;
     assert!(problem["detail"].as_str().unwrap().contains("sweep"), "{problem}");
     assert_eq!(job_ids(&app).await.len(), 3);
 }
@@ -194,7 +233,10 @@ async fn a_retried_signal_upload_with_the_same_key_stores_one_signal_until_it_is
     assert_problem(other, StatusCode::UNPROCESSABLE_ENTITY, "/idempotency-key-reused").await;
 
     // The key lives as long as its signal: once deleted, the key is free again.
-    assert_eq!(app.delete(&format!("/signals/{id}")).await.status(), StatusCode::NO_CONTENT);
+    assert_eq!(
+        app.delete(&format!("/signals/{id}")).await.status(),
+        StatusCode::NO_CONTENT
+    );
     let again = answer(upload(csv).await.unwrap()).await;
     assert_eq!(again.status, StatusCode::CREATED, "{}", again.body);
     assert!(!again.replayed);
@@ -204,15 +246,24 @@ async fn a_retried_signal_upload_with_the_same_key_stores_one_signal_until_it_is
 async fn keys_belong_to_their_tenant(backend: Backend) {
     const ALPHA: &str = "alpha-token-0123456789";
     const BETA: &str = "beta-token-9876543210";
-    let tokens = chocmodal::service::auth::TokenTable::parse(&format!("alpha {ALPHA}\nbeta {BETA}\n")).unwrap();
+    let tokens =
+        chocmodal::service::auth::TokenTable::parse(&format!("alpha {ALPHA}\nbeta {BETA}\n")).unwrap();
     let app = spawn_app_on(backend, |config| config.auth = Some(tokens)).await;
     let body = r#"{"inputs": {"steps": 1}}"#;
     let alpha = answer(execute_with_key(&app, "shared-key", body, Some(ALPHA)).await).await;
     let beta = answer(execute_with_key(&app, "shared-key", body, Some(BETA)).await).await;
-    assert_eq!((alpha.status, beta.status), (StatusCode::CREATED, StatusCode::CREATED));
+    assert_eq!(
+        (alpha.status, beta.status),
+        (StatusCode::CREATED, StatusCode::CREATED)
+    );
     assert!(!beta.replayed, "another tenant's key is another key");
     assert_ne!(alpha.body["jobID"], beta.body["jobID"]);
     // And a tenant's other body under the same key is refused for that tenant only.
     let refused = execute_with_key(&app, "shared-key", r#"{"inputs": {"steps": 2}}"#, Some(BETA)).await;
-    assert_problem(refused, StatusCode::UNPROCESSABLE_ENTITY, "/idempotency-key-reused").await;
+    assert_problem(
+        refused,
+        StatusCode::UNPROCESSABLE_ENTITY,
+        "/idempotency-key-reused",
+    )
+    .await;
 }

@@ -658,7 +658,9 @@ async fn huge_accelerations_get_their_exact_arias_intensity_or_a_422_stating_the
         .await;
     // In the order that stays finite: π/(2g)·T first.
     let expected = PI / (2.0 * G) * 2.0 * amplitude * amplitude;
-    let measured = metadata["arias_intensity"].as_f64().expect("a finite Arias intensity");
+    let measured = metadata["arias_intensity"]
+        .as_f64()
+        .expect("a finite Arias intensity");
     assert!(
         ((measured - expected) / expected).abs() < 1e-12,
         "Arias measured {measured:e} vs expected {expected:e}"
@@ -678,5 +680,8 @@ async fn huge_accelerations_get_their_exact_arias_intensity_or_a_422_stating_the
     let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-signal").await;
     assert_eq!(problem["errors"][0]["pointer"], "/acceleration", "{problem}");
     let detail = problem["errors"][0]["detail"].as_str().unwrap();
-    assert!(detail.contains("Arias intensity") && detail.contains("1.7976931348623157e308"), "{detail}");
+    assert!(
+        detail.contains("Arias intensity") && detail.contains("1.7976931348623157e308"),
+        "{detail}"
+    );
 }

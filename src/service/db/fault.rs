@@ -103,7 +103,10 @@ mod tests {
     #[test]
     fn an_enospc_io_error_is_a_full_disk() {
         let error = sqlx::Error::Io(std::io::Error::from_raw_os_error(ENOSPC));
-        assert_eq!(StorageFault::of(&error), Some(StorageFault::Full(FullCause::Enospc)));
+        assert_eq!(
+            StorageFault::of(&error),
+            Some(StorageFault::Full(FullCause::Enospc))
+        );
         let other = sqlx::Error::Io(std::io::Error::from_raw_os_error(13));
         assert_eq!(StorageFault::of(&other), None);
         assert_eq!(StorageFault::of(&sqlx::Error::RowNotFound), None);

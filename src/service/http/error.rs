@@ -95,9 +95,7 @@ pub fn storage_fault_response(fault: StorageFault) -> Response {
         format!("{CHOCMODAL_PROBLEMS}/{slug}"),
         title,
         fault.status(),
-        format!(
-            "{fault}: nothing was stored; retry in {STORAGE_RETRY_SECONDS} s (reads still work)"
-        ),
+        format!("{fault}: nothing was stored; retry in {STORAGE_RETRY_SECONDS} s (reads still work)"),
     );
     let mut response = problem_response(&problem);
     response

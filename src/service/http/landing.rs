@@ -97,7 +97,11 @@ pub async fn conformance() -> Json<Conformance> {
 pub async fn healthz(State(state): State<AppState>) -> Response {
     match state.queue.database().ping().await {
         Ok(()) => {
-            let fault = state.metrics.storage().current().map(|cannot| cannot.fault.cause());
+            let fault = state
+                .metrics
+                .storage()
+                .current()
+                .map(|cannot| cannot.fault.cause());
             Json(Health {
                 status: "ok",
                 writable: fault.is_none(),

@@ -16,7 +16,7 @@ use crate::problem::Problem;
 use crate::processes::Process;
 use crate::service::auth::Tenant;
 use crate::service::queue::Admission;
-use crate::service::queue::idempotency::{Kind, KeyedRequest, RequestHash};
+use crate::service::queue::idempotency::{KeyedRequest, Kind, RequestHash};
 
 fn summary(process: &dyn Process) -> ProcessSummary {
     let href = format!("/processes/{}", process.id());

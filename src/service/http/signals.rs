@@ -17,8 +17,8 @@ use axum::response::{IntoResponse, Response};
 use super::AppState;
 use super::error::ApiError;
 use super::extract::ApiQuery;
-use super::idempotency::{IdempotencyHeader, key_reused, mark_replayed};
 use super::history_view::Format;
+use super::idempotency::{IdempotencyHeader, key_reused, mark_replayed};
 use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
 use super::models::Link;
 use super::response_spectra::{parse_spectrum_query, spectra_csv};
@@ -26,7 +26,7 @@ use super::signal_models::{DampedSpectrum, SignalList, SignalMetadata, SignalSpe
 use crate::physics::response_spectrum::{self, log_spaced};
 use crate::problem::Problem;
 use crate::service::auth::Tenant;
-use crate::service::queue::idempotency::{Keyed, Kind, KeyedRequest, RequestHash};
+use crate::service::queue::idempotency::{Keyed, KeyedRequest, Kind, RequestHash};
 use crate::service::signals::SignalReadError;
 use crate::service::signals::create::CreateError;
 use crate::service::signals::delete::Deletion;

@@ -37,10 +37,14 @@ impl JobQueue {
         max_queued: Option<u64>,
         key: Option<&KeyedRequest>,
     ) -> Result<Admission<JobRecord>, sqlx::Error> {
-        match self.enqueue_once(tenant, process_id, inputs, warnings, max_queued, key).await {
+        match self
+            .enqueue_once(tenant, process_id, inputs, warnings, max_queued, key)
+            .await
+        {
             // A concurrent first use of the same key won: this one now finds it.
             Err(error) if key.is_some() && is_key_taken(&error) => {
-                self.enqueue_once(tenant, process_id, inputs, warnings, max_queued, key).await
+                self.enqueue_once(tenant, process_id, inputs, warnings, max_queued, key)
+                    .await
             }
             outcome => outcome,
         }

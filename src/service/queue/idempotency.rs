@@ -213,7 +213,11 @@ pub fn is_key_taken(error: &sqlx::Error) -> bool {
 /// The key statements, run inside the caller's transaction on either backend.
 pub(crate) trait IdempotencyStore {
     /// The key `key` of `tenant`, if used.
-    async fn find_key(&mut self, tenant: &str, key: &IdempotencyKey) -> Result<Option<StoredKey>, sqlx::Error>;
+    async fn find_key(
+        &mut self,
+        tenant: &str,
+        key: &IdempotencyKey,
+    ) -> Result<Option<StoredKey>, sqlx::Error>;
 
     /// Records `request`'s key as having created `resource_id`.
     async fn store_key(
@@ -260,17 +264,19 @@ macro_rules! idempotency_store {
                     .bind(key.as_str())
                     .fetch_optional(&mut *self)
                     .await?;
-                row.map(|(kind, request_hash, resource_id)| -> Result<StoredKey, sqlx::Error> {
-                    let kind = Kind::parse(&kind).ok_or_else(|| sqlx::Error::ColumnDecode {
-                        index: "kind".into(),
-                        source: format!("unknown idempotency key kind `{kind}`").into(),
-                    })?;
-                    Ok(StoredKey {
-                        kind,
-                        request_hash,
-                        resource_id,
-                    })
-                })
+                row.map(
+                    |(kind, request_hash, resource_id)| -> Result<StoredKey, sqlx::Error> {
+                        let kind = Kind::parse(&kind).ok_or_else(|| sqlx::Error::ColumnDecode {
+                            index: "kind".into(),
+                            source: format!("unknown idempotency key kind `{kind}`").into(),
+                        })?;
+                        Ok(StoredKey {
+                            kind,
+                            request_hash,
+                            resource_id,
+                        })
+                    },
+                )
                 .transpose()
             }
 
@@ -306,12 +312,19 @@ mod tests {
 
     #[test]
     fn keys_are_visible_ascii_of_bounded_length() {
-        assert_eq!(IdempotencyKey::parse(b"order-17/retry").unwrap().as_str(), "order-17/retry");
+        assert_eq!(
+            IdempotencyKey::parse(b"order-17/retry").unwrap().as_str(),
+            "order-17/retry"
+        );
         assert!(IdempotencyKey::parse(b"").unwrap_err().contains("empty"));
         assert!(IdempotencyKey::parse(b"two words").unwrap_err().contains("' '"));
         assert!(IdempotencyKey::parse("clé".as_bytes()).is_err());
         let long = "k".repeat(MAX_KEY_LENGTH + 1);
-        assert!(IdempotencyKey::parse(long.as_bytes()).unwrap_err().contains("255"));
+        assert!(
+            IdempotencyKey::parse(long.as_bytes())
+                .unwrap_err()
+                .contains("255")
+        );
     }
 
     #[test]
@@ -347,7 +360,10 @@ mod tests {
         };
         assert!(matches!(
             stored.clone().prior_for(&other),
-            Prior::Conflict(KeyConflict { other_kind: false, .. })
+            Prior::Conflict(KeyConflict {
+                other_kind: false,
+                ..
+            })
         ));
         let job = KeyedRequest {
             kind: Kind::Job,

@@ -259,7 +259,10 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
                     record(
                         lease,
                         "complete",
-                        super::persist::until_stored(ctx, lease, "complete", || ctx.queue.complete(lease, &document, &histories)).await,
+                        super::persist::until_stored(ctx, lease, "complete", || {
+                            ctx.queue.complete(lease, &document, &histories)
+                        })
+                        .await,
                     );
                     "successful"
                 }
@@ -284,7 +287,11 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
             }
         }
         Ok(Err(RunError::Cancelled)) if handing_back => {
-            record(lease, "hand back", super::persist::until_stored(ctx, lease, "hand back", || ctx.queue.hand_back(lease)).await);
+            record(
+                lease,
+                "hand back",
+                super::persist::until_stored(ctx, lease, "hand back", || ctx.queue.hand_back(lease)).await,
+            );
             "handed_back"
         }
         Ok(Err(RunError::Cancelled)) if timed_out.is_some() => {
