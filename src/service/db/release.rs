@@ -62,3 +62,77 @@ pub fn postgres_after_release(
         Ok(true)
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use std::time::{Duration, Instant};
+
+    use super::super::fault::StorageFault;
+
+    /// A database full to its page limit refuses transactions (as a full disk does);
+    /// once rows are deleted, every pooled connection takes a write at once: none was
+    /// returned to the pool inside a transaction holding the write lock (it would make
+    /// the others wait for the busy timeout, and its own "commits" would be lost).
+    #[tokio::test]
+    async fn failed_transactions_on_a_full_database_leave_no_connection_inside_one() {
+        let dir = tempfile::TempDir::new().unwrap();
+        let path = dir.path().join("full.sqlite");
+        let pool = super::super::sqlite::open(&path, Some(1 << 20)).await.unwrap();
+        sqlx::query("CREATE TABLE filler (data BLOB)")
+            .execute(&pool)
+            .await
+            .unwrap();
+        let mut rows = 0;
+        loop {
+            match sqlx::query("INSERT INTO filler VALUES (randomblob(16384))")
+                .execute(&pool)
+                .await
+            {
+                Ok(_) => rows += 1,
+                Err(error) => {
+                    assert!(StorageFault::of(&error).is_some(), "{error}");
+                    break;
+                }
+            }
+            assert!(rows < 1000, "the page limit never refused a row");
+        }
+        // Several failed transactions, as failed submissions would make.
+        for _ in 0..4 {
+            let mut tx = pool.begin().await.unwrap();
+            let error = sqlx::query("INSERT INTO filler VALUES (randomblob(300000))")
+                .execute(&mut *tx)
+                .await
+                .expect_err("the database is full");
+            assert!(StorageFault::of(&error).is_some(), "{error}");
+            drop(tx);
+        }
+        sqlx::query("DELETE FROM filler").execute(&pool).await.unwrap();
+        let started = Instant::now();
+        let mut held = Vec::new();
+        for k in 0..8 {
+            // Hold each connection so that every pooled one is used once.
+            let mut connection = pool.acquire().await.unwrap();
+            let mut tx = sqlx::Connection::begin(&mut *connection).await.unwrap();
+            sqlx::query("INSERT INTO filler VALUES (randomblob(16))")
+                .execute(&mut *tx)
+                .await
+                .unwrap_or_else(|error| panic!("write {k} after freeing space: {error}"));
+            tx.commit().await.unwrap();
+            held.push(connection);
+        }
+        drop(held);
+        assert!(
+            started.elapsed() < Duration::from_secs(3),
+            "writes after freeing space took {:?}",
+            started.elapsed()
+        );
+        pool.close().await;
+        // Every commit is in the file, as another process sees it.
+        let reopened = super::super::sqlite::open(&path, None).await.unwrap();
+        let count: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM filler")
+            .fetch_one(&reopened)
+            .await
+            .unwrap();
+        assert_eq!(count, 8);
+    }
+}
