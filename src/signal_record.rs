@@ -261,8 +261,35 @@ fn parse_json(text: &str) -> Result<Table, RecordError> {
     }
 }
 
-/// At least two samples; times non-negative and strictly increasing.
+/// At least two samples; times non-negative and strictly increasing; an Arias intensity
+/// that a number can hold.
 fn check(record: &Table, lines: &[usize]) -> Result<(), RecordError> {
+    check_samples(record, lines)?;
+    check_intensity(record)
+}
+
+/// The record's Arias intensity π/(2g) ∫ a² dt must be finite (at most `f64::MAX`,
+/// about 1.8e308 m/s): computed without overflow, it is infinite only for
+/// accelerations of order 1e154 m/s² held for seconds, or larger.
+fn check_intensity(record: &Table) -> Result<(), RecordError> {
+    match crate::physics::accelerogram::RecordSummary::of(record) {
+        Some(summary) if !summary.arias_intensity.is_finite() => Err(invalid(
+            "/acceleration",
+            format!(
+                "the record's Arias intensity π/(2g)∫a²dt exceeds the largest representable \
+                 number ({:e} m/s): accelerations of {:e} m/s² are too large (keep the intensity \
+                 at most {:e} m/s)",
+                f64::MAX,
+                summary.pga,
+                f64::MAX
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// At least two samples; times non-negative and strictly increasing.
+fn check_samples(record: &Table, lines: &[usize]) -> Result<(), RecordError> {
     let at_line = |k: usize| {
         lines
             .get(k)

@@ -44,6 +44,11 @@ pub struct QueueArgs {
     /// Largest number of connections this process opens to a PostgreSQL database.
     #[arg(long, env = "CHOCMODAL_DATABASE_CONNECTIONS", default_value_t = 10)]
     pub database_connections: u32,
+    /// A SQLite database never grows beyond this many MiB (SQLite's `max_page_count`):
+    /// writes that need more space are refused with 507, as on a full disk, while reads
+    /// go on. 0: no limit but the disk's.
+    #[arg(long, env = "CHOCMODAL_MAX_DATABASE_MIB", default_value_t = 0)]
+    pub max_database_mib: u64,
     /// Delete finished jobs (and their results) this many days after they finished; 0 keeps them forever.
     #[arg(long, env = "CHOCMODAL_RETENTION_DAYS", default_value_t = 30)]
     pub retention_days: u32,
@@ -155,6 +160,9 @@ pub struct ServiceConfig {
     pub database: DatabaseUrl,
     /// Largest number of connections to a PostgreSQL database.
     pub database_connections: u32,
+    /// Largest size of a SQLite database (bytes, rounded down to whole pages); `None`:
+    /// the disk's.
+    pub max_database_bytes: Option<u64>,
     /// Number of worker slots (jobs computed at once).
     pub workers: usize,
     /// Age after which finished jobs are deleted; `None` keeps them.
@@ -234,6 +242,7 @@ impl ServiceConfig {
             health_bind: None,
             database,
             database_connections: 10,
+            max_database_bytes: None,
             workers: default_workers(),
             retention: Some(Duration::from_secs(30 * 86_400)),
             max_body_bytes: 1 << 20,
@@ -269,6 +278,8 @@ impl ServiceConfig {
             .unwrap_or_else(|| DatabaseUrl::Sqlite(args.data_dir.join(SQLITE_FILE)));
         Self {
             database_connections: args.database_connections.max(2),
+            max_database_bytes: (args.max_database_mib > 0)
+                .then(|| args.max_database_mib.saturating_mul(1 << 20)),
             workers: args.workers.unwrap_or_else(default_workers),
             retention: (args.retention_days > 0)
                 .then(|| Duration::from_secs(u64::from(args.retention_days) * 86_400)),

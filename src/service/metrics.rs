@@ -12,6 +12,7 @@ use prometheus::{
 };
 
 use super::queue::JobStatus;
+use super::storage_health::StorageHealth;
 
 /// The service's metrics.
 #[derive(Clone)]
@@ -25,6 +26,7 @@ pub struct Metrics {
     threads: IntGauge,
     http_requests: IntCounterVec,
     http_duration: HistogramVec,
+    storage: StorageHealth,
 }
 
 impl std::fmt::Debug for Metrics {
@@ -98,6 +100,16 @@ impl Metrics {
             &["method", "route"],
         )
         .expect("valid metric");
+        let failed_writes = IntCounterVec::new(
+            Opts::new(
+                "chocmodal_failed_writes_total",
+                "Writes the storage refused (full disk, I/O error), by cause (SQLITE_FULL, \
+                 disk_full, ENOSPC, io_error) and by what was written (request, results, claim, \
+                 heartbeat, maintenance, probe).",
+            ),
+            &["cause", "during"],
+        )
+        .expect("valid metric");
         for collector in [
             Box::new(jobs.clone()) as Box<dyn prometheus::core::Collector>,
             Box::new(job_duration.clone()),
@@ -107,6 +119,7 @@ impl Metrics {
             Box::new(threads.clone()),
             Box::new(http_requests.clone()),
             Box::new(http_duration.clone()),
+            Box::new(failed_writes.clone()),
         ] {
             registry.register(collector).expect("metric names are unique");
         }
@@ -120,7 +133,14 @@ impl Metrics {
             threads,
             http_requests,
             http_duration,
+            storage: StorageHealth::new(failed_writes),
         }
+    }
+
+    /// Whether this instance can write ([`StorageHealth`]), which also counts failed
+    /// writes.
+    pub fn storage(&self) -> &StorageHealth {
+        &self.storage
     }
 
     /// A run starts (`delta` > 0) or ends (< 0) on `delta` threads.

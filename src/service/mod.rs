@@ -18,6 +18,7 @@ mod server;
 pub mod signals;
 pub mod spectrum_table;
 mod startup;
+pub mod storage_health;
 pub mod store;
 pub mod telemetry;
 pub mod thinning;

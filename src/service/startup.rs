@@ -61,12 +61,16 @@ impl Engine {
     /// Opens the database and recovers the jobs whose lease expired (a previous run of
     /// this or another process died).
     async fn open(config: &ServiceConfig) -> Result<Self, StartupError> {
-        let database = Database::open(&config.database, config.database_connections)
-            .await
-            .map_err(|source| StartupError::Database {
-                database: config.database.to_string(),
-                source,
-            })?;
+        let database = Database::open_limited(
+            &config.database,
+            config.database_connections,
+            config.max_database_bytes,
+        )
+        .await
+        .map_err(|source| StartupError::Database {
+            database: config.database.to_string(),
+            source,
+        })?;
         let queue = JobQueue::new(database, config.clock.clone());
         let metrics = Metrics::new();
         let wake = Arc::new(Notify::new());
@@ -77,7 +81,7 @@ impl Engine {
             max_attempts: config.max_attempts,
             retention: config.retention,
         };
-        maintenance.run_once().await?;
+        maintenance.run_at_start().await?;
         Ok(Self {
             queue,
             metrics,

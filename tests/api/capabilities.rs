@@ -91,9 +91,13 @@ async fn an_unknown_process_is_a_404_problem() {
 }
 
 #[tokio::test]
-async fn the_health_check_answers_ok() {
+async fn the_health_check_answers_ok_and_the_readiness_check_ready() {
     let app = spawn_app().await;
-    assert_eq!(app.get_json("/healthz").await, json!({"status": "ok"}));
+    assert_eq!(
+        app.get_json("/healthz").await,
+        json!({"status": "ok", "writable": true})
+    );
+    assert_eq!(app.get_json("/readyz").await, json!({"status": "ready"}));
 }
 
 #[tokio::test]
@@ -160,6 +164,7 @@ fn the_openapi_document_describes_every_route_and_problem_schema() {
         "/conformance",
         "/openapi.json",
         "/healthz",
+        "/readyz",
         "/metrics",
         "/processes",
         "/processes/{processId}",

@@ -56,8 +56,9 @@ pub(crate) use on_both_backends;
 #[derive(Debug)]
 pub struct TestStore {
     pub database: DatabaseUrl,
-    /// The SQLite file's directory (unused with PostgreSQL), deleted with the store.
-    _dir: TempDir,
+    /// The SQLite file's directory (unused with PostgreSQL), deleted with the store;
+    /// `None` when the test owns the directory ([`TestStore::sqlite_at`]).
+    _dir: Option<TempDir>,
 }
 
 impl TestStore {
@@ -68,7 +69,19 @@ impl TestStore {
             Backend::Sqlite => DatabaseUrl::Sqlite(dir.path().join("chocmodal.sqlite")),
             Backend::Postgres => DatabaseUrl::Postgres(crate::postgres::fresh_database().await),
         };
-        Self { database, _dir: dir }
+        Self {
+            database,
+            _dir: Some(dir),
+        }
+    }
+
+    /// A SQLite database at `path`, in a directory the caller owns (a mounted file
+    /// system).
+    pub fn sqlite_at(path: std::path::PathBuf) -> Self {
+        Self {
+            database: DatabaseUrl::Sqlite(path),
+            _dir: None,
+        }
     }
 }
 

@@ -639,3 +639,49 @@ async fn unknown_ids_and_file_paths_in_a_job_are_refused_at_their_pointer() {
     let jobs = app.get_json("/jobs").await;
     assert_eq!(jobs["jobs"], json!([]), "nothing queued: {jobs}");
 }
+
+/// Accelerations of 1e154 m/s² square to 1e308, at the edge of `f64`: such a record
+/// (a hostile or broken upload) is stored with its exact Arias intensity π/(2g)∫a²dt,
+/// computed without overflow (here a constant A over T = 2 s: π A² T/(2g), about
+/// 3.2e307 m/s), not a 500; one whose intensity is beyond the largest number is a 422 at
+/// `/acceleration` stating the bound. Its metadata and spectrum read back.
+#[tokio::test]
+async fn huge_accelerations_get_their_exact_arias_intensity_or_a_422_stating_the_bound() {
+    let app = spawn_with_bundle().await;
+    let amplitude = 1e154;
+    let metadata = app
+        .upload_signal(
+            format!("time,acceleration\n0,{amplitude:e}\n1,{amplitude:e}\n2,{amplitude:e}\n"),
+            "text/csv",
+            "",
+        )
+        .await;
+    // In the order that stays finite: π/(2g)·T first.
+    let expected = PI / (2.0 * G) * 2.0 * amplitude * amplitude;
+    let measured = metadata["arias_intensity"]
+        .as_f64()
+        .expect("a finite Arias intensity");
+    assert!(
+        ((measured - expected) / expected).abs() < 1e-12,
+        "Arias measured {measured:e} vs expected {expected:e}"
+    );
+    assert_eq!(metadata["pga"], amplitude);
+    let id = metadata["id"].as_str().unwrap();
+    let read = app.get_json(&format!("/signals/{id}")).await;
+    assert_eq!(read["arias_intensity"], metadata["arias_intensity"]);
+
+    let response = app
+        .post_signal(
+            r#"{"time": [0, 1000000], "acceleration": [1e300, 1e300]}"#,
+            "application/json",
+            "",
+        )
+        .await;
+    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-signal").await;
+    assert_eq!(problem["errors"][0]["pointer"], "/acceleration", "{problem}");
+    let detail = problem["errors"][0]["detail"].as_str().unwrap();
+    assert!(
+        detail.contains("Arias intensity") && detail.contains("1.7976931348623157e308"),
+        "{detail}"
+    );
+}

@@ -129,7 +129,11 @@ async fn without_a_token_every_route_but_the_health_check_is_a_401_problem() {
     // Before anything reads the body: no 413, 415 or 422 for an unauthenticated client.
     let response = app.post_execution_raw(counting::ID, "not even json").await;
     assert_problem(response, StatusCode::UNAUTHORIZED, "/unauthorized").await;
-    assert_eq!(app.get_json("/healthz").await, json!({"status": "ok"}));
+    assert_eq!(
+        app.get_json("/healthz").await,
+        json!({"status": "ok", "writable": true})
+    );
+    assert_eq!(app.get_json("/readyz").await, json!({"status": "ready"}));
 }
 
 #[tokio::test]

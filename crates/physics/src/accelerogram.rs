@@ -10,6 +10,9 @@
 //!   h (a₀² + a₀a₁ + a₁²)/3. For a sine of amplitude A over whole periods, ∫ a² dt = A² T/2
 //!   (T the record's length); the sampled record's value is within (ωh)²/6 of it
 //!   (relative), from the linear interpolation between samples.
+//!   The squares are taken of a/PGA (at most 1 in size) and the sum scaled back by PGA²
+//!   at the end: accelerations up to the largest finite number never overflow in the
+//!   sum, and the intensity is infinite only when its true value is beyond `f64::MAX`.
 
 use crate::loads::Table;
 
@@ -52,18 +55,6 @@ impl RecordSummary {
         if time.len() < 2 || time.len() != values.len() {
             return None;
         }
-        let (mut shortest, mut longest) = (f64::INFINITY, 0.0f64);
-        let mut square_integral = 0.0;
-        for k in 1..time.len() {
-            let h = time[k] - time[k - 1];
-            if h.is_nan() || h <= 0.0 {
-                return None;
-            }
-            shortest = shortest.min(h);
-            longest = longest.max(h);
-            let (a0, a1) = (values[k - 1], values[k]);
-            square_integral += h * (a0 * a0 + a0 * a1 + a1 * a1) / 3.0;
-        }
         let (mut pga, mut pga_time) = (0.0f64, time[0]);
         for (t, a) in time.iter().zip(values) {
             if a.abs() > pga {
@@ -71,6 +62,23 @@ impl RecordSummary {
                 pga_time = *t;
             }
         }
+        // ∫ (a/PGA)² dt: each scaled sample is at most 1 in size, so no square overflows.
+        let scale = if pga > 0.0 { pga } else { 1.0 };
+        let (mut shortest, mut longest) = (f64::INFINITY, 0.0f64);
+        let mut scaled_square_integral = 0.0;
+        for k in 1..time.len() {
+            let h = time[k] - time[k - 1];
+            if h.is_nan() || h <= 0.0 {
+                return None;
+            }
+            shortest = shortest.min(h);
+            longest = longest.max(h);
+            let (a0, a1) = (values[k - 1] / scale, values[k] / scale);
+            scaled_square_integral += h * (a0 * a0 + a0 * a1 + a1 * a1) / 3.0;
+        }
+        // π/(2g) · PGA² · ∫ (a/PGA)² dt, multiplied in the order that overflows last.
+        let arias_intensity =
+            std::f64::consts::PI / (2.0 * STANDARD_GRAVITY) * scaled_square_integral * scale * scale;
         let duration = time[time.len() - 1] - time[0];
         let mean = duration / (time.len() - 1) as f64;
         Some(Self {
@@ -83,7 +91,7 @@ impl RecordSummary {
             uniform: (longest - shortest) <= UNIFORM_TOLERANCE * mean,
             pga,
             pga_time,
-            arias_intensity: std::f64::consts::PI / (2.0 * STANDARD_GRAVITY) * square_integral,
+            arias_intensity,
         })
     }
 }
@@ -132,6 +140,36 @@ mod tests {
             "Arias measured {} vs expected {expected} (relative {relative:e}, bound {bound:e})",
             summary.arias_intensity
         );
+    }
+
+    /// Accelerations of 1e154 m/s² square to 1e308, at the edge of `f64`: a constant
+    /// record of that size over 2 s still has its exact intensity π A² T/(2g) (finite,
+    /// about 1.6e307 m/s), and one whose true intensity is beyond `f64::MAX` is infinite
+    /// (never NaN).
+    #[test]
+    fn huge_accelerations_do_not_overflow_the_arias_intensity() {
+        let amplitude = 1e154;
+        let record = Table {
+            time: vec![0.0, 1.0, 2.0],
+            values: vec![amplitude, -amplitude, amplitude],
+        };
+        let summary = RecordSummary::of(&record).unwrap();
+        // Two segments from A to −A: each ∫a² = h (A² − A² + A²)/3 = A²/3.
+        let expected = std::f64::consts::PI / (2.0 * STANDARD_GRAVITY) * (2.0 / 3.0) * amplitude * amplitude;
+        assert!(expected.is_finite());
+        let relative = (summary.arias_intensity - expected).abs() / expected;
+        assert!(
+            relative < 1e-14,
+            "Arias measured {:e} vs expected {expected:e}",
+            summary.arias_intensity
+        );
+        let beyond = Table {
+            time: vec![0.0, 1e6],
+            values: vec![1e307, 1e307],
+        };
+        let summary = RecordSummary::of(&beyond).unwrap();
+        assert_eq!(summary.arias_intensity, f64::INFINITY, "{summary:?}");
+        assert_eq!(summary.pga, 1e307);
     }
 
     /// On a linear segment the square integral is exact: a ramp 0 → A over h gives A²h/3.

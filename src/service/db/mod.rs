@@ -6,7 +6,9 @@
 //! pool ([`with_pool!`]); the few that differ (the claim, JSON array parameters) pick
 //! their text with [`Database::choose`].
 
+pub mod fault;
 pub mod postgres;
+pub mod release;
 pub mod sqlite;
 
 use std::fmt;
@@ -104,12 +106,22 @@ impl Database {
     /// missing) and brings its schema up to date. `max_connections` sizes a PostgreSQL
     /// pool (SQLite has one writer anyway and keeps its own size).
     pub async fn open(url: &DatabaseUrl, max_connections: u32) -> Result<Self, sqlx::Error> {
+        Self::open_limited(url, max_connections, None).await
+    }
+
+    /// [`Database::open`], with a SQLite database capped at `max_sqlite_bytes`
+    /// ([`sqlite::open`]; ignored for PostgreSQL, whose size is its server's business).
+    pub async fn open_limited(
+        url: &DatabaseUrl,
+        max_connections: u32,
+        max_sqlite_bytes: Option<u64>,
+    ) -> Result<Self, sqlx::Error> {
         match url {
             DatabaseUrl::Sqlite(path) => {
                 if let Some(dir) = path.parent().filter(|dir| !dir.as_os_str().is_empty()) {
                     std::fs::create_dir_all(dir)?;
                 }
-                Ok(Self::Sqlite(sqlite::open(path).await?))
+                Ok(Self::Sqlite(sqlite::open(path, max_sqlite_bytes).await?))
             }
             DatabaseUrl::Postgres(url) => Ok(Self::Postgres(postgres::open(url, max_connections).await?)),
         }
@@ -148,6 +160,22 @@ impl Database {
     /// Whether the database answers (health checks).
     pub async fn ping(&self) -> Result<(), sqlx::Error> {
         with_pool!(self, pool => sqlx::query("SELECT 1").execute(pool).await.map(|_| ()))
+    }
+
+    /// Whether the database takes a write: rewrites the one row of `write_probe`
+    /// (`migrations/0007`) in a transaction and commits it (`/readyz`).
+    pub async fn probe_write(&self, now_ms: i64) -> Result<(), sqlx::Error> {
+        with_pool!(self, pool => {
+            let mut tx = pool.begin().await?;
+            sqlx::query(
+                "INSERT INTO write_probe (id, probed_at) VALUES (1, $1) \
+                 ON CONFLICT (id) DO UPDATE SET probed_at = excluded.probed_at",
+            )
+            .bind(now_ms)
+            .execute(&mut *tx)
+            .await?;
+            tx.commit().await
+        })
     }
 
     /// Closes every connection (pending statements fail from now on).

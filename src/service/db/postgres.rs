@@ -25,6 +25,7 @@ pub async fn open(url: &str, max_connections: u32) -> Result<PgPool, sqlx::Error
         .max_connections(max_connections)
         .min_connections(1)
         .acquire_timeout(Duration::from_secs(10))
+        .after_release(super::release::postgres_after_release)
         .connect(url)
         .await?;
     sqlx::migrate!("./migrations/postgres").run(&pool).await?;

@@ -33,7 +33,10 @@ pub struct AuthPolicy {
 
 /// Routes that answer without a token.
 fn is_open(policy: &AuthPolicy, path: &str) -> bool {
-    path == "/healthz" || path.starts_with("/ui/") || (policy.metrics_public && path == "/metrics")
+    path == "/healthz"
+        || path == "/readyz"
+        || path.starts_with("/ui/")
+        || (policy.metrics_public && path == "/metrics")
 }
 
 /// The dashboard page a browser asks for, if the request is one.

@@ -7,7 +7,9 @@
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 
-use crate::problem::Problem;
+use crate::problem::{CHOCMODAL_PROBLEMS, Problem};
+use crate::service::db::fault::StorageFault;
+use crate::service::storage_health::FAILURE_MEMORY;
 
 /// Media type of problem documents.
 pub const PROBLEM_JSON: &str = "application/problem+json";
@@ -21,7 +23,9 @@ pub enum ApiError {
     /// The problem's status (429): try again after `retry_after` seconds (`Retry-After`).
     #[error("{}", .problem.detail)]
     RetryLater { problem: Box<Problem>, retry_after: u64 },
-    /// 500: the database failed; logged, hidden from the client.
+    /// 507 (full disk) or 503 (I/O error) with `Retry-After` when the storage refused a
+    /// write ([`StorageFault`]): nothing was stored, the problem names the cause. Any
+    /// other database failure is a 500, logged and hidden from the client.
     #[error("database: {0}")]
     Database(#[from] sqlx::Error),
     /// 500: any other unexpected failure; logged, hidden from the client.
@@ -59,16 +63,46 @@ impl IntoResponse for ApiError {
                     .insert(header::RETRY_AFTER, HeaderValue::from(retry_after));
                 response
             }
-            ApiError::Database(error) => {
-                tracing::error!(%error, "database error while handling a request");
-                problem_response(&Problem::internal())
-            }
+            ApiError::Database(error) => match StorageFault::of(&error) {
+                Some(fault) => {
+                    tracing::error!(%error, cause = fault.cause(), "the storage refused a write");
+                    storage_fault_response(fault)
+                }
+                None => {
+                    tracing::error!(%error, "database error while handling a request");
+                    problem_response(&Problem::internal())
+                }
+            },
             ApiError::Internal(error) => {
                 tracing::error!(%error, "internal error while handling a request");
                 problem_response(&Problem::internal())
             }
         }
     }
+}
+
+/// Seconds a client whose write the storage refused is asked to wait (`Retry-After`).
+pub const STORAGE_RETRY_SECONDS: u64 = FAILURE_MEMORY.as_secs();
+
+/// 507 `storage-full` or 503 `storage-unavailable`, with `Retry-After` and the fault as
+/// a response extension (the request tracker reports it to [`crate::service::storage_health`]).
+pub fn storage_fault_response(fault: StorageFault) -> Response {
+    let (slug, title) = match fault {
+        StorageFault::Full(_) => ("storage-full", "Insufficient storage"),
+        StorageFault::Io => ("storage-unavailable", "Storage unavailable"),
+    };
+    let problem = Problem::new(
+        format!("{CHOCMODAL_PROBLEMS}/{slug}"),
+        title,
+        fault.status(),
+        format!("{fault}: nothing was stored; retry in {STORAGE_RETRY_SECONDS} s (reads still work)"),
+    );
+    let mut response = problem_response(&problem);
+    response
+        .headers_mut()
+        .insert(header::RETRY_AFTER, HeaderValue::from(STORAGE_RETRY_SECONDS));
+    response.extensions_mut().insert(fault);
+    response
 }
 
 /// A problem document with its status and `application/problem+json`.

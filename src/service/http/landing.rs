@@ -7,7 +7,7 @@ use axum::response::{IntoResponse, Response};
 
 use super::AppState;
 use super::error::ApiError;
-use super::models::{Conformance, Health, LandingPage, Link};
+use super::models::{Conformance, Health, LandingPage, Link, Readiness};
 use super::openapi;
 
 const OGC_CONFORMANCE: &[&str] = &[
@@ -87,7 +87,8 @@ pub async fn conformance() -> Json<Conformance> {
 
 /// Liveness
 ///
-/// 200 while the service answers and its database responds, 503 otherwise.
+/// 200 while the service answers and its database responds (`writable` says whether the
+/// storage takes writes: a full disk does not make the service dead), 503 otherwise.
 #[utoipa::path(get, path = "/healthz", operation_id = "getHealth", tag = "Operations",
     responses(
         (status = 200, description = "Alive", body = Health),
@@ -95,7 +96,19 @@ pub async fn conformance() -> Json<Conformance> {
             content_type = "application/problem+json")))]
 pub async fn healthz(State(state): State<AppState>) -> Response {
     match state.queue.database().ping().await {
-        Ok(()) => Json(Health { status: "ok" }).into_response(),
+        Ok(()) => {
+            let fault = state
+                .metrics
+                .storage()
+                .current()
+                .map(|cannot| cannot.fault.cause());
+            Json(Health {
+                status: "ok",
+                writable: fault.is_none(),
+                storage_fault: fault,
+            })
+            .into_response()
+        }
         Err(error) => {
             tracing::error!(%error, "health check: database unavailable");
             crate::problem::Problem::from_status(503, "Service Unavailable", "the database does not respond")
@@ -104,12 +117,59 @@ pub async fn healthz(State(state): State<AppState>) -> Response {
     }
 }
 
+/// Readiness
+///
+/// 200 `{"status": "ready"}` when the database takes a write: a probe write (one row,
+/// in a transaction) commits, and no write was refused by the storage in the last 5 s. Otherwise 507 `storage-full` (full disk: `SQLITE_FULL`,
+/// PostgreSQL `53100` `disk_full`, `ENOSPC`) or 503 `storage-unavailable` (I/O error,
+/// or a database that does not answer), with `Retry-After`; reads keep working
+/// meanwhile, and readiness comes back on its own once space is freed.
+#[utoipa::path(get, path = "/readyz", operation_id = "getReadiness", tag = "Operations",
+    responses(
+        (status = 200, description = "Ready: the database takes writes", body = Readiness),
+        (status = 503, description = "The storage failed an I/O operation or the database does not respond (`storage-unavailable`)",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json",
+            headers(("Retry-After" = u64, description = "Seconds to wait"))),
+        (status = 507, description = "The disk is full (`storage-full`), naming the cause",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json",
+            headers(("Retry-After" = u64, description = "Seconds to wait")))))]
+pub async fn readyz(State(state): State<AppState>) -> Response {
+    let storage = state.metrics.storage();
+    let now = state.queue.clock().now_ms();
+    match state.queue.database().probe_write(now).await {
+        Ok(()) => match storage.current() {
+            // The probe fits where a larger write did not (free pages, the WAL's
+            // reused space): a recent refusal still counts.
+            Some(cannot) => super::error::storage_fault_response(cannot.fault),
+            None => Json(Readiness { status: "ready" }).into_response(),
+        },
+        Err(error) => match storage.check(&error, "probe") {
+            Some(fault) => super::error::storage_fault_response(fault),
+            None => {
+                tracing::error!(%error, "readiness: the database does not take a write");
+                let mut response = crate::problem::Problem::from_status(
+                    503,
+                    "Service Unavailable",
+                    "the database does not take a write (see the service's log)",
+                )
+                .into_response();
+                response.headers_mut().insert(
+                    header::RETRY_AFTER,
+                    HeaderValue::from(super::error::STORAGE_RETRY_SECONDS),
+                );
+                response
+            }
+        },
+    }
+}
+
 /// Prometheus metrics
 ///
 /// Text exposition format: `chocmodal_jobs{status}` (gauge), `chocmodal_job_duration_seconds`
 /// and `chocmodal_job_queue_wait_seconds` (histograms, s), `chocmodal_jobs_rescued_total`,
 /// `chocmodal_jobs_abandoned_total`, `chocmodal_http_requests_total{method,route,status}`,
-/// `chocmodal_http_request_duration_seconds` (s).
+/// `chocmodal_http_request_duration_seconds` (s), `chocmodal_failed_writes_total{cause,during}`
+/// (writes the storage refused).
 #[utoipa::path(get, path = "/metrics", operation_id = "getMetrics", tag = "Operations",
     responses((status = 200, description = "Prometheus text format", body = String,
         content_type = "text/plain; version=0.0.4")))]

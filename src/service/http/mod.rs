@@ -10,6 +10,7 @@ pub mod dashboard;
 pub mod error;
 pub mod extract;
 mod history_view;
+pub mod idempotency;
 pub mod impacts;
 pub mod job_inputs;
 pub mod jobs;
@@ -42,6 +43,7 @@ use tower_http::trace::{DefaultMakeSpan, DefaultOnResponse, TraceLayer};
 use tracing::Level;
 
 use super::auth::TokenTable;
+use super::db::fault::StorageFault;
 use super::metrics::Metrics;
 use super::queue::JobQueue;
 use super::signals::SignalStore;
@@ -102,6 +104,7 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/", get(landing::landing))
         .route("/conformance", get(landing::conformance))
         .route("/healthz", get(landing::healthz))
+        .route("/readyz", get(landing::readyz))
         .route("/metrics", get(landing::metrics))
         .route("/openapi.json", get(landing::openapi_document))
         .route("/processes", get(processes::list))
@@ -171,6 +174,7 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
 pub fn health_router(state: AppState) -> Router {
     Router::new()
         .route("/healthz", get(landing::healthz))
+        .route("/readyz", get(landing::readyz))
         .route("/metrics", get(landing::metrics))
         .fallback(not_found)
         .with_state(state)
@@ -241,5 +245,12 @@ async fn track_request(State(state): State<AppState>, request: Request, next: Ne
     state
         .metrics
         .observe_request(&method, &route, response.status().as_u16(), started.elapsed());
+    // A refused write says why (`error::storage_fault_response`); `/readyz` reports its
+    // own probe.
+    if let Some(fault) = response.extensions().get::<StorageFault>()
+        && route != "/readyz"
+    {
+        state.metrics.storage().failed(*fault, "request");
+    }
     response
 }

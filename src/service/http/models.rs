@@ -242,4 +242,18 @@ pub struct Conformance {
 pub struct Health {
     /// `ok` when the service answers and its database responds.
     pub status: &'static str,
+    /// `false` while the storage refuses writes (a write was refused in the last 5 s);
+    /// the service stays alive and keeps serving reads.
+    pub writable: bool,
+    /// Why writes are refused: `SQLITE_FULL`, `disk_full` (PostgreSQL 53100), `ENOSPC`
+    /// or `io_error`; absent while writable.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub storage_fault: Option<&'static str>,
+}
+
+/// Readiness.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct Readiness {
+    /// `ready`: the database answers and takes writes.
+    pub status: &'static str,
 }

@@ -105,7 +105,7 @@ impl Modify for BearerSecurity {
                     .description(Some(
                         "A token of the service's auth file (`--auth-file`), as `Authorization: Bearer \
                          <token>`. Not needed when the service runs without an auth file (one \
-                         implicit tenant), nor for `/healthz`, nor for `/metrics` with `--metrics-public`.",
+                         implicit tenant), nor for `/healthz` and `/readyz`, nor for `/metrics` with `--metrics-public`.",
                     ))
                     .build(),
             ),
@@ -124,7 +124,7 @@ impl Modify for BearerSecurity {
             let operations: [&mut Option<Operation>; 4] =
                 [&mut item.get, &mut item.put, &mut item.post, &mut item.delete];
             for operation in operations.into_iter().flatten() {
-                if path == "/healthz" {
+                if path == "/healthz" || path == "/readyz" {
                     // An empty requirement: no authentication.
                     operation.security = Some(vec![SecurityRequirement::default()]);
                 } else {
@@ -207,6 +207,7 @@ impl Modify for ResourceLinks {
         landing::conformance,
         landing::openapi_document,
         landing::healthz,
+        landing::readyz,
         landing::metrics,
         processes::list,
         processes::describe,
@@ -256,6 +257,7 @@ impl Modify for ResourceLinks {
         models::LandingPage,
         models::Conformance,
         models::Health,
+        models::Readiness,
         sweep_models::SweepState,
         sweep_models::RunCounts,
         sweep_models::SweepStatus,

@@ -10,11 +10,13 @@ use axum::response::{IntoResponse, Response};
 use super::AppState;
 use super::error::ApiError;
 use super::extract::ExecutionInputs;
+use super::idempotency::{IdempotencyHeader, key_reused, mark_replayed};
 use super::models::{ExecuteRequest, Link, ProcessDescription, ProcessList, ProcessSummary, StatusInfo};
 use crate::problem::Problem;
 use crate::processes::Process;
 use crate::service::auth::Tenant;
 use crate::service::queue::Admission;
+use crate::service::queue::idempotency::{KeyedRequest, Kind, RequestHash};
 
 fn summary(process: &dyn Process) -> ProcessSummary {
     let href = format!("/processes/{}", process.id());
@@ -77,24 +79,32 @@ pub async fn describe(
 /// field, each with a JSON pointer into the request body (`/inputs/beam/modes`). A run
 /// whose estimated cost is above this service's ceilings: 422 `too-costly`, pointing at
 /// the fields that drive the cost. Too many queued jobs already: 429 with `Retry-After`.
+/// A retry with the same `Idempotency-Key` and inputs gets the same job back. The disk
+/// full: 507 `storage-full` with `Retry-After`, nothing queued.
 #[utoipa::path(post, path = "/processes/{processId}/execution", operation_id = "execute", tag = "Processes",
-    params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`", example = "cantilever-impact")),
+    params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`", example = "cantilever-impact"),
+        ("Idempotency-Key" = Option<String>, Header, description = "Optional, 1 to 255 visible ASCII characters: a retry with the same key and the same request gets the same resource back (same id, `201`, same `Location`, plus `Idempotent-Replayed: true`) instead of creating another; the same key with another request is a 422 `idempotency-key-reused`. Keys are per tenant and kept as long as the resource they created.")),
     request_body(content = ExecuteRequest, description = "`{\"inputs\": {...}}`, see the process description"),
     responses(
         (status = 201, description = "Job queued", body = StatusInfo,
             headers(("Location" = String, description = "`/jobs/{jobId}`"))),
-        (status = 400, description = "Malformed JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 400, description = "Malformed JSON, or an invalid `Idempotency-Key` (`invalid-header`)", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 404, description = "No such process", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 413, description = "Body over the size limit", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 415, description = "Body not declared as JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
-        (status = 422, description = "Invalid inputs (`invalid-inputs`), or a run above the cost ceilings (`too-costly`), with `errors` pointers",
+        (status = 422, description = "Invalid inputs (`invalid-inputs`), or a run above the cost ceilings (`too-costly`), with `errors` pointers; or an `Idempotency-Key` first sent with another request (`idempotency-key-reused`)",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 429, description = "Too many queued jobs (`too-many-queued-jobs`)", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json", headers(("Retry-After" = String, description = "s"))),
+        (status = 503, description = "The storage failed an I/O operation (`storage-unavailable`): nothing queued", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json", headers(("Retry-After" = String, description = "s"))),
+        (status = 507, description = "The disk is full (`storage-full`, naming SQLITE_FULL, disk_full or ENOSPC): nothing queued", body = super::openapi::ProblemSchema,
             content_type = "application/problem+json", headers(("Retry-After" = String, description = "s")))))]
 pub async fn execute(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
     Path(process_id): Path<String>,
+    IdempotencyHeader(key): IdempotencyHeader,
     body: Result<ExecutionInputs, ApiError>,
 ) -> Result<Response, ApiError> {
     // An unknown process is reported before anything about the body.
@@ -103,6 +113,11 @@ pub async fn execute(
         .get(&process_id)
         .ok_or_else(|| Problem::no_such_process(&process_id))?;
     let ExecutionInputs(inputs) = body?;
+    let keyed = key.map(|key| KeyedRequest {
+        key,
+        kind: Kind::Job,
+        hash: RequestHash::of_json(Kind::Job, &process_id, &inputs),
+    });
     // The stored signals the inputs refer to, the tenant's only: resolved now, so that an
     // unknown or foreign id is refused at its pointer before anything is queued.
     let signals = state.signals.library(tenant.as_str(), &inputs).await?;
@@ -127,10 +142,22 @@ pub async fn execute(
             &inputs,
             &validated.warnings,
             state.max_queued_jobs,
+            keyed.as_ref(),
         )
         .await?;
+    let mut headers = HeaderMap::new();
     let job = match admission {
-        Admission::Admitted(job) => job,
+        Admission::Admitted(job) => {
+            state.wake.notify_one();
+            tracing::info!(job = %job.id, process = %process_id, %tenant, "job queued");
+            job
+        }
+        Admission::Replayed(job) => {
+            tracing::info!(job = %job.id, %tenant, "idempotent retry: the key's job, nothing queued");
+            mark_replayed(&mut headers);
+            job
+        }
+        Admission::KeyConflict(conflict) => return Err(key_reused(&conflict)),
         Admission::QueueFull { queued } => {
             return Err(ApiError::queue_full(
                 queued,
@@ -139,9 +166,6 @@ pub async fn execute(
             ));
         }
     };
-    state.wake.notify_one();
-    tracing::info!(job = %job.id, process = %process_id, %tenant, "job queued");
-    let mut headers = HeaderMap::new();
     headers.insert(
         header::LOCATION,
         HeaderValue::from_str(&format!("/jobs/{}", job.id)).expect("uuid is a valid header value"),

@@ -18,6 +18,7 @@ use super::AppState;
 use super::error::ApiError;
 use super::extract::ApiQuery;
 use super::history_view::Format;
+use super::idempotency::{IdempotencyHeader, key_reused, mark_replayed};
 use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
 use super::models::Link;
 use super::response_spectra::{parse_spectrum_query, spectra_csv};
@@ -25,6 +26,7 @@ use super::signal_models::{DampedSpectrum, SignalList, SignalMetadata, SignalSpe
 use crate::physics::response_spectrum::{self, log_spaced};
 use crate::problem::Problem;
 use crate::service::auth::Tenant;
+use crate::service::queue::idempotency::{Keyed, KeyedRequest, Kind, RequestHash};
 use crate::service::signals::SignalReadError;
 use crate::service::signals::create::CreateError;
 use crate::service::signals::delete::Deletion;
@@ -80,22 +82,30 @@ fn upload_format(headers: &HeaderMap, text: &str) -> Result<RecordFormat, ApiErr
 /// `{"type": "signal", "id": "<id>", "scale": 1.0}`. A bad record is a 422
 /// `invalid-signal` with an error per sample at fault (`/acceleration/17`, the detail
 /// naming the CSV line); a body or record over this route's limits is a 413 stating them.
+/// A record whose Arias intensity is beyond the largest number (accelerations of order
+/// 1e154 m/s² held for seconds) is a 422 at `/acceleration`. A retry with the same
+/// `Idempotency-Key` and body gets the same signal back.
 #[utoipa::path(post, path = "/signals", operation_id = "createSignal", tag = "Signals",
-    params(UploadQuery),
+    params(UploadQuery, ("Idempotency-Key" = Option<String>, Header, description = "Optional, 1 to 255 visible ASCII characters: a retry with the same key and the same request gets the same resource back (same id, `201`, same `Location`, plus `Idempotent-Replayed: true`) instead of creating another; the same key with another request is a 422 `idempotency-key-reused`. Keys are per tenant and kept as long as the resource they created.")),
     request_body(description = "CSV `time,acceleration` (or one column with `sampling_rate`), or JSON `{\"time\", \"acceleration\"}` / `{\"sampling_rate\", \"acceleration\"}`",
         content((String = "text/csv"), (super::openapi::SignalUploadSchema = "application/json"))),
     responses(
         (status = 201, description = "Signal stored", body = SignalMetadata,
             headers(("Location" = String, description = "`/signals/{id}`"))),
-        (status = 400, description = "Malformed JSON or bad query parameter", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 400, description = "Malformed JSON, bad query parameter, or an invalid `Idempotency-Key` (`invalid-header`)", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 413, description = "Body or record over this route's limits (stated in the detail)", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 415, description = "Neither CSV nor JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
-        (status = 422, description = "Invalid record (`invalid-signal`): non-numeric or non-finite samples, times not increasing, a sampling rate not positive",
-            body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
+        (status = 422, description = "Invalid record (`invalid-signal`): non-numeric or non-finite samples, times not increasing, a sampling rate not positive, an Arias intensity beyond the largest number; or an `Idempotency-Key` first sent with another request (`idempotency-key-reused`)",
+            body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 503, description = "The storage failed an I/O operation (`storage-unavailable`): nothing stored", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json", headers(("Retry-After" = String, description = "s"))),
+        (status = 507, description = "The disk is full (`storage-full`, naming SQLITE_FULL, disk_full or ENOSPC): nothing stored", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json", headers(("Retry-After" = String, description = "s")))))]
 pub async fn create(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
     ApiQuery(query): ApiQuery<UploadQuery>,
+    IdempotencyHeader(key): IdempotencyHeader,
     headers: HeaderMap,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Response, ApiError> {
@@ -122,6 +132,15 @@ pub async fn create(
     let text = String::from_utf8(bytes.to_vec())
         .map_err(|_| Problem::malformed_body("the body is not valid UTF-8"))?;
     let format = upload_format(&headers, &text)?;
+    let keyed = key.map(|key| KeyedRequest {
+        key,
+        kind: Kind::Signal,
+        hash: RequestHash::of_bytes(
+            Kind::Signal,
+            &format!("{format:?} sampling_rate={:?}", query.sampling_rate),
+            &bytes,
+        ),
+    });
     if format == RecordFormat::Json && query.sampling_rate.is_some() {
         return Err(Problem::invalid_query(
             "`sampling_rate` in the query goes with a CSV record; a JSON record gives it as its \
@@ -146,16 +165,27 @@ pub async fn create(
             .into(),
         }
     })?;
-    let stored = state
+    let created = state
         .signals
-        .create(tenant.as_str(), &record)
+        .create(tenant.as_str(), &record, keyed.as_ref())
         .await
         .map_err(|error| match error {
             CreateError::Database(error) => ApiError::Database(error),
             unchecked => ApiError::Internal(unchecked.to_string()),
         })?;
-    tracing::info!(signal = %stored.id, samples = stored.samples, %tenant, "signal stored");
     let mut headers = HeaderMap::new();
+    let stored = match created {
+        Keyed::Created(stored) => {
+            tracing::info!(signal = %stored.id, samples = stored.samples, %tenant, "signal stored");
+            stored
+        }
+        Keyed::Replayed(stored) => {
+            tracing::info!(signal = %stored.id, %tenant, "idempotent retry: the key's signal, nothing stored");
+            mark_replayed(&mut headers);
+            stored
+        }
+        Keyed::Conflict(conflict) => return Err(key_reused(&conflict)),
+    };
     headers.insert(
         header::LOCATION,
         HeaderValue::from_str(&format!("/signals/{}", stored.id)).expect("uuid is a valid header value"),
@@ -258,7 +288,9 @@ pub async fn list(
         (status = 404, description = "No such signal (`no-such-signal`)", body = super::openapi::ProblemSchema,
             content_type = "application/problem+json"),
         (status = 409, description = "Queued or running jobs refer to it (`signal-in-use`)", body = super::openapi::ProblemSchema,
-            content_type = "application/problem+json")))]
+            content_type = "application/problem+json"),
+        (status = 507, description = "The disk is full (`storage-full`, naming the cause): the signal is kept", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json", headers(("Retry-After" = String, description = "s")))))]
 pub async fn delete(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,

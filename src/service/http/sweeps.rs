@@ -11,12 +11,14 @@ use super::conditional::tagged;
 use super::error::ApiError;
 use super::extract::{ApiQuery, JsonBody};
 use super::history_view::Format;
+use super::idempotency::{IdempotencyHeader, key_reused, mark_replayed};
 use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
 use super::models::Link;
 use super::sweep_models::{SweepList, SweepResults, SweepStatus};
 use crate::problem::Problem;
 use crate::processes::{InvalidInputs, Process, TooCostly};
 use crate::service::auth::Tenant;
+use crate::service::queue::idempotency::{KeyedRequest, Kind, RequestHash};
 use crate::service::queue::sweep_create::{NewRun, NewSweep};
 use crate::service::queue::sweep_read::SweepRun;
 use crate::service::queue::{Admission, SweepRecord};
@@ -32,27 +34,39 @@ use crate::sweep::{SweepDefinition, SweepError};
 /// invalid: 422 with `errors` pointing into the request (`/axes/0/linspace`) or, for a
 /// generated run, `/runs/{run}/inputs/...` (the detail names the run's axis values).
 /// Every run must also be within the service's cost ceilings (422 `too-costly`, with
-/// the same run pointers), and the runs must fit in the tenant's queue (429).
+/// the same run pointers), and the runs must fit in the tenant's queue (429). A retry
+/// with the same `Idempotency-Key` and request gets the same sweep back.
 #[utoipa::path(post, path = "/sweeps", operation_id = "createSweep", tag = "Sweeps",
+    params(("Idempotency-Key" = Option<String>, Header, description = "Optional, 1 to 255 visible ASCII characters: a retry with the same key and the same request gets the same resource back (same id, `201`, same `Location`, plus `Idempotent-Replayed: true`) instead of creating another; the same key with another request is a 422 `idempotency-key-reused`. Keys are per tenant and kept as long as the resource they created.")),
     request_body(content = crate::sweep::SweepRequest, description = "The process, base inputs and axes"),
     responses(
         (status = 201, description = "Sweep queued", body = SweepStatus,
             headers(("Location" = String, description = "`/sweeps/{sweepId}`"))),
-        (status = 400, description = "Malformed JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
+        (status = 400, description = "Malformed JSON, or an invalid `Idempotency-Key` (`invalid-header`)", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 404, description = "No such process", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 413, description = "Body over the size limit", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 415, description = "Body not declared as JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
-        (status = 422, description = "Invalid sweep or run inputs (`invalid-inputs`), more runs than allowed (`sweep-too-large`), or a run above the cost ceilings (`too-costly`)",
+        (status = 422, description = "Invalid sweep or run inputs (`invalid-inputs`), more runs than allowed (`sweep-too-large`), or a run above the cost ceilings (`too-costly`); or an `Idempotency-Key` first sent with another request (`idempotency-key-reused`)",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 429, description = "The runs would exceed the limit of queued jobs (`too-many-queued-jobs`)",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json",
-            headers(("Retry-After" = String, description = "s")))))]
+            headers(("Retry-After" = String, description = "s"))),
+        (status = 503, description = "The storage failed an I/O operation (`storage-unavailable`): nothing stored", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json", headers(("Retry-After" = String, description = "s"))),
+        (status = 507, description = "The disk is full (`storage-full`, naming SQLITE_FULL, disk_full or ENOSPC): nothing stored", body = super::openapi::ProblemSchema,
+            content_type = "application/problem+json", headers(("Retry-After" = String, description = "s")))))]
 pub async fn create(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
+    IdempotencyHeader(key): IdempotencyHeader,
     body: Result<JsonBody, ApiError>,
 ) -> Result<Response, ApiError> {
     let JsonBody(body) = body?;
+    let keyed = key.map(|key| KeyedRequest {
+        key,
+        kind: Kind::Sweep,
+        hash: RequestHash::of_json(Kind::Sweep, "", &body),
+    });
     // The tenant's stored signals the base inputs or an axis refer to.
     let signals = state.signals.library(tenant.as_str(), &body).await?;
     let registry = state.registry.clone();
@@ -88,10 +102,23 @@ pub async fn create(
                 runs: &runs,
             },
             state.max_queued_jobs,
+            keyed.as_ref(),
         )
         .await?;
+    let mut headers = HeaderMap::new();
     let record = match admission {
-        Admission::Admitted(record) => record,
+        Admission::Admitted(record) => {
+            state.wake.notify_waiters();
+            state.wake.notify_one();
+            tracing::info!(sweep = %record.id, process = %record.process_id, runs = record.runs, %tenant, "sweep queued");
+            record
+        }
+        Admission::Replayed(record) => {
+            tracing::info!(sweep = %record.id, %tenant, "idempotent retry: the key's sweep, nothing queued");
+            mark_replayed(&mut headers);
+            record
+        }
+        Admission::KeyConflict(conflict) => return Err(key_reused(&conflict)),
         Admission::QueueFull { queued } => {
             let adding = runs.iter().filter(|run| run.invalid.is_none()).count();
             return Err(ApiError::queue_full(
@@ -101,11 +128,7 @@ pub async fn create(
             ));
         }
     };
-    state.wake.notify_waiters();
-    state.wake.notify_one();
-    tracing::info!(sweep = %record.id, process = %record.process_id, runs = record.runs, %tenant, "sweep queued");
     let status = sweep_status(&state, &tenant, &record).await?;
-    let mut headers = HeaderMap::new();
     headers.insert(
         header::LOCATION,
         HeaderValue::from_str(&format!("/sweeps/{}", record.id)).expect("uuid is a valid header value"),

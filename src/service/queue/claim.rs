@@ -5,7 +5,10 @@
 //! PostgreSQL: the candidate is picked in a CTE with `FOR UPDATE SKIP LOCKED` and
 //! `LIMIT 1` (a CTE is evaluated once, so the planner cannot claim more rows than
 //! asked), then updated: concurrent claimers skip each other's row instead of waiting
-//! or taking the same one. Nothing is held once the statement returns.
+//! or taking the same one. The statement runs in its own explicit transaction, committed
+//! before the claim is returned: a `RETURNING` read alone in autocommit would drop the
+//! commit's error (sqlx issue #3430), and a worker would run a job whose claim was never
+//! stored. Nothing is held once the claim returns.
 //!
 //! Order: single jobs first (oldest first), then sweep runs (oldest first). A sweep of
 //! thousands of runs queued before a single job never makes it wait for more than the
@@ -44,15 +47,18 @@ impl JobQueue {
         let now = self.now();
         let sql = self.db.choose(CLAIM_SQLITE, CLAIM_POSTGRES);
         with_pool!(&self.db, pool => {
+            let mut tx = pool.begin().await?;
             let row = sqlx::query(sql)
                 .bind(owner)
                 .bind(now.saturating_add(duration_ms(lease)))
                 .bind(now)
-                .fetch_optional(pool)
+                .fetch_optional(&mut *tx)
                 .await?;
             let Some(row) = row else {
+                tx.rollback().await?;
                 return Ok(None);
             };
+            tx.commit().await?;
             let inputs: String = row.try_get("inputs")?;
             let inputs = serde_json::from_str(&inputs).map_err(|e| sqlx::Error::ColumnDecode {
                 index: "inputs".into(),

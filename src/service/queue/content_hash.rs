@@ -28,7 +28,7 @@ pub fn content_hash(process_id: &str, inputs: &Value) -> String {
 }
 
 /// Canonical JSON: members sorted by key, no whitespace.
-fn canonical(value: &Value, out: &mut String) {
+pub(crate) fn canonical(value: &Value, out: &mut String) {
     match value {
         Value::Object(map) => {
             let mut members: Vec<(&String, &Value)> = map.iter().collect();

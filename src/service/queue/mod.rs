@@ -24,7 +24,15 @@
 //! - [`inputs`]: the inputs a job was submitted with;
 //! - [`reuse`]: complete a claimed job with the results of an identical one
 //!   ([`content_hash`]);
-//! - [`sweep_create`], [`sweep_read`], [`sweep_dismiss`]: sweeps, whose runs are jobs.
+//! - [`sweep_create`], [`sweep_read`], [`sweep_dismiss`]: sweeps, whose runs are jobs;
+//! - [`idempotency`]: `Idempotency-Key`s, stored with the job, sweep or signal they create.
+//!
+//! Every write is a transaction whose outcome the caller sees: a statement that returns
+//! rows (`... RETURNING`) or a write of several statements runs in an explicit
+//! transaction and is committed before the call returns (an autocommit `RETURNING` read
+//! with `fetch_one`/`fetch_optional` loses the commit's error, sqlx issue #3430); a lone
+//! `UPDATE`/`DELETE` runs to completion with `execute`, which reports its commit. A
+//! connection never goes back to the pool inside a transaction ([`super::db::release`]).
 
 pub mod claim;
 pub mod content_hash;
@@ -32,6 +40,7 @@ pub mod dismiss;
 pub mod enqueue;
 pub mod finish;
 pub mod heartbeat;
+pub mod idempotency;
 pub mod inputs;
 pub mod read;
 pub mod recovery;
@@ -231,6 +240,12 @@ pub enum Admission<T> {
     /// Nothing was queued: the tenant has `queued` accepted jobs, and the new ones would
     /// take it over the limit.
     QueueFull { queued: i64 },
+    /// Nothing was queued: the request's idempotency key created this, for the same
+    /// request, before.
+    Replayed(T),
+    /// Nothing was queued: the request's idempotency key was first used with another
+    /// request.
+    KeyConflict(idempotency::KeyConflict),
 }
 
 /// A sweep as stored: its definition and bookkeeping (its runs are jobs).

@@ -48,11 +48,13 @@ impl JobQueue {
         let now = self.now();
         let abandon = self.db.choose(ABANDON_SQLITE, ABANDON_POSTGRES);
         let recovered = with_pool!(&self.db, pool => {
+            // One transaction: both updates land, or neither (and the caller sees which).
+            let mut tx = pool.begin().await?;
             let failed: Vec<String> = sqlx::query_scalar(abandon)
                 .bind(now)
                 .bind(i64::from(max_attempts))
                 .bind(format!("{CHOCMODAL_PROBLEMS}/job-abandoned"))
-                .fetch_all(pool)
+                .fetch_all(&mut *tx)
                 .await?;
             let requeued: Vec<String> = sqlx::query_scalar(
                 "UPDATE jobs SET status = 'accepted', lease_owner = NULL, lease_expires_at = NULL, \
@@ -62,8 +64,9 @@ impl JobQueue {
             )
             .bind(now)
             .bind(i64::from(max_attempts))
-            .fetch_all(pool)
+            .fetch_all(&mut *tx)
             .await?;
+            tx.commit().await?;
             Recovered { requeued, failed }
         });
         if !recovered.requeued.is_empty() {

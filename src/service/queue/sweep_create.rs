@@ -11,6 +11,8 @@
 use serde_json::{Value, json};
 
 use super::content_hash::content_hash;
+use super::enqueue::{BEGIN_WRITE_POSTGRES, BEGIN_WRITE_SQLITE};
+use super::idempotency::{IdempotencyStore, KeyedRequest, Prior, is_key_taken};
 use super::{Admission, JobQueue, SweepRecord, sweep_columns};
 use crate::problem::Problem;
 use crate::service::db::{TenantQueueLock, with_pool};
@@ -72,10 +74,30 @@ impl JobQueue {
     /// Inserts the sweep and its runs (invalid runs directly as `failed`); returns the
     /// sweep, or nothing when its queued runs would give the tenant more than
     /// `max_queued` accepted jobs.
+    ///
+    /// With `key`, a sweep the key already created for the same request is returned
+    /// instead ([`Admission::Replayed`]), another request with that key is refused
+    /// ([`Admission::KeyConflict`]), and a new key is stored with the new sweep.
     pub async fn create_sweep(
         &self,
         sweep: &NewSweep<'_>,
         max_queued: Option<u64>,
+        key: Option<&KeyedRequest>,
+    ) -> Result<Admission<SweepRecord>, sqlx::Error> {
+        match self.create_sweep_once(sweep, max_queued, key).await {
+            // A concurrent first use of the same key won: this one now finds it.
+            Err(error) if key.is_some() && is_key_taken(&error) => {
+                self.create_sweep_once(sweep, max_queued, key).await
+            }
+            outcome => outcome,
+        }
+    }
+
+    async fn create_sweep_once(
+        &self,
+        sweep: &NewSweep<'_>,
+        max_queued: Option<u64>,
+        key: Option<&KeyedRequest>,
     ) -> Result<Admission<SweepRecord>, sqlx::Error> {
         let queued_runs = sweep.runs.iter().filter(|run| run.invalid.is_none()).count();
         let id = uuid::Uuid::new_v4().to_string();
@@ -97,9 +119,26 @@ impl JobQueue {
             })
             .collect();
         let runs = self.db.choose(RUNS_SQLITE, RUNS_POSTGRES);
+        let begin = self.db.choose(BEGIN_WRITE_SQLITE, BEGIN_WRITE_POSTGRES);
         let record = with_pool!(&self.db, pool => {
-            let mut tx = pool.begin().await?;
+            let mut tx = pool.begin_with(begin).await?;
             tx.lock_tenant_queue(sweep.tenant).await?;
+            if let Some(request) = key
+                && let Some(stored) = tx.find_key(sweep.tenant, &request.key).await?
+            {
+                let prior = match stored.prior_for(request) {
+                    Prior::Same(sweep_id) => Admission::Replayed(
+                        sqlx::query_as(concat!("SELECT ", sweep_columns!(), " FROM sweeps WHERE id = $1 AND tenant = $2"))
+                            .bind(&sweep_id)
+                            .bind(sweep.tenant)
+                            .fetch_one(&mut *tx)
+                            .await?,
+                    ),
+                    Prior::Conflict(conflict) => Admission::KeyConflict(conflict),
+                };
+                tx.rollback().await?;
+                return Ok(prior);
+            }
             let record: Option<SweepRecord> = sqlx::query_as(concat!(
                 "INSERT INTO sweeps (id, tenant, process_id, definition, design, policy, runs, created_at, \
                      updated_at) \
@@ -130,6 +169,9 @@ impl JobQueue {
                     .bind(sweep.tenant)
                     .execute(&mut *tx)
                     .await?;
+                if let (Some(record), Some(request)) = (&record, key) {
+                    tx.store_key(sweep.tenant, request, &record.id, now).await?;
+                }
                 tx.commit().await?;
             } else {
                 tx.rollback().await?;

@@ -6,6 +6,8 @@ use crate::physics::accelerogram::RecordSummary;
 use crate::physics::loads::Table;
 use crate::processes::History;
 use crate::service::db::with_pool;
+use crate::service::queue::enqueue::{BEGIN_WRITE_POSTGRES, BEGIN_WRITE_SQLITE};
+use crate::service::queue::idempotency::{IdempotencyStore, Keyed, KeyedRequest, Prior, is_key_taken};
 use crate::service::store;
 
 /// Why a record cannot be stored.
@@ -29,16 +31,59 @@ pub(super) fn as_history(record: &Table) -> History {
 }
 
 impl SignalStore {
-    /// Stores `record` (already checked) as a new signal of `tenant`.
-    pub async fn create(&self, tenant: &str, record: &Table) -> Result<SignalRecord, CreateError> {
+    /// Stores `record` (already checked) as a new signal of `tenant`. With `key`, a
+    /// signal the key already created for the same request is returned instead
+    /// ([`Keyed::Replayed`]) and another request with that key is refused
+    /// ([`Keyed::Conflict`]); a new key is stored with the new signal.
+    pub async fn create(
+        &self,
+        tenant: &str,
+        record: &Table,
+        key: Option<&KeyedRequest>,
+    ) -> Result<Keyed<SignalRecord>, CreateError> {
+        match self.create_once(tenant, record, key).await {
+            // A concurrent first use of the same key won: this one now finds it.
+            Err(CreateError::Database(error)) if key.is_some() && is_key_taken(&error) => {
+                self.create_once(tenant, record, key).await
+            }
+            outcome => outcome,
+        }
+    }
+
+    async fn create_once(
+        &self,
+        tenant: &str,
+        record: &Table,
+        key: Option<&KeyedRequest>,
+    ) -> Result<Keyed<SignalRecord>, CreateError> {
         let summary = RecordSummary::of(record)
             .ok_or_else(|| CreateError::Unchecked("fewer than 2 samples or times not increasing".into()))?;
         let stored = store::encode(&as_history(record)).map_err(|e| CreateError::Unchecked(e.to_string()))?;
         let id = uuid::Uuid::new_v4().to_string();
         let now = self.clock.now_ms();
         let samples = i64::try_from(summary.samples).unwrap_or(i64::MAX);
+        // An explicit transaction: the commit's outcome is this call's outcome (an
+        // autocommit `RETURNING` read with `fetch_one` drops it, sqlx issue #3430).
+        let begin = self.db.choose(BEGIN_WRITE_SQLITE, BEGIN_WRITE_POSTGRES);
         let created = with_pool!(&self.db, pool => {
-            sqlx::query_as(concat!(
+            let mut tx = pool.begin_with(begin).await?;
+            if let Some(request) = key
+                && let Some(stored) = tx.find_key(tenant, &request.key).await?
+            {
+                let prior = match stored.prior_for(request) {
+                    Prior::Same(signal_id) => Keyed::Replayed(
+                        sqlx::query_as(concat!("SELECT ", signal_columns!(), " FROM signals WHERE id = $1 AND tenant = $2"))
+                            .bind(&signal_id)
+                            .bind(tenant)
+                            .fetch_one(&mut *tx)
+                            .await?,
+                    ),
+                    Prior::Conflict(conflict) => Keyed::Conflict(conflict),
+                };
+                tx.rollback().await?;
+                return Ok(prior);
+            }
+            let created: SignalRecord = sqlx::query_as(concat!(
                 "INSERT INTO signals (id, tenant, samples, start_time, duration, sampling_interval, \
                      shortest_interval, longest_interval, uniform, pga, pga_time, arias_intensity, data, \
                      created_at) \
@@ -59,9 +104,14 @@ impl SignalStore {
             .bind(summary.arias_intensity)
             .bind(&stored.data)
             .bind(now)
-            .fetch_one(pool)
-            .await?
+            .fetch_one(&mut *tx)
+            .await?;
+            if let Some(request) = key {
+                tx.store_key(tenant, request, &created.id, now).await?;
+            }
+            tx.commit().await?;
+            created
         });
-        Ok(created)
+        Ok(Keyed::Created(created))
     }
 }

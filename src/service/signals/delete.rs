@@ -24,8 +24,10 @@ impl SignalStore {
     /// Deletes signal `id` of `tenant` unless an unfinished job of `tenant` refers to it.
     pub async fn delete(&self, tenant: &str, id: &str) -> Result<Deletion, sqlx::Error> {
         let pattern = format!("%\"{id}\"%");
+        // An explicit transaction: a `204` means the commit succeeded (sqlx issue #3430).
         let deleted: Option<String> = with_pool!(&self.db, pool => {
-            sqlx::query_scalar(
+            let mut tx = pool.begin().await?;
+            let deleted = sqlx::query_scalar(
                 "DELETE FROM signals WHERE id = $1 AND tenant = $2 AND NOT EXISTS (\
                      SELECT 1 FROM jobs WHERE tenant = $2 AND status IN ('accepted', 'running') \
                      AND inputs LIKE $3) \
@@ -34,8 +36,10 @@ impl SignalStore {
             .bind(id)
             .bind(tenant)
             .bind(&pattern)
-            .fetch_optional(pool)
-            .await?
+            .fetch_optional(&mut *tx)
+            .await?;
+            tx.commit().await?;
+            deleted
         });
         if deleted.is_some() {
             return Ok(Deletion::Deleted);

@@ -44,6 +44,19 @@ impl Maintenance {
         Ok(())
     }
 
+    /// The pass at start-up: a storage that refuses writes (a full disk) does not keep
+    /// the service from starting (it serves reads, refuses writes with 507, and the
+    /// periodic passes recover the leases once space is freed); other errors do.
+    pub async fn run_at_start(&self) -> Result<(), sqlx::Error> {
+        match self.run_once().await {
+            Err(error) if self.metrics.storage().check(&error, "maintenance").is_some() => {
+                tracing::error!(%error, "queue maintenance at start-up: the storage refuses writes; starting anyway");
+                Ok(())
+            }
+            outcome => outcome,
+        }
+    }
+
     /// Runs a pass every `interval`, forever (the caller aborts the task).
     pub async fn run_every(self, interval: Duration) {
         let mut ticker = tokio::time::interval(interval);
@@ -52,6 +65,7 @@ impl Maintenance {
         loop {
             ticker.tick().await;
             if let Err(error) = self.run_once().await {
+                self.metrics.storage().check(&error, "maintenance");
                 tracing::error!(%error, "queue maintenance failed");
             }
         }

@@ -11,6 +11,7 @@
 
 pub mod control;
 mod maintenance;
+mod persist;
 mod run;
 
 use std::sync::Arc;
@@ -179,7 +180,10 @@ async fn worker_loop(
                 continue;
             }
             Ok(None) => {}
-            Err(error) => tracing::error!(%error, worker = %owner, "claiming a job failed"),
+            Err(error) => {
+                ctx.metrics.storage().check(&error, "claim");
+                tracing::error!(%error, worker = %owner, "claiming a job failed")
+            }
         }
         drop(core);
         tokio::select! {

@@ -5,7 +5,8 @@
 //! copy progress into the row (only when the percent changed), renew the lease (every
 //! third of it), and check that the job is still ours (twice a second: a dismissal or a
 //! lost lease sets the cancel flag, and the run stops at its next progress callback).
-//! The outcome is then written under the lease guard.
+//! The outcome is then written under the lease guard, and retried while the storage
+//! refuses it ([`super::persist`]).
 
 use std::ops::ControlFlow;
 use std::panic::AssertUnwindSafe;
@@ -193,7 +194,10 @@ pub(super) async fn run_job(
                         lost = true;
                         control.cancel();
                     }
-                    Err(error) => tracing::warn!(job = %lease.job_id, %error, "heartbeat failed"),
+                    Err(error) => {
+                        ctx.metrics.storage().check(&error, "heartbeat");
+                        tracing::warn!(job = %lease.job_id, %error, "heartbeat failed")
+                    }
                 }
             }
         }
@@ -255,7 +259,10 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
                     record(
                         lease,
                         "complete",
-                        ctx.queue.complete(lease, &document, &histories).await,
+                        super::persist::until_stored(ctx, lease, "complete", || {
+                            ctx.queue.complete(lease, &document, &histories)
+                        })
+                        .await,
                     );
                     "successful"
                 }
@@ -264,7 +271,7 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
                     record(
                         lease,
                         "fail",
-                        ctx.queue.fail(lease, &crashed_problem(), Some(reached)).await,
+                        fail_stored(ctx, lease, &crashed_problem(), Some(reached)).await,
                     );
                     "crashed"
                 }
@@ -273,14 +280,18 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
                     record(
                         lease,
                         "fail",
-                        ctx.queue.fail(lease, &crashed_problem(), Some(reached)).await,
+                        fail_stored(ctx, lease, &crashed_problem(), Some(reached)).await,
                     );
                     "crashed"
                 }
             }
         }
         Ok(Err(RunError::Cancelled)) if handing_back => {
-            record(lease, "hand back", ctx.queue.hand_back(lease).await);
+            record(
+                lease,
+                "hand back",
+                super::persist::until_stored(ctx, lease, "hand back", || ctx.queue.hand_back(lease)).await,
+            );
             "handed_back"
         }
         Ok(Err(RunError::Cancelled)) if timed_out.is_some() => {
@@ -288,7 +299,7 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
             record(
                 lease,
                 "fail",
-                ctx.queue.fail(lease, &problem, Some(reached)).await,
+                fail_stored(ctx, lease, &problem, Some(reached)).await,
             );
             "timed_out"
         }
@@ -298,9 +309,7 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
             record(
                 lease,
                 "fail",
-                ctx.queue
-                    .fail(lease, &Problem::job_failed(reason), Some(reached))
-                    .await,
+                fail_stored(ctx, lease, &Problem::job_failed(reason), Some(reached)).await,
             );
             "failed"
         }
@@ -309,7 +318,7 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
             record(
                 lease,
                 "fail",
-                ctx.queue.fail(lease, &problem, Some(reached)).await,
+                fail_stored(ctx, lease, &problem, Some(reached)).await,
             );
             "failed"
         }
@@ -318,11 +327,21 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
             record(
                 lease,
                 "fail",
-                ctx.queue.fail(lease, &crashed_problem(), Some(reached)).await,
+                fail_stored(ctx, lease, &crashed_problem(), Some(reached)).await,
             );
             "crashed"
         }
     }
+}
+
+/// Fails the job with `problem`, retrying while the storage refuses the write.
+async fn fail_stored(
+    ctx: &WorkerContext,
+    lease: &Lease,
+    problem: &Problem,
+    reached: Option<u8>,
+) -> Result<bool, sqlx::Error> {
+    super::persist::until_stored(ctx, lease, "fail", || ctx.queue.fail(lease, problem, reached)).await
 }
 
 /// The problem stored for a job whose process crashed: no internals, they are logged.
