@@ -25,9 +25,7 @@ pub fn verdict_of(document: &Value) -> Option<Verdict> {
 
 /// `good`, `unchecked`, `doubtful` or `poor` as a [`Verdict`].
 pub fn parse_verdict(name: &str) -> Option<Verdict> {
-    Verdict::ALL
-        .into_iter()
-        .find(|verdict| verdict.as_str() == name)
+    Verdict::ALL.into_iter().find(|verdict| verdict.as_str() == name)
 }
 
 /// A verdict other than `good`, with its reasons.

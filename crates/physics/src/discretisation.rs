@@ -254,7 +254,11 @@ impl MeshProbes {
 /// The probes at `contacts` for `basis` built on `spec`: basis against its complete
 /// mesh, mesh against the mesh twice as fine. Contacts where the first mode does not
 /// move are left out.
-pub fn probe(spec: &BeamSpec, basis: &ModalBasis, contacts: &[ProbeContact]) -> Result<Vec<Probe>, ModalError> {
+pub fn probe(
+    spec: &BeamSpec,
+    basis: &ModalBasis,
+    contacts: &[ProbeContact],
+) -> Result<Vec<Probe>, ModalError> {
     Ok(MeshProbes::new(spec, contacts)?.compare(basis))
 }
 
@@ -295,7 +299,11 @@ fn probe_contact(model: &Model<'_>, contact: usize) -> Option<ProbeContact> {
     let resolution = HEIGHT_RESOLUTION * model.basis.length();
     Some(ProbeContact {
         height: (c.height / resolution).round() * resolution,
-        stiffness: if between_pins { 2.0 * c.stiffness } else { c.stiffness },
+        stiffness: if between_pins {
+            2.0 * c.stiffness
+        } else {
+            c.stiffness
+        },
     })
 }
 
@@ -332,21 +340,18 @@ pub fn assess(model: &Model<'_>, peaks: &[f64]) -> Result<BasisErrors, ModalErro
         probe(model.basis.spec(), model.basis, &contacts)?
     };
     let worst = |error: fn(&Probe) -> f64| {
-        probes
-            .iter()
-            .max_by(|a, b| error(a).total_cmp(&error(b)))
-            .map_or(
-                ProbeError {
-                    estimated_peak_force_error: 0.0,
-                    height: None,
-                    probed_stiffness: None,
-                },
-                |p| ProbeError {
-                    estimated_peak_force_error: SAFETY_FACTOR * error(p),
-                    height: Some(p.contact.height),
-                    probed_stiffness: Some(p.contact.stiffness),
-                },
-            )
+        probes.iter().max_by(|a, b| error(a).total_cmp(&error(b))).map_or(
+            ProbeError {
+                estimated_peak_force_error: 0.0,
+                height: None,
+                probed_stiffness: None,
+            },
+            |p| ProbeError {
+                estimated_peak_force_error: SAFETY_FACTOR * error(p),
+                height: Some(p.contact.height),
+                probed_stiffness: Some(p.contact.stiffness),
+            },
+        )
     };
     Ok(BasisErrors {
         modal_truncation: worst(|p| p.basis_error),

@@ -61,9 +61,19 @@ fn truncated_bases_overestimate_the_peak_and_converge_to_the_complete_basis() {
     let spec = pin(40);
     let heights = [0.45, 0.9, 1.5];
     let k = 6e6;
-    let complete = probe(&spec, &complete_basis(&spec).unwrap(), &heights.map(|z| contact(z, k))).unwrap();
+    let complete = probe(
+        &spec,
+        &complete_basis(&spec).unwrap(),
+        &heights.map(|z| contact(z, k)),
+    )
+    .unwrap();
     for p in &complete {
-        assert!(p.basis_error < 1e-9, "complete basis at z = {}: error {}", p.contact.height, p.basis_error);
+        assert!(
+            p.basis_error < 1e-9,
+            "complete basis at z = {}: error {}",
+            p.contact.height,
+            p.basis_error
+        );
     }
     for &z in &heights {
         let mut previous = f64::INFINITY;
@@ -125,7 +135,10 @@ fn the_mesh_error_falls_with_the_element_size() {
         assert!(pair[1] < pair[0], "mesh errors {errors:?} do not fall");
     }
     let order = (errors[2] / errors[3]).log2();
-    assert!(order > 2.0, "mesh errors {errors:?}: observed order {order} between 40 and 80 elements");
+    assert!(
+        order > 2.0,
+        "mesh errors {errors:?}: observed order {order} between 40 and 80 elements"
+    );
 }
 
 /// The secular-equation terms against a dense eigensolver of A = Ω² + kψψᵀ: same
@@ -139,7 +152,11 @@ fn secular_roots_match_a_dense_eigensolver() {
     let psi = basis.deflection_at(z);
     let omega = basis.angular_frequencies();
     let n = psi.len();
-    let a = Mat::from_fn(n, n, |i, j| if i == j { omega[i] * omega[i] } else { 0.0 } + k * psi[i] * psi[j]);
+    let a = Mat::from_fn(
+        n,
+        n,
+        |i, j| if i == j { omega[i] * omega[i] } else { 0.0 } + k * psi[i] * psi[j],
+    );
     let eigen = a.self_adjoint_eigen(Side::Lower).unwrap();
     let mut dense: Vec<(f64, f64)> = (0..n)
         .map(|j| {

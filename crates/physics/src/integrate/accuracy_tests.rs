@@ -299,11 +299,25 @@ fn a_run_without_the_check_is_never_good() {
     let model = row.model(&basis);
     let checked = run_at(&model, &row, TimeStep::Auto, Check::StepHalving);
     let unchecked = run_at(&model, &row, TimeStep::Auto, Check::None);
-    assert_ne!(unchecked.quality.verdict, Verdict::Good, "{name}: {:?}", unchecked.quality);
+    assert_ne!(
+        unchecked.quality.verdict,
+        Verdict::Good,
+        "{name}: {:?}",
+        unchecked.quality
+    );
     if checked.quality.verdict == Verdict::Good {
-        assert_eq!(unchecked.quality.verdict, Verdict::Unchecked, "{name}: {:?}", unchecked.quality);
+        assert_eq!(
+            unchecked.quality.verdict,
+            Verdict::Unchecked,
+            "{name}: {:?}",
+            unchecked.quality
+        );
         assert!(
-            unchecked.quality.reasons.iter().any(|r| r.contains("solver.check")),
+            unchecked
+                .quality
+                .reasons
+                .iter()
+                .any(|r| r.contains("solver.check")),
             "{name}: {:?}",
             unchecked.quality.reasons
         );

@@ -108,7 +108,11 @@ impl<'a> Plan<'a> {
                 ))
             }
         };
-        let peaks: Vec<f64> = simulation.contact_statistics.iter().map(|s| s.max_force).collect();
+        let peaks: Vec<f64> = simulation
+            .contact_statistics
+            .iter()
+            .map(|s| s.max_force)
+            .collect();
         let basis = crate::discretisation::assess(model, &peaks).map_err(|e| {
             SimulationError::InvalidModel(vec![InputIssue::new(
                 "modes",

@@ -78,7 +78,12 @@ impl Verdict {
     }
 
     /// Every verdict, from the best to the worst.
-    pub const ALL: [Verdict; 4] = [Verdict::Good, Verdict::Unchecked, Verdict::Doubtful, Verdict::Poor];
+    pub const ALL: [Verdict; 4] = [
+        Verdict::Good,
+        Verdict::Unchecked,
+        Verdict::Doubtful,
+        Verdict::Poor,
+    ];
 }
 
 /// The step-halving check: the whole run repeated at half the step.
