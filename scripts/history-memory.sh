@@ -12,6 +12,7 @@
 #   scripts/history-memory.sh                       # release build
 #   PROFILE=dev scripts/history-memory.sh           # quicker to build, same allocations
 #   HISTORY_CLIENTS=16 RESPONSE_MEMORY_MB=256 scripts/history-memory.sh
+#   CHOCMODAL_BIN=target/debug/chocmodal scripts/history-memory.sh   # a binary already built
 #
 # Linux only (reads /proc).
 set -euo pipefail
@@ -22,11 +23,15 @@ clients="${HISTORY_CLIENTS:-8}"
 samples="${HISTORY_SAMPLES:-500000}"
 budget="${RESPONSE_MEMORY_MB:-1024}"
 target_dir="${CARGO_TARGET_DIR:-target}"
-case "$profile" in
-    dev) binary="$target_dir/debug/chocmodal" ;;
-    *) binary="$target_dir/$profile/chocmodal" ;;
-esac
-cargo build --profile "$profile" --quiet --bin chocmodal
+if [ -n "${CHOCMODAL_BIN:-}" ]; then
+    binary="$CHOCMODAL_BIN"
+else
+    case "$profile" in
+        dev) binary="$target_dir/debug/chocmodal" ;;
+        *) binary="$target_dir/$profile/chocmodal" ;;
+    esac
+    cargo build --profile "$profile" --quiet --bin chocmodal
+fi
 
 data="$(mktemp -d)"
 server=""

@@ -168,7 +168,10 @@ impl Engine {
         mut self,
         shutdown: &ShutdownHandle,
         grace: Duration,
-        server: impl FnOnce(Pin<Box<dyn Future<Output = ()> + Send>>, Pin<Box<dyn Future<Output = ()> + Send>>) -> JoinHandle<std::io::Result<()>>,
+        server: impl FnOnce(
+            Pin<Box<dyn Future<Output = ()> + Send>>,
+            Pin<Box<dyn Future<Output = ()> + Send>>,
+        ) -> JoinHandle<std::io::Result<()>>,
     ) -> std::io::Result<()> {
         let (workers_done, stop_serving) = oneshot::channel::<()>();
         let (deadline_tx, deadline_rx) = oneshot::channel::<Instant>();
@@ -190,7 +193,9 @@ impl Engine {
         let _ = deadline_tx.send(Instant::now() + grace);
         self.stop_work(grace, shutdown.reached(Phase::Immediate)).await;
         let _ = workers_done.send(());
-        let served = served.await.unwrap_or_else(|error| Err(std::io::Error::other(error)));
+        let served = served
+            .await
+            .unwrap_or_else(|error| Err(std::io::Error::other(error)));
         self.close().await;
         served
     }
@@ -313,7 +318,13 @@ impl Application {
         } = self;
         engine
             .shut_down_when_asked(&shutdown, shutdown_grace, move |stop, give_up| {
-                tokio::spawn(server::serve(listener, router, header_read_timeout, stop, give_up))
+                tokio::spawn(server::serve(
+                    listener,
+                    router,
+                    header_read_timeout,
+                    stop,
+                    give_up,
+                ))
             })
             .await
     }
@@ -416,9 +427,13 @@ impl WorkerService {
         } = self;
         engine
             .shut_down_when_asked(&shutdown, shutdown_grace, move |stop, give_up| match health {
-                Some((_, listener, router)) => {
-                    tokio::spawn(server::serve(listener, router, header_read_timeout, stop, give_up))
-                }
+                Some((_, listener, router)) => tokio::spawn(server::serve(
+                    listener,
+                    router,
+                    header_read_timeout,
+                    stop,
+                    give_up,
+                )),
                 None => tokio::spawn(async move {
                     stop.await;
                     Ok(())

@@ -222,7 +222,8 @@ async fn the_impact_table_and_a_history_follow_every_openapi_path_their_url_matc
         assert_eq!(matching, expected, "templates matching {path}");
         let served = app.get_json(&path).await;
         for template in matching {
-            let schema = &openapi["paths"][template]["get"]["responses"]["200"]["content"]["application/json"]["schema"];
+            let schema = &openapi["paths"][template]["get"]["responses"]["200"]["content"]["application/json"]
+                ["schema"];
             assert!(!schema.is_null(), "{template} declares no JSON schema");
             let violations = crate::schema_check::violations(&openapi, schema, &served);
             assert!(

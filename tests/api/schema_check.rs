@@ -34,7 +34,12 @@ fn resolve<'a>(openapi: &'a Value, schema: &'a Value) -> &'a Value {
     match schema.get("$ref").and_then(Value::as_str) {
         Some(reference) => {
             let pointer = reference.trim_start_matches('#');
-            resolve(openapi, openapi.pointer(pointer).unwrap_or_else(|| panic!("unresolved {reference}")))
+            resolve(
+                openapi,
+                openapi
+                    .pointer(pointer)
+                    .unwrap_or_else(|| panic!("unresolved {reference}")),
+            )
         }
         None => schema,
     }
@@ -61,10 +66,18 @@ fn check(openapi: &Value, schema: &Value, value: &Value, at: &str, found: &mut V
             .filter(|option| violations(openapi, option, value).is_empty())
             .count();
         if passing != 1 {
-            found.push(format!("{at}: matches {passing} of the {} `oneOf` schemas, not 1", options.len()));
+            found.push(format!(
+                "{at}: matches {passing} of the {} `oneOf` schemas, not 1",
+                options.len()
+            ));
         }
     }
-    for part in schema.get("allOf").and_then(Value::as_array).into_iter().flatten() {
+    for part in schema
+        .get("allOf")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
         check(openapi, part, value, at, found);
     }
     if let Some(types) = schema.get("type") {
@@ -89,7 +102,12 @@ fn check(openapi: &Value, schema: &Value, value: &Value, at: &str, found: &mut V
         found.push(format!("{at}: {number} is below the minimum {minimum}"));
     }
     if let Some(object) = value.as_object() {
-        for name in schema.get("required").and_then(Value::as_array).into_iter().flatten() {
+        for name in schema
+            .get("required")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+        {
             let name = name.as_str().unwrap();
             if !object.contains_key(name) {
                 found.push(format!("{at}: required member `{name}` is missing"));
@@ -125,13 +143,18 @@ mod tests {
             "B": {"type": "object", "required": ["b"], "properties": {"b": {"type": "array", "items": {"type": "string"}}}}
         }}});
         let a = json!({"$ref": "#/components/schemas/A"});
-        let either = json!({"oneOf": [{"$ref": "#/components/schemas/A"}, {"$ref": "#/components/schemas/B"}]});
+        let either =
+            json!({"oneOf": [{"$ref": "#/components/schemas/A"}, {"$ref": "#/components/schemas/B"}]});
         assert!(violations(&openapi, &a, &json!({"a": 3})).is_empty());
         assert_eq!(violations(&openapi, &a, &json!({"b": 3})).len(), 1);
         assert_eq!(violations(&openapi, &a, &json!({"a": -1})).len(), 1);
         assert_eq!(violations(&openapi, &a, &json!({"a": "x"})).len(), 1);
         assert!(violations(&openapi, &either, &json!({"b": ["x"]})).is_empty());
         assert_eq!(violations(&openapi, &either, &json!({"b": [1]})).len(), 1);
-        assert_eq!(violations(&openapi, &either, &json!({"a": 1, "b": []})).len(), 1, "both match");
+        assert_eq!(
+            violations(&openapi, &either, &json!({"a": 1, "b": []})).len(),
+            1,
+            "both match"
+        );
     }
 }

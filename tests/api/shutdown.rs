@@ -11,8 +11,8 @@ use reqwest::StatusCode;
 use serde_json::{Value, json};
 
 use crate::counting;
-use crate::scale_out::Process;
 use crate::helpers::{Backend, TestApp, assert_problem, on_both_backends, spawn_app_in, spawn_app_on};
+use crate::scale_out::Process;
 
 on_both_backends!(
     jobs_outliving_the_grace_are_handed_back_and_complete_on_the_next_start,
@@ -51,7 +51,7 @@ async fn jobs_outliving_the_grace_are_handed_back_and_complete_on_the_next_start
     wait_until_running(&app, &jobs[..2]).await;
     assert_eq!(app.probe.started(), 2);
 
-    app.shutdown.request();
+    // One request to stop (as one SIGTERM): the 300 ms grace, then the hand-back.
     let probe = app.probe.clone();
     let store = app.stop().await;
     assert_eq!(probe.started(), 2, "no job started after the signal");
@@ -196,7 +196,11 @@ async fn two_sigterms_make_the_binary_hand_its_running_job_back_and_exit() {
 
     server.send_sigterm();
     server.wait_for_log("stopping: no new jobs are claimed, running jobs get the grace period; a second signal hands them back at once").await;
-    assert_eq!(status_of(&job).await["status"], "running", "reads are answered while draining");
+    assert_eq!(
+        status_of(&job).await["status"],
+        "running",
+        "reads are answered while draining"
+    );
     let refused = client
         .post(format!("{address}/processes/cantilever-impact/execution"))
         .json(&long)

@@ -9,8 +9,8 @@ use axum::response::{IntoResponse, Response};
 use super::AppState;
 use super::conditional::{entity_tag, if_none_match};
 use super::error::ApiError;
-use super::streamed::{Rendered, WriteBody, held_bytes, streamed, working_bytes};
 use super::results::{successful, with_retry_after};
+use super::streamed::{Rendered, WriteBody, held_bytes, streamed, working_bytes};
 use crate::problem::Problem;
 use crate::service::auth::Tenant;
 use crate::service::queue::read::JobOutcome;
@@ -107,9 +107,11 @@ where
                 .await?
                 .ok_or_else(|| Problem::no_such_output(job_id, output))?;
             let permit = state.response_memory.admit(working_bytes(&stored))?;
-            let rendered = tokio::task::spawn_blocking(move || render(&stored, &outcome).map(|body| -> Rendered { body.into() }))
-                .await
-                .map_err(|e| ApiError::Internal(format!("{work} panicked: {e}")))??;
+            let rendered = tokio::task::spawn_blocking(move || {
+                render(&stored, &outcome).map(|body| -> Rendered { body.into() })
+            })
+            .await
+            .map_err(|e| ApiError::Internal(format!("{work} panicked: {e}")))??;
             let (etag, body) = match rendered {
                 Rendered::Bytes(bytes) => (entity_tag(&bytes), Either::Bytes(bytes)),
                 Rendered::Stream { etag, write } => (etag, Either::Stream(write)),
@@ -120,7 +122,10 @@ where
             if if_none_match(headers, &etag) {
                 return Ok((StatusCode::NOT_MODIFIED, response_headers).into_response());
             }
-            response_headers.insert(header::CONTENT_TYPE, HeaderValue::from_static(format.content_type()));
+            response_headers.insert(
+                header::CONTENT_TYPE,
+                HeaderValue::from_static(format.content_type()),
+            );
             let body = match body {
                 Either::Bytes(bytes) => held_bytes(permit, bytes),
                 Either::Stream(write) => streamed(permit, write),

@@ -22,8 +22,8 @@ pub mod results;
 pub mod signal_models;
 pub mod signals;
 pub mod spectra;
-pub mod sweep_models;
 pub mod streamed;
+pub mod sweep_models;
 pub mod sweeps;
 
 use std::sync::Arc;
@@ -143,7 +143,10 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .fallback(not_found)
         // HTML for browsers on the routes that have a page (innermost: it sees the route).
         .layer(middleware::from_fn(dashboard::negotiate))
-        .layer(middleware::from_fn_with_state(state.clone(), refuse_writes_while_stopping))
+        .layer(middleware::from_fn_with_state(
+            state.clone(),
+            refuse_writes_while_stopping,
+        ))
         // Layers run outside-in from the last one added: trace and count every request,
         // turn any bare error below (timeout, panic, 405, 413) into a problem, and
         // authenticate before anything reads the body.
@@ -243,7 +246,11 @@ pub const SHUTTING_DOWN_RETRY_SECONDS: u64 = 5;
 /// Once the process is stopping, requests that would change something (any method but
 /// GET, HEAD and OPTIONS) get 503 with `Retry-After`; reads are served until the
 /// workers are done.
-async fn refuse_writes_while_stopping(State(state): State<AppState>, request: Request, next: Next) -> Response {
+async fn refuse_writes_while_stopping(
+    State(state): State<AppState>,
+    request: Request,
+    next: Next,
+) -> Response {
     let safe = request.method().is_safe();
     if !safe && state.shutdown.is_stopping() {
         return error::ApiError::RetryLater {

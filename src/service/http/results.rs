@@ -283,7 +283,9 @@ fn render(
             time: selected.time,
             series: Series::from_columns(selected.series),
         };
-        Box::new(move |out: &mut dyn Write| serde_json::to_writer(out, &document).map_err(std::io::Error::other))
+        Box::new(move |out: &mut dyn Write| {
+            serde_json::to_writer(out, &document).map_err(std::io::Error::other)
+        })
     };
     Ok(Rendered::Stream { etag, write })
 }

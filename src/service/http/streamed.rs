@@ -51,7 +51,10 @@ impl std::fmt::Debug for Rendered {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Rendered::Bytes(bytes) => f.debug_tuple("Bytes").field(&bytes.len()).finish(),
-            Rendered::Stream { etag, .. } => f.debug_struct("Stream").field("etag", etag).finish_non_exhaustive(),
+            Rendered::Stream { etag, .. } => f
+                .debug_struct("Stream")
+                .field("etag", etag)
+                .finish_non_exhaustive(),
         }
     }
 }
@@ -168,7 +171,10 @@ impl ChunkSink {
         if self.buffer.is_empty() {
             return Ok(());
         }
-        let chunk = Bytes::from(std::mem::replace(&mut self.buffer, Vec::with_capacity(CHUNK_BYTES)));
+        let chunk = Bytes::from(std::mem::replace(
+            &mut self.buffer,
+            Vec::with_capacity(CHUNK_BYTES),
+        ));
         let sender = &self.sender;
         let sent = self
             .runtime
@@ -209,7 +215,9 @@ mod tests {
         let memory = ResponseMemory::new(4 << 20);
         let first = memory.admit(3 << 20).expect("3 of 4 MiB");
         assert!(matches!(memory.admit(2 << 20), Err(ApiError::RetryLater { .. })));
-        let small = memory.admit(512 << 10).expect("the last MiB still takes half a MiB");
+        let small = memory
+            .admit(512 << 10)
+            .expect("the last MiB still takes half a MiB");
         drop(first);
         drop(small);
         // Larger than the whole budget: admitted alone.
@@ -223,7 +231,9 @@ mod tests {
     async fn a_streamed_body_is_the_bytes_written_in_chunks() {
         use futures_util::StreamExt;
         let memory = ResponseMemory::new(1 << 20);
-        let text: Vec<u8> = (0..(3 * CHUNK_BYTES + 17)).map(|k| b'a' + (k % 26) as u8).collect();
+        let text: Vec<u8> = (0..(3 * CHUNK_BYTES + 17))
+            .map(|k| b'a' + (k % 26) as u8)
+            .collect();
         let expected = text.clone();
         let body = streamed(
             memory.admit(1).unwrap(),
