@@ -244,15 +244,17 @@ mod tests {
                 Ok(())
             }),
         );
-        let mut frames = 0;
+        let mut sizes = Vec::new();
         let mut received = Vec::new();
         let mut chunks = body.into_data_stream();
         while let Some(chunk) = chunks.next().await {
-            received.extend_from_slice(&chunk.unwrap());
-            frames += 1;
+            let chunk = chunk.unwrap();
+            sizes.push(chunk.len());
+            received.extend_from_slice(&chunk);
         }
         assert_eq!(received, expected);
-        assert_eq!(frames, 4, "three full chunks and the rest");
+        // Writes of 1000 bytes: a chunk goes once it holds CHUNK_BYTES or more.
+        assert_eq!(sizes, vec![66_000, 66_000, 3 * CHUNK_BYTES + 17 - 132_000]);
         // The writer is done and its permit returned.
         assert_eq!(memory.permits.available_permits(), memory.total_kib as usize);
     }
