@@ -258,6 +258,27 @@ impl Problem {
         )
     }
 
+    /// 503: this process is shutting down and takes no more writes (reads still work).
+    pub fn shutting_down() -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/shutting-down"),
+            "Shutting down",
+            503,
+            "this server is shutting down and accepts no more changes; retry after \
+             `Retry-After` seconds (another instance, or this one restarted, takes it)",
+        )
+    }
+
+    /// 503: the server's memory for large responses is in use; retry shortly.
+    pub fn server_busy(detail: impl Into<String>) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/server-busy"),
+            "Server busy",
+            503,
+            detail,
+        )
+    }
+
     /// 422 (stored with a failed job): the run went over the wall-time limit and was stopped.
     pub fn job_time_limit(limit: std::time::Duration) -> Self {
         Self::new(

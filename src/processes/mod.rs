@@ -117,6 +117,27 @@ pub fn columns_csv(key: &str, keys: &[f64], series: &[(String, Vec<f64>)]) -> St
     out
 }
 
+/// [`columns_csv`]'s rows (without its header line) written to `out` one by one, so that
+/// the text of a long history is never whole in memory: the same bytes.
+pub fn write_columns_csv_rows(
+    out: &mut dyn std::io::Write,
+    keys: &[f64],
+    series: &[(String, Vec<f64>)],
+) -> std::io::Result<()> {
+    let mut line = String::with_capacity((series.len() + 1) * 24);
+    for (row, k) in keys.iter().enumerate() {
+        line.clear();
+        crate::csv_format::push_number(&mut line, *k);
+        for (_, values) in series {
+            line.push(',');
+            crate::csv_format::push_number(&mut line, values[row]);
+        }
+        line.push('\n');
+        out.write_all(line.as_bytes())?;
+    }
+    Ok(())
+}
+
 /// What a successful run produces.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutput {

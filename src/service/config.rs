@@ -109,6 +109,11 @@ pub struct ServeArgs {
     /// Most rows one history response holds: longer windows are thinned (peaks kept).
     #[arg(long, env = "CHOCMODAL_MAX_HISTORY_POINTS", default_value_t = DEFAULT_MAX_HISTORY_POINTS)]
     pub max_history_points: usize,
+    /// Working memory the history responses being made may use together (MiB): the
+    /// decoded histories and their windows (their text is streamed); a response that does
+    /// not fit gets a 503 with `Retry-After`.
+    #[arg(long, env = "CHOCMODAL_RESPONSE_MEMORY_MB", default_value_t = DEFAULT_RESPONSE_MEMORY_MB, value_parser = clap::value_parser!(u64).range(1..))]
+    pub response_memory_mb: u64,
     /// Most queued (accepted) jobs per tenant, sweep runs included; more is a 429. 0: no limit.
     #[arg(long, env = "CHOCMODAL_MAX_QUEUED_JOBS", default_value_t = DEFAULT_MAX_QUEUED_JOBS)]
     pub max_queued_jobs: u64,
@@ -199,6 +204,8 @@ pub struct ServiceConfig {
     pub limits: CostLimits,
     /// Most rows of one history response (longer windows are thinned).
     pub max_history_points: usize,
+    /// Working memory the history responses being made may use together (bytes).
+    pub response_memory_bytes: usize,
     /// Most queued jobs per tenant; `None`: no limit.
     pub max_queued_jobs: Option<u64>,
     /// Wall-time limit of one job; `None`: no limit.
@@ -222,6 +229,8 @@ pub const DEFAULT_MAX_SIGNAL_BYTES: usize = 48 << 20;
 pub const DEFAULT_MAX_SIGNAL_SAMPLES: usize = 1_000_000;
 /// Default cap of rows per history response.
 pub const DEFAULT_MAX_HISTORY_POINTS: usize = 500_000;
+/// Default `--response-memory-mb`.
+pub const DEFAULT_RESPONSE_MEMORY_MB: u64 = 1024;
 
 /// Default number of workers: the cores available to this process.
 pub fn default_workers() -> usize {
@@ -261,6 +270,7 @@ impl ServiceConfig {
             insecure: false,
             limits: CostLimits::default(),
             max_history_points: DEFAULT_MAX_HISTORY_POINTS,
+            response_memory_bytes: (DEFAULT_RESPONSE_MEMORY_MB as usize) << 20,
             max_queued_jobs: Some(DEFAULT_MAX_QUEUED_JOBS),
             max_job_time: Some(Duration::from_secs(900)),
             request_timeout: Duration::from_secs(30),
@@ -317,6 +327,9 @@ impl ServiceConfig {
                 max_history_values: args.max_history_values,
             },
             max_history_points: args.max_history_points.max(2),
+            response_memory_bytes: usize::try_from(args.response_memory_mb)
+                .unwrap_or(usize::MAX)
+                .saturating_mul(1 << 20),
             max_queued_jobs: (args.max_queued_jobs > 0).then_some(args.max_queued_jobs),
             request_timeout: Duration::from_secs(args.request_timeout_seconds.max(1)),
             header_read_timeout: Duration::from_secs(args.header_timeout_seconds.max(1)),

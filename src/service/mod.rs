@@ -15,6 +15,7 @@ pub mod http;
 pub mod metrics;
 pub mod queue;
 mod server;
+pub mod shutdown;
 pub mod signals;
 pub mod spectrum_table;
 mod startup;
@@ -25,7 +26,8 @@ pub mod thinning;
 pub mod worker;
 
 pub use config::{ServeArgs, ServiceConfig, WorkerArgs};
-pub use startup::{Application, StartupError, WorkerService, shutdown_signal};
+pub use shutdown::ShutdownHandle;
+pub use startup::{Application, StartupError, WorkerService};
 
 /// `chocmodal serve`: logs, builds the service and serves until SIGTERM or ctrl-c.
 pub fn serve(args: &ServeArgs, registry: crate::processes::Registry) -> std::process::ExitCode {

@@ -5,7 +5,7 @@
 //! Here every connection gets hyper's header read timeout, which also closes a
 //! kept-alive connection that stays idle longer than that; the router's timeout layer
 //! bounds the rest of each request, its body included. On shutdown, idle connections
-//! close at once and requests in flight finish.
+//! close at once and requests in flight finish, within what is left of the grace period.
 
 use std::future::Future;
 use std::time::Duration;
@@ -18,12 +18,13 @@ use hyper_util::service::TowerToHyperService;
 use tokio::net::TcpListener;
 
 /// Serves `router` on `listener` until `stop` completes, then waits for the requests in
-/// flight.
+/// flight, unless `give_up` completes first (their connections are then dropped).
 pub async fn serve(
     listener: TcpListener,
     router: Router,
     header_read_timeout: Duration,
     stop: impl Future<Output = ()> + Send + 'static,
+    give_up: impl Future<Output = ()> + Send + 'static,
 ) -> std::io::Result<()> {
     let mut builder = http1::Builder::new();
     builder
@@ -54,6 +55,9 @@ pub async fn serve(
         });
     }
     drop(listener);
-    graceful.shutdown().await;
+    tokio::select! {
+        () = graceful.shutdown() => {}
+        () = give_up => tracing::warn!("requests still in flight at the end of the grace period are dropped"),
+    }
     Ok(())
 }

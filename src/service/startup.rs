@@ -10,19 +10,23 @@
 
 use std::future::Future;
 use std::net::SocketAddr;
+use std::pin::Pin;
 use std::sync::Arc;
 use std::time::Duration;
 
 use tokio::net::TcpListener;
-use tokio::sync::Notify;
+use tokio::sync::{Notify, oneshot};
 use tokio::task::JoinHandle;
+use tokio::time::Instant;
 
 use super::config::ServiceConfig;
 use super::db::{self, Database};
+use super::http::streamed::ResponseMemory;
 use super::http::{self, AppState, HttpSettings};
 use super::metrics::Metrics;
 use super::queue::JobQueue;
 use super::server;
+use super::shutdown::{Phase, ShutdownHandle, forward_signals};
 use super::worker::{Maintenance, RunningJobs, WorkerContext, Workers};
 use crate::processes::Registry;
 
@@ -55,6 +59,8 @@ struct Engine {
     maintenance: Maintenance,
     workers: Option<Workers>,
     background: Vec<JoinHandle<()>>,
+    /// Shared by every router of the process (API and health port alike).
+    response_memory: ResponseMemory,
 }
 
 impl Engine {
@@ -90,6 +96,7 @@ impl Engine {
             maintenance,
             workers: None,
             background: Vec::new(),
+            response_memory: ResponseMemory::new(config.response_memory_bytes),
         })
     }
 
@@ -121,8 +128,9 @@ impl Engine {
         }
     }
 
-    fn state(&self, registry: Registry, config: &ServiceConfig) -> AppState {
+    fn state(&self, registry: Registry, config: &ServiceConfig, shutdown: &ShutdownHandle) -> AppState {
         AppState {
+            shutdown: shutdown.clone(),
             queue: self.queue.clone(),
             registry,
             running: self.running.clone(),
@@ -132,26 +140,74 @@ impl Engine {
             limits: config.limits,
             max_queued_jobs: config.max_queued_jobs,
             max_history_points: config.max_history_points,
+            response_memory: self.response_memory.clone(),
             signals: self.queue.signals(),
             max_signal_bytes: config.max_signal_bytes,
             max_signal_samples: config.max_signal_samples,
         }
     }
 
-    /// Stops claiming, lets running jobs finish within `grace` (then hands them back),
-    /// stops the background tasks and closes the database.
-    async fn stop(self, grace: Duration) {
+    /// Stops claiming, lets running jobs finish within `grace` or until `hurry`
+    /// completes (then hands them back), and stops the background tasks.
+    async fn stop_work(&mut self, grace: Duration, hurry: impl Future<Output = ()>) {
         tracing::info!("shutting down: no new jobs are claimed");
-        if let Some(workers) = self.workers {
-            workers.shutdown(grace).await;
+        if let Some(workers) = self.workers.take() {
+            workers.shutdown(grace, hurry).await;
         }
         for task in &self.background {
             task.abort();
         }
+    }
+
+    async fn close(self) {
         self.queue.database().close().await;
         tracing::info!("shut down");
     }
+
+    /// The whole shutdown once `shutdown` asks for it: the workers drain (within
+    /// `grace`, or until a second request) while `server` keeps serving; then the server
+    /// stops (its requests in flight get what is left of the grace period) and the
+    /// database closes.
+    async fn shut_down_when_asked(
+        mut self,
+        shutdown: &ShutdownHandle,
+        grace: Duration,
+        server: impl FnOnce(
+            Pin<Box<dyn Future<Output = ()> + Send>>,
+            Pin<Box<dyn Future<Output = ()> + Send>>,
+        ) -> JoinHandle<std::io::Result<()>>,
+    ) -> std::io::Result<()> {
+        let (workers_done, stop_serving) = oneshot::channel::<()>();
+        let (deadline_tx, deadline_rx) = oneshot::channel::<Instant>();
+        let hurry = shutdown.reached(Phase::Immediate);
+        let give_up = async move {
+            let deadline = deadline_rx.await.unwrap_or_else(|_| Instant::now());
+            tokio::select! {
+                () = tokio::time::sleep_until(deadline.max(Instant::now() + MIN_REQUEST_DRAIN)) => {}
+                () = hurry => {}
+            }
+        };
+        let served = server(
+            Box::pin(async move {
+                let _ = stop_serving.await;
+            }),
+            Box::pin(give_up),
+        );
+        shutdown.reached(Phase::Draining).await;
+        let _ = deadline_tx.send(Instant::now() + grace);
+        self.stop_work(grace, shutdown.reached(Phase::Immediate)).await;
+        let _ = workers_done.send(());
+        let served = served
+            .await
+            .unwrap_or_else(|error| Err(std::io::Error::other(error)));
+        self.close().await;
+        served
+    }
 }
+
+/// Requests in flight when the server stops get at least this long, even when the
+/// workers used up the grace period.
+const MIN_REQUEST_DRAIN: Duration = Duration::from_secs(1);
 
 async fn bind(address: SocketAddr) -> Result<(TcpListener, SocketAddr), StartupError> {
     let listener = TcpListener::bind(address)
@@ -172,6 +228,7 @@ pub struct Application {
     engine: Engine,
     shutdown_grace: Duration,
     header_read_timeout: Duration,
+    shutdown: ShutdownHandle,
 }
 
 impl Application {
@@ -185,8 +242,9 @@ impl Application {
         let (listener, address) = bind(config.bind).await?;
         engine.start(&config, registry.clone());
         let tenants = config.auth.as_ref().map_or(0, |table| table.len());
+        let shutdown = ShutdownHandle::default();
         let router = http::router(
-            engine.state(registry, &config),
+            engine.state(registry, &config, &shutdown),
             &HttpSettings {
                 max_body_bytes: config.max_body_bytes,
                 request_timeout: config.request_timeout,
@@ -206,7 +264,14 @@ impl Application {
             engine,
             shutdown_grace: config.shutdown_grace,
             header_read_timeout: config.header_read_timeout,
+            shutdown,
         })
+    }
+
+    /// Asks this service to stop, as SIGTERM does (a second request, as a second
+    /// signal does): see [`super::shutdown`].
+    pub fn shutdown_handle(&self) -> ShutdownHandle {
+        self.shutdown.clone()
     }
 
     /// The bound address (its port is the real one when the configured port was 0).
@@ -219,18 +284,53 @@ impl Application {
         &self.engine.queue
     }
 
-    /// Serves until SIGTERM or ctrl-c, then shuts down gracefully.
+    /// Serves until SIGTERM or ctrl-c, then shuts down gracefully; a second signal
+    /// hands the running jobs back at once.
     pub async fn run_until_stopped(self) -> std::io::Result<()> {
-        self.run_until(shutdown_signal()).await
+        let signals = tokio::spawn(forward_signals(self.shutdown.clone()));
+        let served = self.run().await;
+        signals.abort();
+        served
     }
 
-    /// Serves until `stop` completes, then: stops accepting requests and finishes those
-    /// in flight, stops claiming jobs, lets running jobs finish within the grace period,
-    /// hands the rest back to the queue, closes the database.
+    /// Serves until `stop` completes, then shuts down as on a first SIGTERM (a second
+    /// request through [`Self::shutdown_handle`] hurries it).
     pub async fn run_until(self, stop: impl Future<Output = ()> + Send + 'static) -> std::io::Result<()> {
-        let served = server::serve(self.listener, self.router, self.header_read_timeout, stop).await;
-        self.engine.stop(self.shutdown_grace).await;
+        let shutdown = self.shutdown.clone();
+        let trigger = tokio::spawn(async move {
+            stop.await;
+            shutdown.request();
+        });
+        let served = self.run().await;
+        trigger.abort();
         served
+    }
+
+    /// Serves until the shutdown handle is asked to stop, then: stops claiming jobs at
+    /// once and lets running jobs finish within the grace period (handing the rest back
+    /// to the queue) while the API keeps answering reads (writes get 503); then stops
+    /// accepting connections, finishes the requests in flight and closes the database.
+    pub async fn run(self) -> std::io::Result<()> {
+        let Self {
+            listener,
+            router,
+            engine,
+            shutdown_grace,
+            header_read_timeout,
+            shutdown,
+            ..
+        } = self;
+        engine
+            .shut_down_when_asked(&shutdown, shutdown_grace, move |stop, give_up| {
+                tokio::spawn(server::serve(
+                    listener,
+                    router,
+                    header_read_timeout,
+                    stop,
+                    give_up,
+                ))
+            })
+            .await
     }
 }
 
@@ -243,6 +343,7 @@ pub struct WorkerService {
     workers: usize,
     shutdown_grace: Duration,
     header_read_timeout: Duration,
+    shutdown: ShutdownHandle,
 }
 
 impl WorkerService {
@@ -250,10 +351,11 @@ impl WorkerService {
     /// port if any and starts `config.workers` workers running `registry`'s processes.
     pub async fn build(config: ServiceConfig, registry: Registry) -> Result<Self, StartupError> {
         let mut engine = Engine::open(&config).await?;
+        let shutdown = ShutdownHandle::default();
         let health = match config.health_bind {
             Some(address) => {
                 let (listener, address) = bind(address).await?;
-                let router = http::health_router(engine.state(registry.clone(), &config));
+                let router = http::health_router(engine.state(registry.clone(), &config, &shutdown));
                 Some((address, listener, router))
             }
             None => None,
@@ -271,6 +373,7 @@ impl WorkerService {
             workers: config.workers,
             shutdown_grace: config.shutdown_grace,
             header_read_timeout: config.header_read_timeout,
+            shutdown,
         })
     }
 
@@ -289,51 +392,57 @@ impl WorkerService {
         self.workers
     }
 
-    /// Works until SIGTERM or ctrl-c, then shuts down gracefully.
+    /// Asks this service to stop, as SIGTERM does.
+    pub fn shutdown_handle(&self) -> ShutdownHandle {
+        self.shutdown.clone()
+    }
+
+    /// Works until SIGTERM or ctrl-c, then shuts down gracefully; a second signal
+    /// hands the running jobs back at once.
     pub async fn run_until_stopped(self) -> std::io::Result<()> {
-        self.run_until(shutdown_signal()).await
+        let signals = tokio::spawn(forward_signals(self.shutdown.clone()));
+        let served = self.run().await;
+        signals.abort();
+        served
     }
 
     /// Works until `stop` completes, then shuts down like [`Application::run_until`].
     pub async fn run_until(self, stop: impl Future<Output = ()> + Send + 'static) -> std::io::Result<()> {
-        let served = match self.health {
-            Some((_, listener, router)) => {
-                server::serve(listener, router, self.header_read_timeout, stop).await
-            }
-            None => {
-                stop.await;
-                Ok(())
-            }
-        };
-        self.engine.stop(self.shutdown_grace).await;
+        let shutdown = self.shutdown.clone();
+        let trigger = tokio::spawn(async move {
+            stop.await;
+            shutdown.request();
+        });
+        let served = self.run().await;
+        trigger.abort();
         served
     }
-}
 
-/// Completes on SIGTERM or ctrl-c.
-pub async fn shutdown_signal() {
-    let ctrl_c = async {
-        if let Err(error) = tokio::signal::ctrl_c().await {
-            tracing::error!(%error, "cannot listen for ctrl-c");
-            std::future::pending::<()>().await;
-        }
-    };
-    #[cfg(unix)]
-    let terminate = async {
-        match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
-            Ok(mut signal) => {
-                signal.recv().await;
-            }
-            Err(error) => {
-                tracing::error!(%error, "cannot listen for SIGTERM");
-                std::future::pending::<()>().await;
-            }
-        }
-    };
-    #[cfg(not(unix))]
-    let terminate = std::future::pending::<()>();
-    tokio::select! {
-        _ = ctrl_c => tracing::info!("ctrl-c received"),
-        _ = terminate => tracing::info!("SIGTERM received"),
+    /// Works until the shutdown handle is asked to stop, then shuts down like
+    /// [`Application::run`] (the health port answers until the workers are done).
+    pub async fn run(self) -> std::io::Result<()> {
+        let Self {
+            health,
+            engine,
+            shutdown_grace,
+            header_read_timeout,
+            shutdown,
+            ..
+        } = self;
+        engine
+            .shut_down_when_asked(&shutdown, shutdown_grace, move |stop, give_up| match health {
+                Some((_, listener, router)) => tokio::spawn(server::serve(
+                    listener,
+                    router,
+                    header_read_timeout,
+                    stop,
+                    give_up,
+                )),
+                None => tokio::spawn(async move {
+                    stop.await;
+                    Ok(())
+                }),
+            })
+            .await
     }
 }

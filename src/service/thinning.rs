@@ -26,6 +26,25 @@ pub fn select(
     }
 }
 
+/// [`select`] taking `history`: the whole of it when the window holds every sample and
+/// needs no thinning (no copy), else the selection.
+pub fn select_owned(
+    history: History,
+    t_start: Option<f64>,
+    t_end: Option<f64>,
+    max_points: Option<usize>,
+) -> History {
+    let rows = window_rows(&history.time, &history.series, t_start, t_end, max_points);
+    if rows.len() == history.time.len() {
+        return history;
+    }
+    History {
+        time: rows.iter().map(|&i| history.time[i]).collect(),
+        series: pick_rows(&history.series, &rows),
+        name: history.name,
+    }
+}
+
 /// The rows of the samples at `axis` (times, or frequencies of a spectrum, increasing)
 /// with `start <= x <= end` (either bound optional), thinned to about `max_points` rows
 /// keeping the extremes of every one of `series` when there are more; ascending.

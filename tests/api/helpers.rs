@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use chocmodal::processes::{Process, Registry};
 use chocmodal::service::db::DatabaseUrl;
 use chocmodal::service::queue::JobQueue;
-use chocmodal::service::{Application, ServiceConfig};
+use chocmodal::service::{Application, ServiceConfig, ShutdownHandle};
 use reqwest::{Response, StatusCode};
 use serde_json::{Value, json};
 use tempfile::TempDir;
@@ -93,6 +93,9 @@ pub struct TestApp {
     pub probe: Arc<Probe>,
     pub queue: JobQueue,
     pub store: Option<TestStore>,
+    /// Asks the service to stop as a signal does (the first drains, the second hands
+    /// running jobs back at once).
+    pub shutdown: ShutdownHandle,
     stop: Option<oneshot::Sender<()>>,
     served: Option<JoinHandle<std::io::Result<()>>>,
 }
@@ -192,6 +195,7 @@ async fn spawn_app_serving(
         .expect("the service starts");
     let address = format!("http://{}", application.address());
     let queue = application.queue().clone();
+    let shutdown = application.shutdown_handle();
     let (stop, stopped) = oneshot::channel::<()>();
     let served = tokio::spawn(application.run_until(async {
         let _ = stopped.await;
@@ -205,6 +209,7 @@ async fn spawn_app_serving(
         probe,
         queue,
         store: Some(store),
+        shutdown,
         stop: Some(stop),
         served: Some(served),
     }

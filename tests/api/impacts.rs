@@ -188,3 +188,48 @@ async fn bad_counting_settings_are_refused_at_their_pointers() {
         assert_eq!(problem["errors"][0]["pointer"], "/inputs/output/impacts/classes");
     }
 }
+
+/// Issue 30: `/jobs/{id}/results/impacts` also matches the generic
+/// `/jobs/{jobId}/results/{output}` template. Whichever template a client matches the
+/// URL to, the served JSON follows that template's 200 schema; and a history served
+/// through the generic template follows it too.
+#[tokio::test]
+async fn the_impact_table_and_a_history_follow_every_openapi_path_their_url_matches() {
+    let app = spawn().await;
+    let mut body = example("cantilever-impact.json");
+    body["inputs"]["solver"]["duration"] = json!(0.05);
+    let (id, results) = run(&app, "cantilever-impact", &body).await;
+    let openapi = app.get_json("/openapi.json").await;
+    let history = results["outputs"]
+        .as_object()
+        .expect("outputs")
+        .keys()
+        .find(|name| *name != "impacts")
+        .expect("a history")
+        .clone();
+    for (output, templates) in [
+        (
+            "impacts",
+            vec!["/jobs/{jobId}/results/impacts", "/jobs/{jobId}/results/{output}"],
+        ),
+        (history.as_str(), vec!["/jobs/{jobId}/results/{output}"]),
+    ] {
+        let path = format!("/jobs/{id}/results/{output}");
+        let mut matching = crate::schema_check::matching_templates(&openapi, &path);
+        matching.sort_unstable();
+        let mut expected = templates.clone();
+        expected.sort_unstable();
+        assert_eq!(matching, expected, "templates matching {path}");
+        let served = app.get_json(&path).await;
+        for template in matching {
+            let schema = &openapi["paths"][template]["get"]["responses"]["200"]["content"]["application/json"]
+                ["schema"];
+            assert!(!schema.is_null(), "{template} declares no JSON schema");
+            let violations = crate::schema_check::violations(&openapi, schema, &served);
+            assert!(
+                violations.is_empty(),
+                "GET {path} does not follow the schema of {template}: {violations:#?}"
+            );
+        }
+    }
+}

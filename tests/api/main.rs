@@ -35,6 +35,8 @@ mod responsiveness;
 mod results;
 mod robustness;
 mod scale_out;
+mod schema_check;
+mod shutdown;
 mod signals;
 mod spectra;
 mod sweeps;

@@ -188,13 +188,13 @@ fn assert_sample(metrics: &str, sample: &str) {
 }
 
 /// A process of the real binary, killed when dropped; its logs (JSON lines) in a file.
-struct Process {
+pub(crate) struct Process {
     child: Child,
     log: PathBuf,
 }
 
 impl Process {
-    fn start(dir: &Path, name: &str, args: &[&str]) -> Self {
+    pub(crate) fn start(dir: &Path, name: &str, args: &[&str]) -> Self {
         let log = dir.join(format!("{name}.log"));
         let child = Command::new(env!("CARGO_BIN_EXE_chocmodal"))
             .args(args)
@@ -209,7 +209,7 @@ impl Process {
     }
 
     /// The fields of the first log line with this message, waiting for it.
-    async fn wait_for_log(&mut self, message: &str) -> Value {
+    pub(crate) async fn wait_for_log(&mut self, message: &str) -> Value {
         let deadline = Instant::now() + Duration::from_secs(30);
         loop {
             let text = std::fs::read_to_string(&self.log).unwrap_or_default();
@@ -234,6 +234,20 @@ impl Process {
 
     fn pid(&self) -> u32 {
         self.child.id()
+    }
+
+    /// Sends SIGTERM, without waiting for the process to exit.
+    pub(crate) fn send_sigterm(&self) {
+        let sent = Command::new("kill")
+            .args(["-TERM", &self.pid().to_string()])
+            .status()
+            .unwrap();
+        assert!(sent.success(), "kill -TERM {}", self.pid());
+    }
+
+    /// Waits for the process to exit.
+    pub(crate) fn wait(&mut self) -> std::process::ExitStatus {
+        self.child.wait().unwrap()
     }
 
     /// SIGTERM, and the exit status of the graceful shutdown.

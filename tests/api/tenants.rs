@@ -9,12 +9,15 @@ use reqwest::{RequestBuilder, Response, StatusCode};
 use serde_json::{Value, json};
 
 use crate::counting;
-use crate::helpers::{Backend, TestApp, assert_problem, on_both_backends, spawn_app_on, spawn_app_with};
+use crate::helpers::{
+    Backend, TestApp, TestStore, assert_problem, on_both_backends, spawn_app_in, spawn_app_on, spawn_app_with,
+};
 
 on_both_backends!(
     another_tenants_job_is_not_found_anywhere,
     identical_inputs_of_another_tenant_are_computed_not_reused,
-    another_tenants_sweep_is_not_found_and_its_runs_are_not_listed
+    another_tenants_sweep_is_not_found_and_its_runs_are_not_listed,
+    one_tenants_300_queued_jobs_do_not_delay_another_tenants_single_job
 );
 
 const ALPHA: &str = "alpha-token-0123456789";
@@ -269,4 +272,45 @@ async fn another_tenants_sweep_is_not_found_and_its_runs_are_not_listed(backend:
     assert_eq!(runs["jobs"].as_array().unwrap().len(), 2);
     let status = alpha.get_json(&format!("/sweeps/{id}")).await;
     assert_ne!(status["status"], "dismissed", "{status}");
+}
+
+/// Fair share: alpha queues 300 jobs, then beta one; once workers start, beta's job is
+/// claimed as soon as a worker is free of alpha's first runs (it has no running job,
+/// alpha has), not after alpha's 300.
+async fn one_tenants_300_queued_jobs_do_not_delay_another_tenants_single_job(backend: Backend) {
+    let with_tenants = |workers: usize| {
+        move |config: &mut chocmodal::service::ServiceConfig| {
+            config.auth = Some(tokens());
+            config.workers = workers;
+            config.max_queued_jobs = None;
+        }
+    };
+    // Queued with no worker running, so that all 300 are waiting when beta's arrives.
+    let queuing = spawn_app_in(TestStore::new(backend).await, with_tenants(0)).await;
+    const ALPHA_JOBS: u64 = 300;
+    const BETA_STEPS: u64 = 7;
+    for k in 0..ALPHA_JOBS {
+        // Distinct inputs: identical ones would reuse results instead of running.
+        As::alpha(&queuing).submit(json!({"steps": 1000 + k})).await;
+    }
+    let beta_job = As::beta(&queuing).submit(json!({"steps": BETA_STEPS})).await;
+    let store = queuing.stop().await;
+
+    let workers = 2;
+    let app = spawn_app_in(store, with_tenants(workers)).await;
+    let status = As::beta(&app).wait_until_finished(&beta_job).await;
+    assert_eq!(status["status"], "successful", "{status}");
+    let runs = app.probe.runs.lock().unwrap().clone();
+    let position = runs
+        .iter()
+        .position(|&steps| steps == BETA_STEPS)
+        .expect("beta's job ran");
+    // Concurrent claims may both take alpha's first jobs; the next free worker takes beta's.
+    assert!(
+        position < 2 * workers,
+        "beta's job started as run #{} of {} started so far; expected within the first {}: {runs:?}",
+        position + 1,
+        runs.len(),
+        2 * workers
+    );
 }

@@ -3,18 +3,38 @@
 //!
 //! The tag hashes exactly the bytes sent (FNV-1a, 64 bit), so it changes whenever the
 //! representation does and never otherwise: a poller that sends back the tag of the
-//! last status it saw gets an empty 304 until progress moves.
+//! last status it saw gets an empty 304 until progress moves. A streamed history's tag
+//! hashes what its bytes are made from instead ([`entity_tag_of_parts`]).
 
 use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 
 /// Strong entity tag of a representation, e.g. `"9f0c2b7e61d3a845"`.
 pub fn entity_tag(body: &[u8]) -> HeaderValue {
-    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-    for byte in body {
+    tag_of_hash(fnv1a(0xcbf2_9ce4_8422_2325, body))
+}
+
+/// Strong entity tag of a representation streamed as it is written, whose bytes are not
+/// there to hash before the headers go: the hash of everything the bytes are a function
+/// of (the stored data, the query, the service version), in `parts`.
+pub fn entity_tag_of_parts(parts: &[&[u8]]) -> HeaderValue {
+    let hash = parts.iter().fold(0xcbf2_9ce4_8422_2325, |hash, part| {
+        // The length first, so that moving bytes between parts changes the tag.
+        let hash = fnv1a(hash, &(part.len() as u64).to_le_bytes());
+        fnv1a(hash, part)
+    });
+    tag_of_hash(hash)
+}
+
+fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
+    for byte in bytes {
         hash ^= u64::from(*byte);
         hash = hash.wrapping_mul(0x0100_0000_01b3);
     }
+    hash
+}
+
+fn tag_of_hash(hash: u64) -> HeaderValue {
     HeaderValue::from_str(&format!("\"{hash:016x}\"")).expect("hex is a valid header value")
 }
 

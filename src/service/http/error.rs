@@ -20,7 +20,8 @@ pub enum ApiError {
     /// The problem's own status (4xx): shown to the client as is.
     #[error("{}", .0.detail)]
     Problem(Box<Problem>),
-    /// The problem's status (429): try again after `retry_after` seconds (`Retry-After`).
+    /// The problem's status (429, or 503 while shutting down): try again after
+    /// `retry_after` seconds (`Retry-After`).
     #[error("{}", .problem.detail)]
     RetryLater { problem: Box<Problem>, retry_after: u64 },
     /// 507 (full disk) or 503 (I/O error) with `Retry-After` when the storage refused a

@@ -3,13 +3,14 @@
 //! both make, and [`respond`], which finds the history of a successful job, renders it
 //! off the runtime and sends it with an entity tag.
 
-use axum::http::{HeaderMap, header};
-use axum::response::Response;
+use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
 
 use super::AppState;
-use super::conditional::tagged;
+use super::conditional::{entity_tag, if_none_match};
 use super::error::ApiError;
 use super::results::{successful, with_retry_after};
+use super::streamed::{Rendered, WriteBody, held_bytes, streamed, working_bytes};
 use crate::problem::Problem;
 use crate::service::auth::Tenant;
 use crate::service::queue::read::JobOutcome;
@@ -80,8 +81,10 @@ pub(super) fn capped_max_points(requested: Option<usize>, cap: usize) -> Result<
 /// its process and results document): 404 (with `Retry-After` while the job is not
 /// finished) unless the job succeeded and recorded that output. Decompressing, thinning
 /// and transforming a long history is CPU work, so `render` runs on the blocking pool;
-/// `work` names it in the error should it panic.
-pub(super) async fn respond<F>(
+/// `work` names it in the error should it panic. The response's working memory comes
+/// out of the server's budget (503 `server-busy` when it is spent) until its body is
+/// sent; a [`Rendered::Stream`] body is written as the client takes it.
+pub(super) async fn respond<F, R>(
     state: &AppState,
     tenant: &Tenant,
     job_id: &str,
@@ -92,7 +95,8 @@ pub(super) async fn respond<F>(
     render: F,
 ) -> Result<Response, ApiError>
 where
-    F: FnOnce(&StoredHistory, &JobOutcome) -> Result<Vec<u8>, ApiError> + Send + 'static,
+    F: FnOnce(&StoredHistory, &JobOutcome) -> Result<R, ApiError> + Send + 'static,
+    R: Into<Rendered>,
 {
     with_retry_after(
         async {
@@ -102,11 +106,38 @@ where
                 .history(tenant.as_str(), job_id, output)
                 .await?
                 .ok_or_else(|| Problem::no_such_output(job_id, output))?;
-            let rendered = tokio::task::spawn_blocking(move || render(&stored, &outcome))
-                .await
-                .map_err(|e| ApiError::Internal(format!("{work} panicked: {e}")))??;
-            Ok(tagged(headers, format.content_type(), rendered, HeaderMap::new()))
+            let permit = state.response_memory.admit(working_bytes(&stored))?;
+            let rendered = tokio::task::spawn_blocking(move || {
+                render(&stored, &outcome).map(|body| -> Rendered { body.into() })
+            })
+            .await
+            .map_err(|e| ApiError::Internal(format!("{work} panicked: {e}")))??;
+            let (etag, body) = match rendered {
+                Rendered::Bytes(bytes) => (entity_tag(&bytes), Either::Bytes(bytes)),
+                Rendered::Stream { etag, write } => (etag, Either::Stream(write)),
+            };
+            let mut response_headers = HeaderMap::new();
+            response_headers.insert(header::ETAG, etag.clone());
+            response_headers.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
+            if if_none_match(headers, &etag) {
+                return Ok((StatusCode::NOT_MODIFIED, response_headers).into_response());
+            }
+            response_headers.insert(
+                header::CONTENT_TYPE,
+                HeaderValue::from_static(format.content_type()),
+            );
+            let body = match body {
+                Either::Bytes(bytes) => held_bytes(permit, bytes),
+                Either::Stream(write) => streamed(permit, write),
+            };
+            Ok((StatusCode::OK, response_headers, body).into_response())
         }
         .await,
     )
+}
+
+/// A rendered body without its tag.
+enum Either {
+    Bytes(Vec<u8>),
+    Stream(WriteBody),
 }

@@ -23,6 +23,7 @@ pub mod results;
 pub mod signal_models;
 pub mod signals;
 pub mod spectra;
+pub mod streamed;
 pub mod sweep_models;
 pub mod sweeps;
 
@@ -46,6 +47,7 @@ use super::auth::TokenTable;
 use super::db::fault::StorageFault;
 use super::metrics::Metrics;
 use super::queue::JobQueue;
+use super::shutdown::ShutdownHandle;
 use super::signals::SignalStore;
 use super::worker::RunningJobs;
 use crate::problem::Problem;
@@ -57,6 +59,8 @@ use error::{PROBLEM_JSON, problem_response};
 #[derive(Debug, Clone)]
 pub struct AppState {
     pub queue: JobQueue,
+    /// The process's shutdown: writes are refused once it is stopping.
+    pub shutdown: ShutdownHandle,
     pub registry: Registry,
     /// Jobs running in this instance (to cancel them at once on dismissal).
     pub running: RunningJobs,
@@ -71,6 +75,8 @@ pub struct AppState {
     pub max_queued_jobs: Option<u64>,
     /// Most rows of one history response.
     pub max_history_points: usize,
+    /// The working memory the history responses being made may use together.
+    pub response_memory: streamed::ResponseMemory,
     /// Stored signals (accelerograms) of every tenant.
     pub signals: SignalStore,
     /// Largest body of `POST /signals` (bytes; the general limit does not apply there).
@@ -140,6 +146,10 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .fallback(not_found)
         // HTML for browsers on the routes that have a page (innermost: it sees the route).
         .layer(middleware::from_fn(dashboard::negotiate))
+        .layer(middleware::from_fn_with_state(
+            state.clone(),
+            refuse_writes_while_stopping,
+        ))
         // Layers run outside-in from the last one added: trace and count every request,
         // turn any bare error below (timeout, panic, 405, 413) into a problem, and
         // authenticate before anything reads the body.
@@ -231,6 +241,29 @@ async fn problem_for_bare_errors(response: Response) -> Response {
         header::HeaderValue::from_static(PROBLEM_JSON),
     );
     Response::from_parts(parts, rendered.into_body())
+}
+
+/// Seconds a client refused by a stopping process is asked to wait (`Retry-After`):
+/// about the time a restart or a load balancer takes to send it elsewhere.
+pub const SHUTTING_DOWN_RETRY_SECONDS: u64 = 5;
+
+/// Once the process is stopping, requests that would change something (any method but
+/// GET, HEAD and OPTIONS) get 503 with `Retry-After`; reads are served until the
+/// workers are done.
+async fn refuse_writes_while_stopping(
+    State(state): State<AppState>,
+    request: Request,
+    next: Next,
+) -> Response {
+    let safe = request.method().is_safe();
+    if !safe && state.shutdown.is_stopping() {
+        return error::ApiError::RetryLater {
+            problem: Box::new(Problem::shutting_down()),
+            retry_after: SHUTTING_DOWN_RETRY_SECONDS,
+        }
+        .into_response();
+    }
+    next.run(request).await
 }
 
 /// Counts and times every request by method, route template and status.

@@ -75,6 +75,21 @@ pub struct SignalUploadSchema {
     acceleration: Vec<f64>,
 }
 
+/// What `GET /jobs/{jobId}/results/{output}` answers as JSON: a time history, or, for
+/// the output named `impacts` (which also has its own path,
+/// `/jobs/{jobId}/results/impacts`), a page of the per-impact table. A client that
+/// matches URLs against the generic path gets a schema its answer follows either way.
+#[derive(Debug, serde::Serialize, utoipa::ToSchema)]
+#[serde(untagged)]
+#[schema(as = ResultOutput)]
+#[allow(dead_code)]
+pub enum ResultOutputSchema {
+    /// A time history.
+    History(models::HistoryDocument),
+    /// A page of the per-impact table (`output` is `impacts`).
+    Impacts(impacts::ImpactPage),
+}
+
 /// A cost ceiling a run exceeds.
 #[derive(Debug, utoipa::ToSchema)]
 #[schema(as = Excess)]
@@ -250,6 +265,7 @@ impl Modify for ResourceLinks {
         crate::processes::report::StepHalvingReport,
         models::HistoryDocument,
         models::Series,
+        ResultOutputSchema,
         impacts::ImpactPage,
         spectra::SpectrumDocument,
         spectra::SpectrumComparison,

@@ -1,17 +1,20 @@
 //! `/jobs/{jobId}/results`: the results document, and each time history as CSV or JSON.
 
 use axum::extract::{Extension, Path, State};
+use std::io::Write;
+
 use axum::http::{HeaderMap, HeaderValue, header};
 use axum::response::Response;
 
 use super::AppState;
-use super::conditional::tagged;
+use super::conditional::{entity_tag_of_parts, tagged};
 use super::error::ApiError;
 use super::extract::ApiQuery;
 use super::history_view::{Format, capped_max_points, require_finite, respond};
 use super::models::{HistoryDocument, Results, Series};
+use super::streamed::{Rendered, WriteBody};
 use crate::problem::Problem;
-use crate::processes::Column;
+use crate::processes::{Column, write_columns_csv_rows};
 use crate::service::auth::Tenant;
 use crate::service::queue::JobStatus;
 use crate::service::queue::read::JobOutcome;
@@ -118,17 +121,20 @@ pub async fn results(
 /// what each column is (unit, what it measures); `header=long` puts the same in the CSV
 /// header (`c12 [N] contact wall–p0 at 0.18 m`). A window longer than the service's cap
 /// (`--max-history-points`) is thinned to it: page through long histories with
-/// `t_start` and `t_end` for full resolution.
+/// `t_start` and `t_end` for full resolution. The output named `impacts` is the
+/// per-impact table, with its own path and query (`/jobs/{jobId}/results/impacts`); the
+/// JSON schema here covers both.
 #[utoipa::path(get, path = "/jobs/{jobId}/results/{output}", operation_id = "getResultOutput", tag = "Results",
     params(
         ("jobId" = String, Path, description = "Job id"),
-        ("output" = String, Path, description = "Output name, e.g. `tip_displacement`", example = "tip_displacement"),
+        ("output" = String, Path, description = "Output name, e.g. `tip_displacement` (`impacts`: see \
+            `/jobs/{jobId}/results/impacts`)", example = "tip_displacement"),
         HistoryQuery,
     ),
     responses(
         (status = 200, description = "The history (time in s; values in the output's unit)",
             content(
-                (HistoryDocument = "application/json"),
+                (super::openapi::ResultOutputSchema = "application/json"),
                 (String = "text/csv")
             ),
             headers(("ETag" = String))),
@@ -172,7 +178,8 @@ pub async fn output(
                 format,
                 long_header,
             };
-            render(stored, &columns_of(&registry, outcome), view)
+            let etag = view.entity_tag(stored, outcome);
+            render(stored, &columns_of(&registry, outcome), view, etag)
         },
     )
     .await
@@ -185,7 +192,35 @@ struct View<'a> {
     long_header: bool,
 }
 
-/// What the columns of a history of this job are: its process describes them from the
+impl View<'_> {
+    /// The tag of the bytes this view of `stored` writes: they are a function of the
+    /// stored history, the job's results document (the columns' descriptions), the view
+    /// and the code that renders them.
+    fn entity_tag(&self, stored: &store::StoredHistory, outcome: &JobOutcome) -> HeaderValue {
+        let query = self.query;
+        let view = format!(
+            "{:?} {} {:?} {:?} {:?} {:?} {} {}",
+            self.format,
+            self.long_header,
+            query.t_start,
+            query.t_end,
+            query.max_points,
+            query.series,
+            stored.samples,
+            stored.series.join(","),
+        );
+        entity_tag_of_parts(&[
+            env!("CARGO_PKG_VERSION").as_bytes(),
+            outcome.record.process_id.as_bytes(),
+            outcome.results.as_deref().unwrap_or_default().as_bytes(),
+            stored.name.as_bytes(),
+            view.as_bytes(),
+            &stored.data,
+        ])
+    }
+}
+
+/// What each column of a history of this job is: its process describes them from the
 /// job's results document.
 fn columns_of<'a>(
     registry: &'a crate::processes::Registry,
@@ -207,37 +242,50 @@ fn columns_of<'a>(
     }
 }
 
+/// Decodes and selects now (a bad `series` is a 400 before anything is sent); the text,
+/// JSON or CSV, is written as the client takes it.
 fn render(
     stored: &store::StoredHistory,
     columns: &dyn Fn(&crate::processes::History) -> Vec<Column>,
     view: View<'_>,
-) -> Result<Vec<u8>, ApiError> {
+    etag: HeaderValue,
+) -> Result<Rendered, ApiError> {
     let query = view.query;
     let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
     let history = thinning::pick_series(history, query.series.as_deref()).map_err(Problem::invalid_query)?;
-    let selected = thinning::select(&history, query.t_start, query.t_end, query.max_points);
-    if view.format == Format::Csv {
-        let csv = selected.to_csv();
-        if !view.long_header {
-            return Ok(csv.into_bytes());
-        }
-        // The descriptive header in place of the names' line.
-        let body = csv.split_once('\n').map_or("", |(_, body)| body);
-        let header: Vec<String> = columns(&selected)
-            .iter()
-            .map(|c| crate::csv_format::quote(&c.long_header()).into_owned())
-            .collect();
-        return Ok(format!("{}\n{body}", header.join(",")).into_bytes());
-    }
+    let total_points = history.time.len();
     let in_window = thinning::count_in_window(&history.time, query.t_start, query.t_end);
-    let document = HistoryDocument {
-        columns: columns(&selected),
-        output: selected.name,
-        points: selected.time.len(),
-        total_points: history.time.len(),
-        thinned: selected.time.len() < in_window,
-        time: selected.time,
-        series: Series::from_columns(selected.series),
+    let selected = thinning::select_owned(history, query.t_start, query.t_end, query.max_points);
+    let columns = columns(&selected);
+    let write: WriteBody = if view.format == Format::Csv {
+        let header: Vec<String> = if view.long_header {
+            columns
+                .iter()
+                .map(|c| crate::csv_format::quote(&c.long_header()).into_owned())
+                .collect()
+        } else {
+            std::iter::once("time".to_owned())
+                .chain(selected.series.iter().map(|(name, _)| name.clone()))
+                .collect()
+        };
+        Box::new(move |out: &mut dyn Write| {
+            out.write_all(header.join(",").as_bytes())?;
+            out.write_all(b"\n")?;
+            write_columns_csv_rows(out, &selected.time, &selected.series)
+        })
+    } else {
+        let document = HistoryDocument {
+            columns,
+            output: selected.name,
+            points: selected.time.len(),
+            total_points,
+            thinned: selected.time.len() < in_window,
+            time: selected.time,
+            series: Series::from_columns(selected.series),
+        };
+        Box::new(move |out: &mut dyn Write| {
+            serde_json::to_writer(out, &document).map_err(std::io::Error::other)
+        })
     };
-    serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
+    Ok(Rendered::Stream { etag, write })
 }

@@ -6,14 +6,16 @@
 //! the poll interval passes. The `N` slots share `N` cores: a run that asks for
 //! several threads (`solver.threads`) gets as many of the free ones, and the other
 //! slots claim nothing until cores are free again, so the runs never use more threads
-//! than the worker has slots. Shutdown happens in two steps: stop claiming, wait for the running jobs up to
-//! a grace period; then cancel what still runs and hand it back to the queue.
+//! than the worker has slots. Shutdown happens in two steps: stop claiming at once, wait for the
+//! running jobs up to a grace period (or until a second signal); then cancel what still
+//! runs and hand it back to the queue, its attempt not counted.
 
 pub mod control;
 mod maintenance;
 mod persist;
 mod run;
 
+use std::future::Future;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -78,15 +80,19 @@ impl Workers {
         }
     }
 
-    /// Stops claiming, lets running jobs finish within `grace`, then cancels the rest
+    /// Stops claiming at once; lets running jobs finish within `grace` or until
+    /// `hurry` completes (a second signal), whichever comes first; then cancels the rest
     /// and hands them back to the queue (waiting a few more seconds for them to stop).
-    pub async fn shutdown(mut self, grace: Duration) {
+    pub async fn shutdown(mut self, grace: Duration, hurry: impl Future<Output = ()>) {
         let _ = self.stop_claiming.send(true);
-        let finished = tokio::time::timeout(grace, drain(&mut self.tasks)).await.is_ok();
+        let finished = tokio::select! {
+            finished = tokio::time::timeout(grace, drain(&mut self.tasks)) => finished.is_ok(),
+            () = hurry => false,
+        };
         if finished {
             return;
         }
-        tracing::warn!("running jobs did not finish within the grace period; handing them back");
+        tracing::warn!("handing the running jobs back to the queue");
         let _ = self.hand_back.send(true);
         if tokio::time::timeout(Duration::from_secs(10), drain(&mut self.tasks))
             .await
@@ -163,6 +169,10 @@ async fn worker_loop(
             },
             changed = stop.changed() => if changed.is_err() { break } else { continue },
         };
+        // The core may have come with the request to stop: claim nothing after it.
+        if *stop.borrow() {
+            break;
+        }
         // Register for wake-ups before looking, so an enqueue right after an empty
         // claim is not missed.
         let wake = ctx.wake.notified();
