@@ -102,7 +102,7 @@ impl Engine {
 
     /// Starts the worker slots, the periodic maintenance and, on PostgreSQL with
     /// workers, the listener that wakes them when another process queues jobs.
-    fn start(&mut self, config: &ServiceConfig, registry: Registry) {
+    fn start(&mut self, config: &ServiceConfig, registry: Registry, shutdown: &ShutdownHandle) {
         let context = Arc::new(WorkerContext {
             queue: self.queue.clone(),
             registry,
@@ -114,7 +114,7 @@ impl Engine {
             progress_interval: config.progress_interval,
             max_job_time: config.max_job_time,
         });
-        self.workers = Some(Workers::start(context, config.workers));
+        self.workers = Some(Workers::start(context, config.workers, shutdown.clone()));
         self.background.push(tokio::spawn(
             self.maintenance.clone().run_every(config.maintenance_interval),
         ));
@@ -240,9 +240,9 @@ impl Application {
         }
         let mut engine = Engine::open(&config).await?;
         let (listener, address) = bind(config.bind).await?;
-        engine.start(&config, registry.clone());
-        let tenants = config.auth.as_ref().map_or(0, |table| table.len());
         let shutdown = ShutdownHandle::default();
+        engine.start(&config, registry.clone(), &shutdown);
+        let tenants = config.auth.as_ref().map_or(0, |table| table.len());
         let router = http::router(
             engine.state(registry, &config, &shutdown),
             &HttpSettings {
@@ -360,7 +360,7 @@ impl WorkerService {
             }
             None => None,
         };
-        engine.start(&config, registry);
+        engine.start(&config, registry, &shutdown);
         tracing::info!(
             workers = config.workers,
             health = %health.as_ref().map_or_else(|| "none".to_owned(), |(address, _, _)| address.to_string()),

@@ -191,11 +191,19 @@ async fn sweep_rows_carry_the_verdict_and_the_aggregates_count_poor_runs_per_axi
     assert!(total_poor >= 2, "both coarse runs are poor");
     assert_eq!(quality["runs"], 4, "{quality}");
     assert_eq!(quality["poor"], total_poor, "{quality}");
-    let counted: u64 = ["good", "doubtful", "poor"]
+    let counted: u64 = ["good", "unchecked", "doubtful", "poor"]
         .iter()
         .map(|v| quality[v].as_u64().unwrap())
         .sum();
     assert_eq!(counted, 4, "{quality}");
+    // The runs have no step-halving check: none is good, and the fine ones are unchecked
+    // unless something else is wrong with them.
+    assert_eq!(quality["good"], 0, "{quality}");
+    let unchecked = rows
+        .iter()
+        .filter(|r| r["quality.verdict"] == "unchecked")
+        .count();
+    assert_eq!(quality["unchecked"], unchecked, "{quality}");
     let by_axis = quality["by_axis"].as_array().unwrap();
     assert_eq!(by_axis.len(), 2, "{quality}");
     for axis in by_axis {

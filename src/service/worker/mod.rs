@@ -27,6 +27,7 @@ pub use maintenance::Maintenance;
 
 use super::metrics::Metrics;
 use super::queue::JobQueue;
+use super::shutdown::{Phase, ShutdownHandle};
 use crate::processes::Registry;
 
 /// What every worker slot shares.
@@ -58,7 +59,9 @@ pub struct Workers {
 
 impl Workers {
     /// Starts `count` worker slots, each leasing jobs under its own owner id.
-    pub fn start(context: Arc<WorkerContext>, count: usize) -> Self {
+    /// A slot claims nothing once `shutdown` has left [`Phase::Serving`], even before
+    /// [`Workers::shutdown`] runs: the request is seen by the next claim at once.
+    pub fn start(context: Arc<WorkerContext>, count: usize, shutdown: ShutdownHandle) -> Self {
         let (stop_claiming, stop_rx) = watch::channel(false);
         let (hand_back, hand_back_rx) = watch::channel(false);
         let instance = instance_id();
@@ -69,7 +72,7 @@ impl Workers {
             tasks.spawn(worker_loop(
                 context.clone(),
                 (owner, cores.clone()),
-                stop_rx.clone(),
+                (stop_rx.clone(), shutdown.clone()),
                 hand_back_rx.clone(),
             ));
         }
@@ -154,7 +157,7 @@ impl Cores {
 async fn worker_loop(
     ctx: Arc<WorkerContext>,
     (owner, cores): (String, Arc<Semaphore>),
-    mut stop: watch::Receiver<bool>,
+    (mut stop, shutdown): (watch::Receiver<bool>, ShutdownHandle),
     hand_back: watch::Receiver<bool>,
 ) {
     loop {
@@ -169,8 +172,9 @@ async fn worker_loop(
             },
             changed = stop.changed() => if changed.is_err() { break } else { continue },
         };
-        // The core may have come with the request to stop: claim nothing after it.
-        if *stop.borrow() {
+        // The core may have come with the request to stop: claim nothing after it (the
+        // phase is the request itself, seen before the workers are told).
+        if *stop.borrow() || shutdown.phase() != Phase::Serving {
             break;
         }
         // Register for wake-ups before looking, so an enqueue right after an empty
