@@ -101,7 +101,8 @@ pub fn first_impact_peak(basis: &ModalBasis, contact: ProbeContact) -> Option<f6
 fn closed_contact_terms(omega: &[f64], psi: &[f64], k: f64) -> Option<Vec<(f64, f64)>> {
     let first = *psi.first()?;
     let largest = psi.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if !(first.abs() > 1e-6 * largest) || !(k > 0.0) {
+    let (first_moves, pushes) = (first.abs() > 1e-6 * largest, k > 0.0);
+    if !first_moves || !pushes {
         return None;
     }
     // Modes that do not move at the contact do not take part; the rest by frequency.
@@ -119,7 +120,8 @@ fn closed_contact_terms(omega: &[f64], psi: &[f64], k: f64) -> Option<Vec<(f64, 
     for (j, &(d, _)) in parts.iter().enumerate() {
         let upper = parts.get(j + 1).map_or(d + k * total, |next| next.0);
         let (mut lo, mut hi) = (d, upper);
-        if !(hi > lo) {
+        let open = hi > lo;
+        if !open {
             // Two modes at the same frequency: the root sits on it (no weight).
             continue;
         }
@@ -154,7 +156,8 @@ fn first_peak(terms: &[(f64, f64)]) -> f64 {
     };
     let fastest = weighted().map(|&(_, l)| l).fold(0.0f64, f64::max);
     let slowest = weighted().map(|&(_, l)| l).fold(f64::INFINITY, f64::min);
-    if !(fastest > 0.0) {
+    let moving = fastest > 0.0;
+    if !moving {
         return 0.0;
     }
     let dt = std::f64::consts::TAU / (SAMPLES_PER_PERIOD * fastest);
@@ -292,7 +295,8 @@ pub struct BasisErrors {
 /// two pins; `None` for a contact without stiffness (it never pushes).
 fn probe_contact(model: &Model<'_>, contact: usize) -> Option<ProbeContact> {
     let c = &model.contacts[contact];
-    if !(c.stiffness > 0.0) {
+    let pushes = c.stiffness > 0.0;
+    if !pushes {
         return None;
     }
     let between_pins = matches!((c.left, c.right), (Body::Pin(_), Body::Pin(_)));
