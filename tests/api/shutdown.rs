@@ -16,14 +16,12 @@ use crate::scale_out::Process;
 
 on_both_backends!(jobs_outliving_the_grace_are_handed_back_and_complete_on_the_next_start);
 
-/// The draining test on each backend. On SQLite a third run starts after the signal in
-/// some runs (seen 2 of 3 on a loaded 2-core machine; not on PostgreSQL): a claim that
-/// began before the signal can still take a job queued after it. Open in issue 30.
+/// The draining test on each backend. A claim that began before the signal and returns
+/// a job after it hands that job straight back, so no job starts after the signal.
 mod draining {
     use crate::helpers::Backend;
 
     #[tokio::test]
-    #[ignore = "flaky on SQLite: a claim begun before the signal can take a job queued after it (issue 30); run with --ignored"]
     async fn sqlite_while_draining_reads_are_answered_writes_get_503_and_a_second_signal_hands_back_at_once()
     {
         super::while_draining_reads_are_answered_writes_get_503_and_a_second_signal_hands_back_at_once(

@@ -184,6 +184,17 @@ async fn worker_loop(
         wake.as_mut().enable();
         match ctx.queue.claim(&owner, ctx.lease).await {
             Ok(Some(job)) => {
+                // The request to stop may have come while the claim ran: the job was
+                // queued (perhaps after the signal) and is not ours to start. Hand it
+                // straight back, its attempt not counted.
+                if *stop.borrow() || shutdown.phase() != Phase::Serving {
+                    let lease = job.lease;
+                    if let Err(error) = ctx.queue.hand_back(&lease).await {
+                        ctx.metrics.storage().check(&error, "hand back");
+                        tracing::error!(%error, job = %lease.job_id, "handing back a job claimed during shutdown failed; its lease will expire");
+                    }
+                    break;
+                }
                 let mut held = Cores { held: vec![core] };
                 let usable = ctx
                     .registry
