@@ -8,6 +8,7 @@ use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
 use super::bundle_inputs::{BaseAccelerationInput, BodyInput, BundleInputs, ContactInput};
+use super::contact_law::{self, LawInput, Utilisation};
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::inputs::{self, SolverDefaults, at};
 use super::model_check::{self, StandIn};
@@ -15,7 +16,7 @@ use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
-use crate::physics::contact::Contact;
+use crate::physics::contact::{Body, Contact};
 use crate::physics::integrate::{self, Model, Settings, StepSize};
 use crate::physics::modal::ModalBasis;
 
@@ -77,6 +78,13 @@ fn pointer_of(inputs: &BundleInputs, path: &str, pins_refused: bool) -> Option<S
         ("pins", None, "") if generated => "/inputs/bundle/pins".to_owned(),
         ("pins", None, "") => "/inputs/pins".to_owned(),
         ("damping_ratios", mode, _) => model_check::damping_ratio_pointer(&inputs.pin, "/inputs/pin", mode),
+        ("contacts", Some(k), rest) if generated && (rest == "law" || rest.starts_with("law/")) => {
+            let generator = inputs.bundle.as_ref().expect("generated");
+            // Expanded level by level: wall–0, 0–1, …, (n−1)–wall.
+            let place = k % (generator.pins + 1);
+            let (_, pointer) = generator.families().of(place == 0 || place == generator.pins);
+            model_check::join(pointer, rest.strip_prefix("law").unwrap_or(rest))
+        }
         ("contacts", Some(_), _) if generated => "/inputs/bundle".to_owned(),
         ("contacts", Some(_), "left" | "right") if pins_refused => return None,
         ("contacts", Some(k), rest) => model_check::join(&format!("/inputs/contacts/{k}"), rest),
@@ -135,6 +143,10 @@ pub struct BundleResults {
     pub contacts: Vec<ContactResult>,
     /// The largest force over all contacts; null without contacts.
     pub max_contact_force: Option<PeakForce>,
+    /// The contact of largest utilisation (peak force over allowable force); absent
+    /// when no law gives an allowable force.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_utilisation: Option<Utilisation>,
     /// Impacts over all contacts, as `output.impacts` counts them.
     pub impacts: u64,
     /// The run's impacts: counting, totals, histogram, contacts ranked.
@@ -180,6 +192,9 @@ pub struct ContactResult {
     pub max_penetration: f64,
     /// Its impacts as `output.impacts` counts them (`impacts` above is their number).
     pub impact_statistics: ContactImpacts,
+    /// `max_force` over the law's `allowable_force`; absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub utilisation: Option<f64>,
 }
 
 /// The largest contact force of the run.
@@ -245,8 +260,9 @@ pub struct Expansion {
     pub contacts: Vec<ContactInput>,
 }
 
-impl From<&Contact> for ContactInput {
-    fn from(c: &Contact) -> Self {
+impl ContactInput {
+    /// Contact `c` in the explicit form, with its law as the user gave it.
+    fn echo(c: &Contact, law: LawInput) -> Self {
         ContactInput {
             left: BodyInput::from(c.left),
             right: BodyInput::from(c.right),
@@ -254,6 +270,7 @@ impl From<&Contact> for ContactInput {
             gap: c.gap,
             stiffness: c.stiffness,
             damping: c.damping,
+            law,
         }
     }
 }
@@ -318,8 +335,16 @@ impl Simulation for BundleDynamics {
         let (pins, contacts) = match (&inputs.bundle, inputs.pins, &inputs.contacts) {
             (Some(generator), None, None) => {
                 let layout = generator.layout();
+                generator.families().check(&mut errors);
+                generator.families().refuse_wear_in_a_row(&mut errors);
                 match layout.expand(length) {
-                    Ok(contacts) => (generator.pins, contacts),
+                    Ok(mut contacts) => {
+                        for contact in &mut contacts {
+                            let wall = contact.left == Body::Wall || contact.right == Body::Wall;
+                            contact.law = generator.families().of(wall).0.law();
+                        }
+                        (generator.pins, contacts)
+                    }
                     Err(issues) => {
                         errors.extend(at("/inputs/bundle", issues));
                         (generator.pins, vec![])
@@ -332,6 +357,11 @@ impl Simulation for BundleDynamics {
                         "/inputs/pins",
                         format!("must be between 1 and {MAX_PINS}"),
                     ));
+                }
+                for (k, contact) in contacts.iter().flatten().enumerate() {
+                    let pointer = format!("/inputs/contacts/{k}/law");
+                    contact.law.check(&pointer, &mut errors);
+                    contact.law.refuse_wear_in_a_row(&pointer, &mut errors);
                 }
                 let contacts = contacts.iter().flatten().map(ContactInput::contact).collect();
                 (pins, contacts)
@@ -493,13 +523,24 @@ impl Simulation for BundleDynamics {
         let assessed = integrate::Plan::with_step(&model, &plan.settings, plan.step)?.run(progress)?;
         let (simulation, quality) = (assessed.simulation, assessed.quality);
 
+        let laws: Vec<LawInput> = (plan.contacts.iter().enumerate())
+            .map(|(k, c)| plan.inputs.law_of(c, k).0)
+            .collect();
+        let allowables: Vec<Option<f64>> = laws.iter().map(LawInput::allowable).collect();
+        let peaks: Vec<f64> = simulation
+            .contact_statistics
+            .iter()
+            .map(|s| s.max_force)
+            .collect();
         let contacts: Vec<ContactResult> = plan
             .contacts
             .iter()
             .zip(&simulation.contact_statistics)
             .zip(impact_report::contact_reports(&simulation))
-            .map(|((c, s), impact_statistics)| ContactResult {
-                contact: c.into(),
+            .zip(laws.iter().zip(&allowables))
+            .map(|(((c, s), impact_statistics), (law, allowable))| ContactResult {
+                contact: ContactInput::echo(c, *law),
+                utilisation: contact_law::utilisation(s.max_force, *allowable),
                 max_force: s.max_force,
                 max_force_time: s.max_force_time,
                 impacts: s.impacts,
@@ -536,6 +577,7 @@ impl Simulation for BundleDynamics {
         let results = BundleResults {
             contacts,
             max_contact_force,
+            max_utilisation: contact_law::worst(&peaks, &allowables),
             impacts: simulation.contact_statistics.iter().map(|s| s.impacts).sum(),
             impact_summary: impact_report::summary(&simulation, &plan.settings.impacts),
             pins,
@@ -549,7 +591,12 @@ impl Simulation for BundleDynamics {
             basis: BasisReport::of(&model, plan.settings.scheme, simulation.step.critical_time_step),
             expansion: plan.inputs.bundle.is_some().then(|| Expansion {
                 pins: plan.pins,
-                contacts: plan.contacts.iter().map(ContactInput::from).collect(),
+                contacts: plan
+                    .contacts
+                    .iter()
+                    .zip(&laws)
+                    .map(|(c, law)| ContactInput::echo(c, *law))
+                    .collect(),
             }),
         };
         let histories = histories(&plan, simulation);

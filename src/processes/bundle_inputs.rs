@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use super::contact_law::{Families, LawInput};
 use super::impact_report::ImpactsInput;
 use super::input_schema::{NonNegativeNumber, PositiveNumber};
 use super::inputs::{BeamInput, SolverInput};
@@ -64,17 +65,23 @@ pub struct ContactInput {
     /// Height from the pin feet (m), at most the pin length.
     #[schema(minimum = 0.0)]
     pub height: f64,
-    /// Gap at rest (m).
+    /// Gap at rest (m); negative: an interference, the contact pushes at rest with
+    /// its preload (which other contacts at the same height must balance).
     #[serde(default)]
-    #[schema(default = 0.0, minimum = 0.0)]
+    #[schema(default = 0.0)]
     pub gap: f64,
-    /// Penalty stiffness Kc (N/m).
+    /// Penalty stiffness K (N/m; N/mⁿ for a power law).
     #[schema(minimum = 0.0)]
     pub stiffness: f64,
     /// Dashpot cc (N·s/m), acting only while the contact is closed.
     #[serde(default)]
     #[schema(default = 0.0, minimum = 0.0)]
     pub damping: f64,
+    /// The rest of the law: power-law exponent, restitution, Hunt–Crossley damping,
+    /// allowable force (the linear spring–dashpot when left out).
+    #[serde(default, skip_serializing_if = "LawInput::is_default")]
+    #[schema(default = json!({}))]
+    pub law: LawInput,
 }
 
 /// "wall" or a pin number.
@@ -128,6 +135,37 @@ impl BundleInputs {
     }
 }
 
+impl BundleGenerator {
+    /// The laws of its two families of contacts.
+    pub fn families(&self) -> Families<'_> {
+        Families {
+            pins: &self.law,
+            walls: self.wall_law.as_ref(),
+            pins_pointer: "/inputs/bundle/law",
+            walls_pointer: "/inputs/bundle/wall_law",
+        }
+    }
+}
+
+impl BundleInputs {
+    /// Each contact's law input (the generator's family laws for an expansion) and
+    /// where the user wrote it.
+    pub fn law_of(&self, contact: &Contact, k: usize) -> (LawInput, String) {
+        match (&self.bundle, &self.contacts) {
+            (Some(generator), _) => {
+                let wall = contact.left == Body::Wall || contact.right == Body::Wall;
+                let (law, pointer) = generator.families().of(wall);
+                (*law, pointer.to_owned())
+            }
+            (None, Some(contacts)) => (
+                contacts.get(k).map(|c| c.law).unwrap_or_default(),
+                format!("/inputs/contacts/{k}/law"),
+            ),
+            (None, None) => (LawInput::default(), "/inputs".to_owned()),
+        }
+    }
+}
+
 impl ContactInput {
     pub fn contact(&self) -> Contact {
         Contact {
@@ -137,6 +175,7 @@ impl ContactInput {
             gap: self.gap,
             stiffness: self.stiffness,
             damping: self.damping,
+            law: self.law.law(),
         }
     }
 }
@@ -160,6 +199,13 @@ pub struct BundleGenerator {
     #[serde(default)]
     #[schema(default = 0.0, minimum = 0.0)]
     pub damping: f64,
+    /// The rest of the law of every contact (of the pin–pin contacts when `wall_law`
+    /// is given): exponent, restitution, Hunt–Crossley damping, allowable force.
+    #[serde(default)]
+    #[schema(default = json!({}))]
+    pub law: LawInput,
+    /// The law of the wall contacts, instead of `law`.
+    pub wall_law: Option<LawInput>,
     /// Nominal wall–pin gap (m).
     #[schema(minimum = 0.0)]
     pub wall_gap: f64,

@@ -8,6 +8,7 @@ use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
 use super::columns::{self, Column};
+use super::contact_law::{self, LawInput};
 use super::impact_report::{self, ContactImpacts, ImpactSummary, ImpactsInput};
 use super::inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::model_check::{self, StandIn};
@@ -91,6 +92,12 @@ pub struct ContactInput {
     #[serde(default)]
     #[schema(default = 0.0, minimum = 0.0)]
     pub damping: f64,
+    /// The rest of the contact's law: exponent, restitution, Hunt–Crossley damping,
+    /// allowable force (the linear spring when left out). The reference knows the
+    /// linear spring without damping only: another law acts on the numerical model.
+    #[serde(default)]
+    #[schema(default = json!({}))]
+    pub law: LawInput,
 }
 
 /// Initial state: released at rest from the static shape of a tip load.
@@ -180,6 +187,7 @@ fn tip_model<'a>(inputs: &CantileverInputs, basis: &'a ModalBasis, contact_stiff
             gap: inputs.contact.gap,
             stiffness: contact_stiffness,
             damping: inputs.contact.damping,
+            law: inputs.contact.law.law(),
         }],
         initial_tip_displacements: vec![inputs.release.tip_displacement],
         base_acceleration: None,
@@ -227,6 +235,9 @@ pub struct NumericalResults {
     pub impact_summary: ImpactSummary,
     /// Largest contact force over every step (N).
     pub max_contact_force: f64,
+    /// `max_contact_force` over the law's `allowable_force`; absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub utilisation: Option<f64>,
     /// Its time (s).
     pub max_contact_force_time: f64,
     /// Total time in contact (s).
@@ -316,11 +327,19 @@ fn contact_stiffness(contact: &ContactInput, tip_stiffness: f64, errors: &mut Ve
         (rk, None) => {
             let rk = rk.unwrap_or(1.0);
             crate::physics::require_non_negative(&mut issues, "rk", rk);
+            if contact.law.exponent.is_some_and(|n| n != 1.0) {
+                issues.push(InputIssue::new(
+                    "stiffness",
+                    "a power law (law.exponent ≠ 1) takes its `stiffness` K in N/mⁿ, not `rk`",
+                ));
+            }
             rk * tip_stiffness
         }
         (None, Some(stiffness)) => stiffness,
     };
     errors.extend(at("/inputs/contact", issues));
+    contact.law.check("/inputs/contact/law", errors);
+    contact.law.refuse_wear_in_a_row("/inputs/contact/law", errors);
     stiffness
 }
 
@@ -338,6 +357,9 @@ fn pointer_of(inputs: &CantileverInputs, path: &str, beam_refused: bool) -> Opti
         ("contacts", Some(_), "stiffness") => "/inputs/contact/rk",
         ("contacts", Some(_), "gap") => "/inputs/contact/gap",
         ("contacts", Some(_), "damping") => "/inputs/contact/damping",
+        ("contacts", Some(_), rest) if rest == "law" || rest.starts_with("law/") => {
+            return Some(format!("/inputs/contact/{rest}"));
+        }
         ("contacts", Some(_), "height") | ("output_heights", _, _) => "/inputs/beam/length",
         ("contacts", _, _) => "/inputs/contact",
         ("initial_tip_displacements", Some(_), "") => "/inputs/release/tip_displacement",
@@ -598,6 +620,17 @@ impl Simulation for CantileverImpact {
                 contact.damping
             ));
         }
+        let law = &contact.law;
+        if law.exponent.is_some_and(|n| n != 1.0)
+            || law.hunt_crossley.is_some_and(|a| a > 0.0)
+            || law.restitution.is_some()
+            || law.friction.is_some()
+        {
+            notes.push(
+                "the reference has the linear spring without damping: contact.law acts on the numerical model only"
+                    .to_owned(),
+            );
+        }
         let spec = plan.inputs.beam.spec();
         let results = CantileverResults {
             model: CantileverModel {
@@ -612,6 +645,7 @@ impl Simulation for CantileverImpact {
                 impact_statistics: impact_report::contact_reports(&simulation).remove(0),
                 impact_summary: impact_report::summary(&simulation, &plan.settings.impacts),
                 max_contact_force: stats.max_force,
+                utilisation: contact_law::utilisation(stats.max_force, contact.law.allowable()),
                 max_contact_force_time: stats.max_force_time,
                 contact_time: stats.contact_time,
                 impulse: stats.impulse,

@@ -11,6 +11,7 @@ use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
 use super::bundle_dynamics::{PeakDeflectionResult, PeakForce};
+use super::contact_law::{self, FrictionReport, LawInput, Utilisation, WearDepth, WearReport};
 use super::hex_inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
 use super::hex_loads::{self, PlaneLoads};
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
@@ -98,6 +99,13 @@ pub struct HexResults {
     pub contacts: Vec<HexContactResult>,
     /// The largest force over all contacts; null without contacts.
     pub max_contact_force: Option<PeakForce>,
+    /// The contact of largest utilisation (peak force over allowable force); absent
+    /// when no law gives an allowable force.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_utilisation: Option<Utilisation>,
+    /// The contact worn deepest after `output.service_time`; absent without wear laws.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_wear_depth: Option<WearDepth>,
     /// Impacts over all contacts, as `output.impacts` counts them.
     pub impacts: u64,
     /// The run's impacts: counting, totals, histogram, contacts ranked.
@@ -194,10 +202,21 @@ pub struct HexContactResult {
     pub first_impact_time: Option<f64>,
     /// Largest penetration (m); ≤ 0 when the contact never closed (smallest clearance).
     pub max_penetration: f64,
-    /// Wear work rate (1/T) ∫ F·|v_t| dt (W), v_t the sliding velocity across the normal.
+    /// Wear work rate (1/T) ∫ F·|v_t| dt (W), v_t the sliding velocity across the normal,
+    /// over the steps the contact slips when its law has friction (code_aster's
+    /// PUIS_USURE), over every closed step without: the P of Archard's wear.
     pub wear_work_rate: f64,
     /// Its impacts as `output.impacts` counts them (`impacts` above is their number).
     pub impact_statistics: ContactImpacts,
+    /// `max_force` over its law's `allowable_force`; absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub utilisation: Option<f64>,
+    /// Its friction (absent when its law has none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionReport>,
+    /// Its Archard wear after `output.service_time` (absent when its law has none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wear: Option<WearReport>,
 }
 
 /// One pin's position and largest deflections.
@@ -332,6 +351,7 @@ impl Simulation for HexBundleDynamics {
             }
         };
         let recorded = recorded_contacts(&inputs, &bundle, &geometry, &mut errors);
+        inputs.contact.check_laws(&mut errors, inputs.output.service_time);
         if !errors.is_empty() {
             return Err(InvalidInputs(errors));
         }
@@ -341,14 +361,11 @@ impl Simulation for HexBundleDynamics {
             .iter()
             .zip(&gaps)
             .map(|(c, gap)| {
-                let (right, stiffness, damping) = match c.touched {
-                    Body::Pin(pin) => (RowBody::Pin(pin), law.stiffness, law.damping),
-                    Body::Flat(_) => (
-                        RowBody::Wall,
-                        law.wall_stiffness.unwrap_or(law.stiffness),
-                        law.wall_damping.unwrap_or(law.damping),
-                    ),
+                let right = match c.touched {
+                    Body::Pin(pin) => RowBody::Pin(pin),
+                    Body::Flat(_) => RowBody::Wall,
                 };
+                let (stiffness, damping, family, _) = law.family(right == RowBody::Wall);
                 Contact {
                     left: RowBody::Pin(c.wire_pin),
                     right,
@@ -356,6 +373,7 @@ impl Simulation for HexBundleDynamics {
                     gap: *gap,
                     stiffness,
                     damping,
+                    law: family.law(),
                 }
             })
             .collect();
@@ -472,6 +490,16 @@ impl Simulation for HexBundleDynamics {
         let (simulation, quality) = (assessed.simulation, assessed.quality);
         let duration = plan.settings.duration;
 
+        let laws: Vec<&LawInput> = (plan.contacts.iter())
+            .map(|c| plan.inputs.contact.family(c.right == RowBody::Wall).2)
+            .collect();
+        let allowables: Vec<Option<f64>> = laws.iter().map(|law| law.allowable()).collect();
+        let service_time = plan.inputs.output.service_time.unwrap_or(0.0);
+        let peaks: Vec<f64> = simulation
+            .contact_statistics
+            .iter()
+            .map(|s| s.max_force)
+            .collect();
         let contacts: Vec<HexContactResult> = plan
             .geometry
             .iter()
@@ -498,9 +526,27 @@ impl Simulation for HexBundleDynamics {
                 first_impact_time: s.first_impact_time,
                 max_penetration: s.max_penetration,
                 wear_work_rate: simulation.wear_work.get(k).copied().unwrap_or(0.0) / duration,
+                utilisation: contact_law::utilisation(s.max_force, allowables[k]),
+                friction: c.law.friction.is_on().then(|| {
+                    FrictionReport::of(&simulation.friction_statistics[k], s.contact_time, duration)
+                }),
+                wear: laws[k].wear.as_ref().map(|wear| {
+                    let power = simulation.wear_work.get(k).copied().unwrap_or(0.0) / duration;
+                    WearReport::of(wear, power, service_time)
+                }),
                 impact_statistics,
             })
             .collect();
+        let max_wear_depth = contacts
+            .iter()
+            .enumerate()
+            .filter_map(|(contact, c)| {
+                c.wear.map(|w| WearDepth {
+                    contact,
+                    depth: w.depth,
+                })
+            })
+            .max_by(|a, b| a.depth.total_cmp(&b.depth));
         let max_contact_force = simulation
             .contact_statistics
             .iter()
@@ -539,6 +585,8 @@ impl Simulation for HexBundleDynamics {
             geometry: geometry_report(&plan.bundle, plan.geometry.len()),
             contacts,
             max_contact_force,
+            max_utilisation: contact_law::worst(&peaks, &allowables),
+            max_wear_depth,
             impacts: simulation.contact_statistics.iter().map(|s| s.impacts).sum(),
             impact_summary: impact_report::summary(&simulation, &plan.settings.impacts),
             recorded_contacts,

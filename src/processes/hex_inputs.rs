@@ -6,6 +6,7 @@
 //! radians). Flats are numbered 0..6 counter-clockwise, flat k's outward normal at
 //! k·60° + 30°; pins from the centre outward, ring by ring (docs/hex-bundle.md).
 
+use super::contact_law::{Families, LawInput};
 use serde::Deserialize;
 use utoipa::ToSchema;
 
@@ -125,6 +126,73 @@ pub struct HexContactInput {
     /// cc of the pin–wrapper contacts (N·s/m); `damping` when left out.
     #[schema(minimum = 0.0)]
     pub wall_damping: Option<f64>,
+    /// The rest of the law of the pin–pin contacts (and of the pin–wrapper ones without
+    /// `wall_law`): exponent, restitution, Hunt–Crossley damping, friction, allowable
+    /// force (the linear spring–dashpot without friction when left out).
+    #[serde(default)]
+    #[schema(default = json!({}))]
+    pub law: LawInput,
+    /// The law of the pin–wrapper contacts, instead of `law`.
+    pub wall_law: Option<LawInput>,
+}
+
+impl HexContactInput {
+    /// The laws of the two families.
+    pub fn families(&self) -> Families<'_> {
+        Families {
+            pins: &self.law,
+            walls: self.wall_law.as_ref(),
+            pins_pointer: "/inputs/contact/law",
+            walls_pointer: "/inputs/contact/wall_law",
+        }
+    }
+
+    /// The stiffness, dashpot and law of a pin–wrapper contact (`wall`) or a pin–pin
+    /// one, and where its law was written.
+    pub fn family(&self, wall: bool) -> (f64, f64, &LawInput, &str) {
+        let (law, pointer) = self.families().of(wall);
+        if wall {
+            (
+                self.wall_stiffness.unwrap_or(self.stiffness),
+                self.wall_damping.unwrap_or(self.damping),
+                law,
+                pointer,
+            )
+        } else {
+            (self.stiffness, self.damping, law, pointer)
+        }
+    }
+
+    /// Every problem of the two laws, at their pointers: the physics' own check of a
+    /// law ([`crate::physics::contact::Law::validate`]) and the inputs' ([`Families::check`]).
+    pub fn check_laws(&self, errors: &mut Vec<super::FieldError>, service_time: Option<f64>) {
+        self.families().check(errors);
+        match (self.families().wears(), service_time) {
+            (true, None) => errors.push(super::FieldError::new(
+                "/inputs/output/service_time",
+                "a contact law has a `wear`: give the service time (s) it wears over",
+            )),
+            (false, Some(_)) => errors.push(super::FieldError::new(
+                "/inputs/output/service_time",
+                "is the time the contact laws' `wear` wears over, and no law has one",
+            )),
+            (_, Some(time)) if !(time.is_finite() && time > 0.0) => errors.push(super::FieldError::new(
+                "/inputs/output/service_time",
+                "must be a time > 0 (s)",
+            )),
+            _ => {}
+        }
+        let mut families = vec![false];
+        if self.wall_law.is_some() || self.wall_damping.is_some() {
+            families.push(true);
+        }
+        for wall in families {
+            let (_, damping, law, pointer) = self.family(wall);
+            let mut issues = Vec::new();
+            law.law().validate(&mut issues, damping);
+            errors.extend(super::inputs::at(pointer, issues));
+        }
+    }
 }
 
 /// Gap state of the bundle: `uniform`, `per_contact` or `random`.
@@ -287,6 +355,10 @@ pub struct HexOutputInput {
     /// reported as their mean and standard deviation (code_aster's NB_BLOC; 1…100).
     #[schema(minimum = 1, maximum = 100, default = 1)]
     pub blocks: Option<usize>,
+    /// The service time (s) the contact laws' `wear` wears over: each contact's worn
+    /// volume and depth after it, at the run's wear power. Required with a `wear`.
+    #[schema(exclusive_minimum = 0.0)]
+    pub service_time: Option<f64>,
 }
 
 /// A selection of contacts: `all`, `none`, `walls`, `list`, `levels` or `rings`.

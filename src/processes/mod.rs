@@ -12,6 +12,7 @@ pub mod bundle_inputs;
 pub mod cantilever_impact;
 /// What each column of a history is: name, unit, what it measures.
 pub mod columns;
+pub mod contact_law;
 pub mod cost;
 pub mod hex_bundle_dynamics;
 pub mod hex_inputs;

@@ -13,7 +13,7 @@
 //! With `relative`, the draw multiplies the contact's nominal gap (`wall_gap` or
 //! `pin_gap`).
 
-use super::contact::{Body, Contact};
+use super::contact::{Body, Contact, Law};
 use super::{InputIssue, number, require_non_negative, require_positive};
 
 pub use super::random::{GapRng, ln, splitmix64};
@@ -204,6 +204,7 @@ impl BundleLayout {
                     gap: if at_wall { self.wall_gap } else { self.pin_gap },
                     stiffness: self.stiffness,
                     damping: self.damping,
+                    law: Law::LINEAR,
                 });
             }
         }

@@ -296,6 +296,7 @@ pub struct BasisErrors {
 fn probe_contact(model: &Model<'_>, contact: usize) -> Option<ProbeContact> {
     let c = &model.contacts[contact];
     let pushes = c.stiffness > 0.0;
+    let spring = c.stability_stiffness();
     if !pushes {
         return None;
     }
@@ -303,11 +304,7 @@ fn probe_contact(model: &Model<'_>, contact: usize) -> Option<ProbeContact> {
     let resolution = HEIGHT_RESOLUTION * model.basis.length();
     Some(ProbeContact {
         height: (c.height / resolution).round() * resolution,
-        stiffness: if between_pins {
-            2.0 * c.stiffness
-        } else {
-            c.stiffness
-        },
+        stiffness: if between_pins { 2.0 * spring } else { spring },
     })
 }
 

@@ -36,6 +36,7 @@ pub mod static_correction;
 pub mod statistics;
 /// Spectrum-compatible synthetic accelerograms (seeded, bit-reproducible).
 pub mod synthetic;
+pub mod wear;
 
 /// One problem with a physics input: which field (slash path relative to the checked
 /// struct) and why.

@@ -13,7 +13,8 @@
 //! right pin's ([`max_angular_frequency_in_plane`]), the same two paths with 2 × modes
 //! per pin. Since (n·(a_x, a_y))² ≤ a_x² + a_y² for a unit n, its λ_max never exceeds
 //! the row's with the same contacts (every normal +x): equal when the normals are all
-//! parallel, smaller when they spread (a pin held from six directions).
+//! parallel, smaller when they spread (a pin held from six directions). A contact with
+//! friction adds its stick spring k_t along the tangent t = (−n_y, n_x) the same way.
 
 use faer::{Mat, Side};
 
@@ -69,7 +70,7 @@ pub fn max_angular_frequency(
                     for i in 0..modes {
                         for j in 0..modes {
                             stiffness[(pa * modes + i, pb * modes + j)] +=
-                                contact.stiffness * sign_a * sign_b * shape[i] * shape[j];
+                                contact.stability_stiffness() * sign_a * sign_b * shape[i] * shape[j];
                         }
                     }
                 }
@@ -97,7 +98,7 @@ pub fn max_angular_frequency(
                     };
                     for i in 0..modes {
                         for j in 0..modes {
-                            stiffness[(i, j)] += factor * contact.stiffness * shape[i] * shape[j];
+                            stiffness[(i, j)] += factor * contact.stability_stiffness() * shape[i] * shape[j];
                         }
                     }
                 }
@@ -153,13 +154,22 @@ pub fn max_angular_frequency_in_plane(
                 if !(include(pa) && include(pb)) {
                     continue;
                 }
-                for (axis_a, na) in normal.iter().enumerate() {
-                    for (axis_b, nb) in normal.iter().enumerate() {
-                        let scale = factor * contact.stiffness * sign_a * sign_b * na * nb;
-                        let (ra, rb) = (line(pa, axis_a), line(pb, axis_b));
-                        for i in 0..modes {
-                            for j in 0..modes {
-                                stiffness[(ra + i, rb + j)] += scale * shape[i] * shape[j];
+                // The normal spring along n and, with friction, the stick spring k_t
+                // along the tangent t = (−n_y, n_x).
+                let tangent = [-normal[1], normal[0]];
+                let springs = [
+                    (normal, contact.stability_stiffness()),
+                    (&tangent, contact.tangential_stiffness()),
+                ];
+                for (direction, spring) in springs.into_iter().filter(|(_, k)| *k > 0.0) {
+                    for (axis_a, na) in direction.iter().enumerate() {
+                        for (axis_b, nb) in direction.iter().enumerate() {
+                            let scale = factor * spring * sign_a * sign_b * na * nb;
+                            let (ra, rb) = (line(pa, axis_a), line(pb, axis_b));
+                            for i in 0..modes {
+                                for j in 0..modes {
+                                    stiffness[(ra + i, rb + j)] += scale * shape[i] * shape[j];
+                                }
                             }
                         }
                     }
@@ -218,6 +228,7 @@ fn largest_eigenvalue(matrix: &Mat<f64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contact::Law;
 
     /// One mode, one wall spring: ω_max² = ω² + Kc ψ² exactly.
     #[test]
@@ -229,6 +240,7 @@ mod tests {
             gap: 0.0,
             stiffness: 300.0,
             damping: 0.0,
+            law: Law::LINEAR,
         };
         let omega = max_angular_frequency(&[10.0], 1, &[contact], &[vec![2.0]]);
         assert!((omega - (100.0f64 + 1200.0).sqrt()).abs() < 1e-9, "ω_max {omega}");
@@ -245,6 +257,7 @@ mod tests {
             gap: 0.0,
             stiffness: 50.0,
             damping: 0.0,
+            law: Law::LINEAR,
         };
         let exact = max_angular_frequency(&[3.0], 2, std::slice::from_ref(&contact), &[vec![1.5]]);
         let expected = (9.0f64 + 2.0 * 50.0 * 2.25).sqrt();
@@ -270,6 +283,7 @@ mod tests {
             gap: 0.0,
             stiffness,
             damping: 0.0,
+            law: Law::LINEAR,
         };
         let contacts = [
             spring(Body::Pin(0), Body::Pin(1), 50.0),

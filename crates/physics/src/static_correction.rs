@@ -227,7 +227,7 @@ mod tests {
     use super::*;
     use crate::beam::tests::default_tube;
     use crate::beam::{BeamSpec, Support};
-    use crate::contact::{Body, Contact};
+    use crate::contact::{Body, Contact, Law};
     use crate::integrate::{
         Check, DEFAULT_TOLERANCE, Model, Plan, Settings, Simulation, SimulationError, TimeStep,
         critical_time_step, simulate,
@@ -389,6 +389,7 @@ mod tests {
             gap: 0.0,
             stiffness,
             damping: 0.0,
+            law: Law::LINEAR,
         }
     }
 
@@ -475,6 +476,7 @@ mod tests {
             gap: 5e-5,
             stiffness: 2e4,
             damping: 2.0,
+            law: Law::LINEAR,
         };
         let contacts = if with_contacts {
             vec![

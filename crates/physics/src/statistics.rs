@@ -21,6 +21,41 @@ pub struct ContactStatistics {
     pub first_impact_time: Option<f64>,
 }
 
+/// Friction at one contact over the whole run, accumulated at every step while it is
+/// closed (docs/contact-laws.md).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct FrictionStatistics {
+    /// ∫ |T| dt (N·s) and ∫ T² dt (N²·s) while closed: the tangential force's mean and
+    /// RMS over the contact time.
+    pub tangential_impulse: f64,
+    pub tangential_square: f64,
+    /// Largest |T| (N).
+    pub max_tangential_force: f64,
+    /// ∫ |v_t| dt while slipping (m): the distance slid.
+    pub slip_distance: f64,
+    /// Time closed and sticking (s).
+    pub stick_time: f64,
+    /// ∫ |T| |v_t| dt while slipping (J): the friction's wear work.
+    pub tangential_wear_work: f64,
+}
+
+impl FrictionStatistics {
+    /// Adds one step Δt of a closed contact: its tangential state and sliding speed.
+    #[inline(always)]
+    pub fn record(&mut self, tangential: &crate::contact::Tangential, sliding: f64, dt: f64) {
+        let force = tangential.force.abs();
+        self.tangential_impulse += force * dt;
+        self.tangential_square += force * force * dt;
+        self.max_tangential_force = self.max_tangential_force.max(force);
+        if tangential.slipping {
+            self.slip_distance += sliding.abs() * dt;
+            self.tangential_wear_work += force * sliding.abs() * dt;
+        } else {
+            self.stick_time += dt;
+        }
+    }
+}
+
 /// Largest deflection of one pin over the run.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct PinExtreme {
@@ -51,11 +86,13 @@ pub struct EnergyBalance {
     pub kinetic: f64,
     /// ½ Σ ωᵢ² qᵢ².
     pub strain: f64,
-    /// ½ Σ Kc δ² over closed contacts.
+    /// Σ K δⁿ⁺¹/(n + 1) over closed contacts (½ Kc δ² for the linear law), and the
+    /// stick springs' T²/(2 k_t) with friction.
     pub contact: f64,
     /// ∫ Σ 2ξᵢωᵢ q̇ᵢ² dt: modal (structural) damping.
     pub dissipated_modal: f64,
-    /// ∫ (F − Kc δ) δ̇ dt over closed contacts: contact dashpots (and the force clamp).
+    /// ∫ (F − K δⁿ) δ̇ dt over closed contacts (dashpots, Hunt–Crossley damping and the
+    /// force clamp), and the work of friction.
     pub dissipated_contact: f64,
     /// ∫ f_ext · q̇ dt: work of the base excitation (inertial load) and point forces.
     pub external_work: f64,

@@ -11,7 +11,7 @@ use std::ops::ControlFlow;
 
 use super::*;
 use crate::beam::{BeamSpec, Section, Support};
-use crate::contact::{Body, Contact};
+use crate::contact::{Body, Contact, Law};
 use crate::loads::{BaseAcceleration, Table};
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
@@ -84,6 +84,7 @@ impl Row {
                     gap: self.gap,
                     stiffness: self.stiffness,
                     damping: 0.0,
+                    law: Law::LINEAR,
                 });
             }
         }

@@ -21,7 +21,7 @@
 use super::kernels::{ContactLanes, Lanes, LevelShapes, PlaneGroups};
 use super::walls::WallLayout;
 use super::{Model, Settings, StepSize};
-use crate::contact::{Body, Contact};
+use crate::contact::{Body, Contact, Friction, NormalLaw};
 use crate::stability::Scheme;
 
 /// The fixed data of one run at one step, for one SIMD level.
@@ -80,8 +80,11 @@ pub(super) struct Layout<'m> {
 /// A contact as its lane needs it; offsets are in SIMD vectors.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct LaneContact {
-    pub stiffness: f64,
-    pub dashpot: f64,
+    /// The normal law, its damping resolved (a restitution turned into a dashpot or a
+    /// Hunt–Crossley factor on the model's basis).
+    pub law: NormalLaw,
+    /// Friction (plane contacts only; [`Friction::NONE`] on the row).
+    pub friction: Friction,
     /// Offset of ψ at the contact's level in `level_shapes`.
     pub shape: usize,
     /// Offsets of the left and right body's rows in the state (`wall_row` for a wall).
@@ -324,12 +327,12 @@ impl<'m> Layout<'m> {
                     .iter()
                     .enumerate()
                     .map(|(c, contact)| LaneContact {
-                        stiffness: contact.stiffness,
-                        dashpot: contact.damping,
+                        law: contact.resolved_law(model.reduced_mass(contact)),
+                        friction: contact.law.friction,
                         shape: vectors * contact_level[c],
                         left: state_row(contact.left),
                         right: state_row(contact.right),
-                        active: contact.stiffness > 0.0 || contact.damping > 0.0,
+                        active: contact.normal_law().is_active(),
                     })
                     .collect::<Vec<_>>(),
                 LaneContact::default(),

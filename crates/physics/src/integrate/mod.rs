@@ -41,7 +41,9 @@
 //! change during the run: modal coefficients, shapes, contact indexing), the state (what
 //! the step advances) and the recorder (histories, statistics, energy).
 
-pub use super::statistics::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme};
+pub use super::statistics::{
+    ContactStatistics, EnergyBalance, FrictionStatistics, PeakDeflection, PinExtreme,
+};
 use crate::InputIssue;
 pub use crate::impacts::{ImpactCounting, ImpactHistogram, ImpactStatistics, ImpactTable};
 pub use model::{Model, NORMAL_LENGTH_TOLERANCE, Plane, Settings, TimeStep, WallMotion};
@@ -115,6 +117,8 @@ pub struct Simulation {
     /// Per contact: wear work ∫ F·|v_t| dt (J), v_t the relative tangential velocity at
     /// the contact (tangent t = (−n_y, n_x)); empty for the row (no tangential motion).
     pub wear_work: Vec<f64>,
+    /// Per contact: its friction (empty for the row; zeros for a contact without).
+    pub friction_statistics: Vec<FrictionStatistics>,
     /// Per contact: its impacts as `Settings::impacts` counts them, over the run and its
     /// blocks (`contact_statistics[c].impacts` is the same count).
     pub impact_statistics: Vec<ImpactStatistics>,
@@ -185,3 +189,6 @@ mod wall_tests;
 
 #[cfg(test)]
 mod thread_tests;
+
+#[cfg(test)]
+mod law_tests;

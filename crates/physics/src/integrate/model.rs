@@ -5,7 +5,7 @@
 //! Field paths are slash paths relative to the checked struct (`contacts/3/right`,
 //! `point_forces/0/height`, `output_heights/1`), as everywhere in this crate.
 
-use crate::contact::Contact;
+use crate::contact::{Body, Contact};
 use crate::impacts::ImpactCounting;
 use crate::loads::{BaseAcceleration, PointForce};
 use crate::modal::ModalBasis;
@@ -177,6 +177,7 @@ impl Model<'_> {
                     .map(|i| i.within(&prefix)),
             );
         }
+        self.validate_laws(&mut issues);
         self.validate_release(&mut issues);
         if let Some(base) = &self.base_acceleration {
             issues.extend(base.validate().into_iter().map(|i| i.within("base_acceleration")));
@@ -219,6 +220,85 @@ impl Model<'_> {
             self.validate_walls(walls, &mut issues);
         }
         issues
+    }
+
+    /// The reduced mass m₁m₂/(m₁ + m₂) (kg) of `contact`'s two bodies as a restitution
+    /// sees them: each pin's first-mode apparent mass 1/φ₁(z)² at the contact height
+    /// (the mass-normalised first mode), a wall's infinite. Infinite at a pin's clamped
+    /// foot, where the first mode does not move.
+    pub fn reduced_mass(&self, contact: &Contact) -> f64 {
+        let shape = self.basis.deflection_at(contact.height);
+        let first = shape.first().copied().unwrap_or(0.0);
+        let pin_mass = 1.0 / (first * first);
+        match (contact.left, contact.right) {
+            (Body::Pin(_), Body::Pin(_)) => 0.5 * pin_mass,
+            _ => pin_mass,
+        }
+    }
+
+    /// Laws the model can carry: a restitution whose bodies have a finite mass (or one
+    /// given), friction only in the plane (the row's contacts have no tangent), and
+    /// preloads that balance at rest on every pin at every height (a preloaded contact
+    /// alone would set the pin moving at t = 0).
+    fn validate_laws(&self, issues: &mut Vec<InputIssue>) {
+        for (k, contact) in self.contacts.iter().enumerate() {
+            if let Some(restitution) = &contact.law.restitution
+                && contact.law.exponent == 1.0
+                && restitution.mass.is_none()
+                && !self.reduced_mass(contact).is_finite()
+            {
+                issues.push(InputIssue::new(
+                    format!("contacts/{k}/law/restitution"),
+                    "the first mode does not move at this height (a clamped foot): give the \
+                     impact's mass (`restitution_mass`) or a damping",
+                ));
+            }
+            if contact.law.friction.is_on() && self.plane.is_none() {
+                issues.push(InputIssue::new(
+                    format!("contacts/{k}/law/friction/coefficient"),
+                    "the pins of a row bend in one plane and their contacts have no tangent: \
+                     friction needs pins in the transverse plane (hex-bundle-dynamics)",
+                ));
+            }
+        }
+        // Preloads, summed per pin and height (m, rounded to the µm).
+        let mut nets: std::collections::BTreeMap<(usize, i64), ([f64; 2], f64, usize)> = Default::default();
+        for (k, contact) in self.contacts.iter().enumerate() {
+            let preload = contact.preload();
+            if preload == 0.0 {
+                continue;
+            }
+            let [nx, ny] = self
+                .plane
+                .as_ref()
+                .and_then(|p| p.normals.get(k))
+                .copied()
+                .unwrap_or([1.0, 0.0]);
+            let level = (contact.height * 1e6).round() as i64;
+            for (body, sign) in [(contact.left, -1.0), (contact.right, 1.0)] {
+                if let Body::Pin(pin) = body {
+                    let entry = nets.entry((pin, level)).or_insert(([0.0, 0.0], 0.0, k));
+                    entry.0[0] += sign * preload * nx;
+                    entry.0[1] += sign * preload * ny;
+                    entry.1 += preload;
+                }
+            }
+        }
+        for ((pin, _), ([x, y], total, k)) in nets {
+            let net = x.hypot(y);
+            if net > 1e-9 * total {
+                let height = self.contacts[k].height;
+                issues.push(InputIssue::new(
+                    format!("contacts/{k}/gap"),
+                    format!(
+                        "the preloads at {height} m push pin {pin} with a net {} N at rest: a \
+                         preloaded contact needs others at the same height that balance it \
+                         (a spring and its dimples), or the pin would start moving at t = 0",
+                        crate::number(net)
+                    ),
+                ));
+            }
+        }
     }
 
     fn validate_walls(&self, walls: &WallMotion, issues: &mut Vec<InputIssue>) {
@@ -417,7 +497,7 @@ mod tests {
     use super::*;
     use crate::beam::tests::default_tube;
     use crate::beam::{BeamSpec, Support};
-    use crate::contact::Body;
+    use crate::contact::{Body, Law};
     use crate::integrate::{DEFAULT_TOLERANCE, Plan, SimulationError, StepSize};
     use crate::loads::Table;
 
@@ -434,6 +514,7 @@ mod tests {
             gap: 1e-4,
             stiffness: 1e4,
             damping: 0.5,
+            law: Law::LINEAR,
         };
         Model {
             basis,

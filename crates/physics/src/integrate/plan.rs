@@ -119,7 +119,14 @@ impl<'a> Plan<'a> {
                 format!("the impact probes of the basis and the mesh failed: {e}"),
             )])
         })?;
-        let quality = quality::assess(&simulation, step, settings.tolerance, step_halving, &basis);
+        let findings = force_scales(model, settings, step, &peaks);
+        let quality = quality::assess(
+            &simulation,
+            step,
+            settings.tolerance,
+            (step_halving, &basis),
+            findings,
+        );
         Ok(Assessed { simulation, quality })
     }
 
@@ -146,6 +153,57 @@ impl<'a> Plan<'a> {
             step,
         })
     }
+}
+
+/// The power laws (n > 1) whose peak force passed the force their tangent stiffness
+/// sized the step with: `doubtful` (the step rules saw a softer contact), `poor` when
+/// the step is above the critical step with those contacts as stiff as at their peaks.
+fn force_scales(
+    model: &Model<'_>,
+    settings: &Settings,
+    step: &StepSize,
+    peaks: &[f64],
+) -> Vec<quality::Finding> {
+    let exceeded: Vec<(usize, f64)> = model
+        .contacts
+        .iter()
+        .zip(peaks)
+        .enumerate()
+        .filter(|(_, (c, peak))| c.law.exponent > 1.0 && **peak > c.law.force_scale)
+        .map(|(k, (_, peak))| (k, *peak))
+        .collect();
+    let Some(&(worst, peak)) = exceeded.iter().max_by(|a, b| {
+        let ratio = |(k, peak): &(usize, f64)| peak / model.contacts[*k].law.force_scale;
+        ratio(a).total_cmp(&ratio(b))
+    }) else {
+        return Vec::new();
+    };
+    let mut stiffer = model.clone();
+    for &(k, peak) in &exceeded {
+        stiffer.contacts[k].law.force_scale = peak;
+    }
+    let critical = step_size::critical_time_step(&stiffer, settings.scheme);
+    let unstable = step.time_step > critical;
+    let scale = model.contacts[worst].law.force_scale;
+    vec![quality::Finding {
+        poor: unstable,
+        reason: format!(
+            "the peak force of contact {worst}, {} N, exceeds its force_scale {} N, whose tangent \
+             stiffness sized the time step{} ({} contacts past their scale): raise force_scale to \
+             at least the peak",
+            crate::number(peak),
+            crate::number(scale),
+            if unstable {
+                format!(
+                    ", and the step is above the critical step at that force ({} s)",
+                    crate::number(critical)
+                )
+            } else {
+                String::new()
+            },
+            exceeded.len()
+        ),
+    }]
 }
 
 /// Refuses a model or settings that cannot be integrated.

@@ -14,7 +14,7 @@ use std::ops::ControlFlow;
 use super::plane_tests::{assert_close, run};
 use super::*;
 use crate::beam::tests::default_tube;
-use crate::contact::{Body, Contact};
+use crate::contact::{Body, Contact, Law};
 use crate::loads::{PointForce, Table};
 use crate::modal::ModalBasis;
 
@@ -159,6 +159,7 @@ fn energy_balance_closes_with_a_point_force_in_the_plane() {
                 gap: c.clearance,
                 stiffness: 2e4,
                 damping: 2.0,
+                law: Law::LINEAR,
             })
             .collect(),
         initial_tip_displacements: vec![-1e-4, 5e-5],

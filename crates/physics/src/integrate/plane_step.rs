@@ -20,7 +20,6 @@
 
 use pulp::Simd;
 
-use super::ContactStatistics;
 use super::kernels::{
     LevelShapes, ModalCoefficients, UpdateSums, level_deflections_of_groups, modal_update, penetration_rate,
     row_axpy,
@@ -28,6 +27,8 @@ use super::kernels::{
 use super::layout::{LaneContact, Layout, PlaneLane};
 use super::recorder::record_closed_contact;
 use super::walls::{WallLayout, WallState};
+use super::{ContactStatistics, FrictionStatistics};
+use crate::contact::{NormalForce, force_vector};
 use crate::impacts::{ContactImpacts, Impact, ImpactClock, ImpactSink};
 
 /// Closed contacts per chunk of the contact pass: each chunk has its own sums.
@@ -105,9 +106,12 @@ pub(super) struct LaneOutputs<'a> {
     /// Dissipation power (F − Kc δ) δ̇ and walls' power F n·ḋ_wall.
     pub powers: &'a mut [[f64; 2]],
     pub forces: &'a mut [f64],
+    /// The tangential force T of friction (read as a step ago, then written).
+    pub tangentials: &'a mut [f64],
     pub statistics: &'a mut [ContactStatistics],
     pub peaks: &'a mut [f64],
     pub wear: &'a mut [f64],
+    pub friction: &'a mut [FrictionStatistics],
     pub impacts: &'a mut [ContactImpacts],
 }
 
@@ -117,27 +121,33 @@ impl<'a> LaneOutputs<'a> {
         let at = lane - self.first;
         let (powers, powers_after) = self.powers.split_at_mut(at);
         let (forces, forces_after) = self.forces.split_at_mut(at);
+        let (tangentials, tangentials_after) = self.tangentials.split_at_mut(at);
         let (statistics, statistics_after) = self.statistics.split_at_mut(at);
         let (peaks, peaks_after) = self.peaks.split_at_mut(at);
         let (wear, wear_after) = self.wear.split_at_mut(at);
+        let (friction, friction_after) = self.friction.split_at_mut(at);
         let (impacts, impacts_after) = self.impacts.split_at_mut(at);
         (
             Self {
                 first: self.first,
                 powers,
                 forces,
+                tangentials,
                 statistics,
                 peaks,
                 wear,
+                friction,
                 impacts,
             },
             Self {
                 first: lane,
                 powers: powers_after,
                 forces: forces_after,
+                tangentials: tangentials_after,
                 statistics: statistics_after,
                 peaks: peaks_after,
                 wear: wear_after,
+                friction: friction_after,
                 impacts: impacts_after,
             },
         )
@@ -180,7 +190,7 @@ impl<S: Simd> ClosedPass<'_, S> {
     /// the dashpot velocity of each body along x and y, rate_x = ψ·Δṽ_x and
     /// rate_y = ψ·Δṽ_y, the penetration rate is δ̇ = n_x rate_x + n_y rate_y and the
     /// sliding velocity v_t = −n_y rate_x + n_x rate_y (tangent t = (−n_y, n_x));
-    /// F = max(0, Kc δ + cc δ̇), and the wear work gains F |v_t| Δt; each lane's
+    /// F from the contact's law ([`crate::contact::NormalLaw::force`]), and the wear work gains F |v_t| Δt; each lane's
     /// dissipation power (F − Kc δ) δ̇ and walls' power F n·ḋ_wall are stored.
     #[inline(always)]
     fn lanes(&self, closed: &[u32], out: &mut LaneOutputs<'_>, log: &mut impl ImpactSink) {
@@ -197,19 +207,34 @@ impl<S: Simd> ClosedPass<'_, S> {
                 penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead);
             let mut rate_y = penetration_rate(simd, shape, rows(lane.left_y), rows(lane.right_y), lookahead);
             let [normal_x, normal_y] = lane.normal;
-            let mut wall_rate = 0.0;
+            let (mut wall_rate, mut wall_sliding) = (0.0, 0.0);
             if let Some((layout, wall)) = self.walls {
                 let [x, y] = wall.velocity_of(layout, j);
                 (rate_x, rate_y) = (rate_x + x, rate_y + y);
                 wall_rate = normal_x * x + normal_y * y;
+                wall_sliding = normal_x * y - normal_y * x;
             }
             let rate = normal_x * rate_x + normal_y * rate_y;
             let sliding = normal_x * rate_y - normal_y * rate_x;
-            let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
+            let NormalForce { force, elastic } = contact.law.force(penetration, rate);
             let k = j - first;
             out.forces[k] = force;
-            let dissipation = (force - contact.stiffness * penetration) * rate;
-            out.powers[k] = [dissipation, force * wall_rate];
+            let mut dissipation = (force - elastic) * rate;
+            let mut wall_power = force * wall_rate;
+            let mut slipping = true;
+            if contact.friction.is_on() {
+                let dt = self.at.2;
+                let previous = if previous > 0.0 { out.tangentials[k] } else { 0.0 };
+                let tangential = contact.friction.step(previous, sliding, dt, force);
+                out.tangentials[k] = tangential.force;
+                dissipation += tangential.dissipation;
+                wall_power += tangential.force * wall_sliding;
+                slipping = tangential.slipping;
+                if self.record {
+                    out.friction[k].record(&tangential, sliding, dt);
+                }
+            }
+            out.powers[k] = [dissipation, wall_power];
             if self.record {
                 if force > out.peaks[k] {
                     out.peaks[k] = force;
@@ -223,7 +248,9 @@ impl<S: Simd> ClosedPass<'_, S> {
                         (force, dissipation),
                     );
                 }
-                out.wear[k] += force * sliding.abs() * self.at.2;
+                if slipping {
+                    out.wear[k] += force * sliding.abs() * self.at.2;
+                }
             }
         }
     }
@@ -248,6 +275,7 @@ pub(super) struct Loads<'a> {
     pub plane_lanes: &'a [PlaneLane],
     pub closed: &'a [u32],
     pub forces: &'a [f64],
+    pub tangentials: &'a [f64],
     pub walls: Option<(&'a WallLayout, &'a WallState)>,
 }
 
@@ -299,17 +327,22 @@ fn update_half<S: Simd>(
                 }
                 let (contact, lane) = (layout.lane_contacts[j], loads.plane_lanes[j]);
                 let shape = &shapes[contact.shape..][..n];
-                let [normal_x, normal_y] = lane.normal;
-                let (left, right, normal) = if half.y {
-                    (lane.left_y, lane.right_y, normal_y)
+                let tangential = if contact.friction.is_on() {
+                    loads.tangentials[j]
                 } else {
-                    (contact.left, contact.right, normal_x)
+                    0.0
+                };
+                let [x, y] = force_vector(force, tangential, lane.normal);
+                let (left, right, along) = if half.y {
+                    (lane.left_y, lane.right_y, y)
+                } else {
+                    (contact.left, contact.right, x)
                 };
                 if contact.left != wall {
-                    row_axpy(simd, -force * normal, shape, &mut rows[left - half.start..]);
+                    row_axpy(simd, -along, shape, &mut rows[left - half.start..]);
                 }
                 if contact.right != wall {
-                    row_axpy(simd, force * normal, shape, &mut rows[right - half.start..]);
+                    row_axpy(simd, along, shape, &mut rows[right - half.start..]);
                 }
             }
             if let Some((walls, wall)) = loads.walls {

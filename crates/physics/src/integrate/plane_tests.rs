@@ -15,7 +15,7 @@ use std::ops::ControlFlow;
 
 use super::*;
 use crate::beam::tests::default_tube;
-use crate::contact::{Body, Contact};
+use crate::contact::{Body, Contact, Law};
 use crate::loads::BaseAcceleration;
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
@@ -44,6 +44,7 @@ fn shaken_row(basis: &ModalBasis, amplitude: f64) -> Model<'_> {
                 gap: gap * (1.0 + 0.3 * k as f64),
                 stiffness: 2e4,
                 damping: 2.0,
+                law: Law::LINEAR,
             });
         }
     }
@@ -286,6 +287,7 @@ fn triangle(basis: &ModalBasis) -> Model<'_> {
                 gap: 2e-5 * (1.0 + 0.2 * ((k + level) % 3) as f64),
                 stiffness: 3e4,
                 damping: 1.5,
+                law: Law::LINEAR,
             });
             normals.push(*normal);
         }
@@ -372,6 +374,7 @@ fn a_contact_between_two_pins_exchanges_equal_and_opposite_impulses() {
         gap,
         stiffness: 5e4,
         damping: 3.0,
+        law: Law::LINEAR,
     };
     let model = Model {
         basis: &basis,
@@ -610,6 +613,7 @@ fn the_planes_critical_step_matches_brute_force_divergence() {
             gap: 0.0,
             stiffness: 1e6,
             damping: 0.0,
+            law: Law::LINEAR,
         }],
         initial_tip_displacements: vec![0.0, 0.0],
         base_acceleration: None,
@@ -696,6 +700,7 @@ fn large_plane_speed() {
                 gap: 1e-5 * (1.0 + (p % 7) as f64 / 7.0),
                 stiffness: 1e6,
                 damping: 10.0,
+                law: Law::LINEAR,
             });
             normals.push(normal);
         }
@@ -781,6 +786,7 @@ fn one_pin_in_the_wrapper_shaken_sixty_degrees_further_gives_the_turned_response
                 gap: c.clearance,
                 stiffness: 2e4,
                 damping: 2.0,
+                law: Law::LINEAR,
             })
             .collect(),
         initial_tip_displacements: vec![],

@@ -224,12 +224,20 @@ pub(super) fn step_halving(
 }
 
 /// The verdict on a run (see the module doc).
+/// A finding of the run's other checks (a power law's peak above the force its step
+/// was sized for): a reason, and whether it makes the result `poor`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finding {
+    pub poor: bool,
+    pub reason: String,
+}
+
 pub(super) fn assess(
     simulation: &Simulation,
     step: &StepSize,
     tolerance: f64,
-    step_halving: Option<StepHalving>,
-    basis: &BasisErrors,
+    (step_halving, basis): (Option<StepHalving>, &BasisErrors),
+    findings: Vec<Finding>,
 ) -> Quality {
     let energy_residual = simulation.energy.relative_residual();
     let steps_per_period = step.steps_per_fastest_period();
@@ -316,6 +324,10 @@ pub(super) fn assess(
                 percent(peak_tolerance)
             ));
         }
+    }
+    for finding in findings {
+        poor |= finding.poor;
+        reasons.push(finding.reason);
     }
     let verdict = if poor {
         Verdict::Poor

@@ -9,7 +9,9 @@ use pulp::Simd;
 use super::kernels::level_deflections;
 use super::layout::{ContactModel, Layout};
 use super::state::State;
-use super::{ContactStatistics, EnergyBalance, PeakDeflection, PinExtreme, Settings, Simulation};
+use super::{
+    ContactStatistics, EnergyBalance, FrictionStatistics, PeakDeflection, PinExtreme, Settings, Simulation,
+};
 use crate::impacts::{ContactImpacts, ImpactClock, ImpactLog, ImpactSink, ImpactStatistics};
 
 /// Powers of a step (W), integrated over time by the trapezoidal rule.
@@ -30,8 +32,10 @@ pub(super) struct Recorder {
     pub statistics: Vec<ContactStatistics>,
     pub max_penetration: Vec<f64>,
     pub force_peak: Vec<f64>,
-    /// Per lane in the plane (empty for the row): ∫ F |v_t| dt (J).
+    /// Per lane in the plane (empty for the row): ∫ F |v_t| dt (J), while slipping
+    /// for a contact with friction, and its friction.
     pub wear: Vec<f64>,
+    pub friction: Vec<FrictionStatistics>,
     /// Per lane: impacts as counted by `Settings::impacts`, the run's clock for them,
     /// their table and the current step's block.
     pub impacts: Vec<ContactImpacts>,
@@ -91,6 +95,10 @@ impl Recorder {
                 ContactModel::Row => Vec::new(),
                 ContactModel::Plane(_) => vec![0.0; lanes],
             },
+            friction: match layout.contact_model {
+                ContactModel::Row => Vec::new(),
+                ContactModel::Plane(_) => vec![FrictionStatistics::default(); lanes],
+            },
             recorded,
             deflection_high: vec![0.0; outputs],
             deflection_low: vec![0.0; outputs],
@@ -114,7 +122,7 @@ impl Recorder {
         for (contact, lane) in layout.model.contacts.iter().zip(&layout.contacts.lane) {
             let lane = *lane as usize;
             let penetration = state.penetration[lane];
-            if penetration > 0.0 && (contact.stiffness > 0.0 || contact.damping > 0.0) {
+            if penetration > 0.0 && contact.normal_law().is_active() {
                 let force = state.contact_force[lane];
                 self.impacts[lane].record_initial(&self.impact_clock, force);
                 let stats = &mut self.statistics[lane];
@@ -299,6 +307,10 @@ impl Recorder {
             wear_work: match layout.contact_model {
                 ContactModel::Row => Vec::new(),
                 ContactModel::Plane(_) => layout.contacts.by_contact(&self.wear),
+            },
+            friction_statistics: match layout.contact_model {
+                ContactModel::Row => Vec::new(),
+                ContactModel::Plane(_) => layout.contacts.by_contact(&self.friction),
             },
             impact_statistics,
             impact_table,

@@ -23,6 +23,8 @@ pub(super) struct State {
     /// Per lane, the contact force (N); only meaningful where the penetration is positive
     /// (see [`kernels::penetrations`]).
     pub contact_force: Vec<f64>,
+    /// Per lane, the tangential force T (N) of friction, as `contact_force`.
+    pub tangential_force: Vec<f64>,
     /// w of every pin at every level, block-major (see [`kernels::level_deflections`]);
     /// the wall slots stay 0.
     pub level_deflections: Vec<f64>,
@@ -62,6 +64,7 @@ impl State {
             penetration: vec![0.0; lanes],
             previous_penetration: vec![0.0; lanes],
             contact_force: vec![0.0; lanes],
+            tangential_force: vec![0.0; lanes],
             level_deflections: vec![0.0; layout.level_deflections_len()],
             closed: vec![0; lanes],
             closed_groups: vec![0; groups.div_ceil(64)],
@@ -81,16 +84,23 @@ impl State {
         modal + self.contact_energy(layout)
     }
 
-    /// ½ Σ Kc δ² over the closed contacts (J).
+    /// Σ K δⁿ⁺¹/(n + 1) over the closed contacts (J): ½ Kc δ² for the linear law, and
+    /// the stick springs' T²/(2 k_t).
     pub fn contact_energy(&self, layout: &Layout<'_>) -> f64 {
         layout
             .model
             .contacts
             .iter()
             .zip(&layout.contacts.lane)
-            .map(|(c, lane)| (c, self.penetration[*lane as usize]))
-            .filter(|(_, d)| *d > 0.0)
-            .map(|(c, d)| 0.5 * c.stiffness * d * d)
+            .map(|(c, lane)| {
+                (
+                    c,
+                    self.penetration[*lane as usize],
+                    self.tangential_force[*lane as usize],
+                )
+            })
+            .filter(|(_, d, _)| *d > 0.0)
+            .map(|(c, d, t)| c.normal_law().energy(d) + c.law.friction.energy(t))
             .sum()
     }
 

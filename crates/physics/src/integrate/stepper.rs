@@ -51,6 +51,7 @@ use super::recorder::{Powers, Recorder, record_closed_contact};
 use super::state::State;
 use super::walls::{WallLayout, WallState};
 use super::{Model, Settings, Simulation, SimulationError, StepSize, step_counts};
+use crate::contact::{NormalForce, force_vector};
 use crate::stability::Scheme;
 
 /// Steps between two calls of the progress callback.
@@ -314,7 +315,7 @@ impl<'m> Integrator<'m> {
             let j = j as usize;
             let contact = lane_contacts[j];
             let (penetration, previous) = (now[j], before[j]);
-            let mut rate = if contact.dashpot > 0.0 {
+            let mut rate = if contact.law.needs_rate() {
                 let rows = |offset: usize| (&v[offset..], &a[offset..]);
                 let shape = &shapes[contact.shape..][..n];
                 penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead)
@@ -328,10 +329,10 @@ impl<'m> Integrator<'m> {
             if walls.is_some() {
                 rate += wall_rate;
             }
-            // The penetration is positive: F = max(0, Kc δ + cc δ̇) (`Contact::force`).
-            let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
+            // The penetration is positive: the contact's law.
+            let NormalForce { force, elastic } = contact.law.force(penetration, rate);
             forces[j] = force;
-            let dissipation = (force - contact.stiffness * penetration) * rate;
+            let dissipation = (force - elastic) * rate;
             dissipation_power += dissipation;
             wall_power += force * wall_rate;
             if record && force > peaks[j] {
@@ -618,6 +619,7 @@ fn plane_split<'a>(
         plane_lanes: contacts,
         closed: &state.closed[..state.closed_count],
         forces: &state.contact_force,
+        tangentials: &state.tangential_force,
         walls: if walls {
             layout.walls.as_ref().zip(state.wall.as_ref())
         } else {
@@ -637,7 +639,7 @@ fn base_accelerations(model: &Model<'_>, t: f64) -> (f64, f64) {
 /// The closed contacts of the plane, after [`plane_penetrations`]: with the dashpot
 /// velocity of each body along x and y, rate_x = ψ·Δṽ_x and rate_y = ψ·Δṽ_y, the
 /// penetration rate is δ̇ = n_x rate_x + n_y rate_y and the sliding velocity
-/// v_t = −n_y rate_x + n_x rate_y (tangent t = (−n_y, n_x)); F = max(0, Kc δ + cc δ̇)
+/// v_t = −n_y rate_x + n_x rate_y (tangent t = (−n_y, n_x)); F from the contact's law
 /// pushes the left body by −F n and the right one by +F n, and the wear work gains
 /// F |v_t| Δt. Returns the contact dissipation power Σ (F − Kc δ) δ̇.
 #[inline(always)]
@@ -665,6 +667,10 @@ fn plane_contact_forces<S: Simd>(
         &mut recorder.statistics[..lanes],
     );
     let (peaks, wear) = (&mut recorder.force_peak[..lanes], &mut recorder.wear[..lanes]);
+    let (tangentials, friction) = (
+        &mut state.tangential_force[..lanes],
+        &mut recorder.friction[..lanes],
+    );
     let impacts = &mut recorder.impacts[..lanes];
     let (clock, log) = (&recorder.impact_clock, &mut recorder.impact_log);
     let at = (step, recorder.impact_block, dt);
@@ -678,17 +684,30 @@ fn plane_contact_forces<S: Simd>(
         let mut rate_x = penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead);
         let mut rate_y = penetration_rate(simd, shape, rows(lane.left_y), rows(lane.right_y), lookahead);
         let [normal_x, normal_y] = lane.normal;
-        let mut wall_rate = 0.0;
+        let (mut wall_rate, mut wall_sliding) = (0.0, 0.0);
         if let Some((layout, wall)) = walls {
             let [x, y] = wall.velocity_of(layout, j);
             (rate_x, rate_y) = (rate_x + x, rate_y + y);
             wall_rate = normal_x * x + normal_y * y;
+            wall_sliding = normal_x * y - normal_y * x;
         }
         let rate = normal_x * rate_x + normal_y * rate_y;
         let sliding = normal_x * rate_y - normal_y * rate_x;
-        let force = (contact.stiffness * penetration + contact.dashpot * rate).max(0.0);
+        let NormalForce { force, elastic } = contact.law.force(penetration, rate);
         forces[j] = force;
-        let dissipation = (force - contact.stiffness * penetration) * rate;
+        let mut dissipation = (force - elastic) * rate;
+        let mut slipping = true;
+        if contact.friction.is_on() {
+            let previous = if previous > 0.0 { tangentials[j] } else { 0.0 };
+            let tangential = contact.friction.step(previous, sliding, dt, force);
+            tangentials[j] = tangential.force;
+            dissipation += tangential.dissipation;
+            wall_power += tangential.force * wall_sliding;
+            slipping = tangential.slipping;
+            if record {
+                friction[j].record(&tangential, sliding, dt);
+            }
+        }
         dissipation_power += dissipation;
         wall_power += force * wall_rate;
         if record {
@@ -704,7 +723,9 @@ fn plane_contact_forces<S: Simd>(
                     (force, dissipation),
                 );
             }
-            wear[j] += force * sliding.abs() * dt;
+            if slipping {
+                wear[j] += force * sliding.abs() * dt;
+            }
         }
     }
     for &j in closed {
@@ -712,14 +733,19 @@ fn plane_contact_forces<S: Simd>(
         let (contact, lane, force) = (lane_contacts[j], plane_lanes[j], forces[j]);
         if force != 0.0 {
             let shape = &shapes[contact.shape..][..n];
-            let [normal_x, normal_y] = lane.normal;
+            let tangential = if contact.friction.is_on() {
+                tangentials[j]
+            } else {
+                0.0
+            };
+            let [x, y] = force_vector(force, tangential, lane.normal);
             if contact.left != wall {
-                row_axpy(simd, -force * normal_x, shape, &mut loads[contact.left..]);
-                row_axpy(simd, -force * normal_y, shape, &mut loads[lane.left_y..]);
+                row_axpy(simd, -x, shape, &mut loads[contact.left..]);
+                row_axpy(simd, -y, shape, &mut loads[lane.left_y..]);
             }
             if contact.right != wall {
-                row_axpy(simd, force * normal_x, shape, &mut loads[contact.right..]);
-                row_axpy(simd, force * normal_y, shape, &mut loads[lane.right_y..]);
+                row_axpy(simd, x, shape, &mut loads[contact.right..]);
+                row_axpy(simd, y, shape, &mut loads[lane.right_y..]);
             }
         }
     }
@@ -763,9 +789,11 @@ fn shared_plane_contact_forces<S: Simd>(
         first: 0,
         powers: &mut state.lane_powers[..lanes],
         forces: &mut state.contact_force[..lanes],
+        tangentials: &mut state.tangential_force[..lanes],
         statistics: &mut recorder.statistics[..lanes],
         peaks: &mut recorder.force_peak[..lanes],
         wear: &mut recorder.wear[..lanes],
+        friction: &mut recorder.friction[..lanes],
         impacts: &mut recorder.impacts[..lanes],
     };
     let closed = &state.closed[..count];

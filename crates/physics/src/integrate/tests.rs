@@ -6,7 +6,7 @@ use std::ops::ControlFlow;
 
 use super::*;
 use crate::beam::tests::default_tube;
-use crate::contact::{Body, Contact};
+use crate::contact::{Body, Contact, Law};
 use crate::loads::{BaseAcceleration, PointForce, Table};
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
@@ -56,6 +56,7 @@ pub(super) fn tip_wall(stiffness: f64, gap: f64, damping: f64) -> Contact {
         gap,
         stiffness,
         damping,
+        law: Law::LINEAR,
     }
 }
 
@@ -247,6 +248,7 @@ pub(super) fn shaken_two_pin_row(basis: &ModalBasis) -> Model<'_> {
         gap: 5e-5,
         stiffness: 2e4,
         damping: 2.0,
+        law: Law::LINEAR,
     };
     Model {
         basis,
@@ -320,6 +322,7 @@ fn this_cpus_simd_level_and_the_scalar_fallback_agree() {
                 gap: 2e-5,
                 stiffness: 3e4,
                 damping,
+                law: Law::LINEAR,
             });
         }
         model.point_forces.push(PointForce {

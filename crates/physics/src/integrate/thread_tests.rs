@@ -7,7 +7,7 @@ use std::ops::ControlFlow;
 
 use super::*;
 use crate::beam::tests::default_tube;
-use crate::contact::{Body, Contact};
+use crate::contact::{Body, Contact, Law};
 use crate::loads::{BaseAcceleration, PointForce, Table};
 use crate::modal::ModalBasis;
 
@@ -51,6 +51,7 @@ fn bundle(basis: &ModalBasis) -> Model<'_> {
                 gap,
                 stiffness: 1e6,
                 damping: 10.0,
+                law: Law::LINEAR,
             });
             normals.push(normal);
         }

@@ -6,7 +6,7 @@ use super::tests::{basis, run, settings, shaken_two_pin_row};
 use super::*;
 use crate::beam::Support;
 use crate::beam::tests::default_tube;
-use crate::contact::{Body, Contact};
+use crate::contact::{Body, Contact, Law};
 use crate::loads::BaseAcceleration;
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
@@ -84,6 +84,7 @@ fn opposite_wall_motions_give_a_mirror_symmetric_response() {
         gap: 5e-5,
         stiffness: 2e4,
         damping: 2.0,
+        law: Law::LINEAR,
     };
     let model = Model {
         basis: &basis,
