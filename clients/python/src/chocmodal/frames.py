@@ -49,7 +49,8 @@ IMPACT_UNITS: dict[str, str] = {
 }
 
 #: Units of the members of a results document's ``contacts`` entries, by the last
-#: segment of their dotted name (``impact_statistics.rms_force`` → ``rms_force``).
+#: segment of their dotted name (``impact_statistics.rms_force`` → ``rms_force``):
+#: docs/service.md, docs/impacts.md, docs/hex-bundle.md.
 CONTACT_UNITS: dict[str, str] = {
     "contact": "1",
     "height": "m",
@@ -63,6 +64,8 @@ CONTACT_UNITS: dict[str, str] = {
     "contact_time": "s",
     "impulse": "N·s",
     "max_penetration": "m",
+    "wear_work_rate": "W",
+    "level": "1",
     "impacts_per_second": "1/s",
     "contact_fraction": "1",
     "mean_force": "N",
