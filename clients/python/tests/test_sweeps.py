@@ -31,10 +31,12 @@ def monte_carlo(client: chocmodal.Client) -> chocmodal.Sweep:
 def grid(client: chocmodal.Client) -> chocmodal.Sweep:
     inputs = copy.deepcopy(example("cantilever-impact.json")["inputs"])
     inputs["solver"]["duration"] = 0.05
+    # 0.1 ms is above the critical step: those runs are recorded as failed, not refused.
     sweep = client.submit_sweep(
         "cantilever-impact",
         inputs,
-        [axes.values("/contact/rk", [1.0, 100.0]), axes.linspace("/solver/time_step", 1e-5, 2e-5, 2)],
+        [axes.linspace("/contact/rk", 1.0, 100.0, 2), axes.values("/solver/time_step", [1e-5, 2e-5, 1e-4])],
+        invalid_runs="record",
     )
     sweep.follow(progress=False, timeout=180)
     return sweep
@@ -88,10 +90,23 @@ def test_the_quality_counts_add_up_to_the_successful_runs(monte_carlo: chocmodal
 
 def test_a_grid_from_axes_spans_the_product_with_the_last_axis_fastest(grid: chocmodal.Sweep) -> None:
     table = grid.results()
-    assert len(table) == 4
-    expected = [(rk, dt) for rk in (1.0, 100.0) for dt in (1e-5, 2e-5)]
+    assert len(table) == 6
+    expected = [(rk, dt) for rk in (1.0, 100.0) for dt in (1e-5, 2e-5, 1e-4)]
     assert list(zip(table["/contact/rk"], table["/solver/time_step"])) == expected
-    assert grid.status()["status"] == "successful"
+    failed = table["status"] == "failed"
+    assert list(table.index[failed]) == [2, 5], "the runs above the critical step"
+    assert grid.status()["status"] == "partial"
+    assert grid.status()["counts"]["failed"] == 2
+
+
+def test_waiting_for_a_failed_run_raises_its_problem(client: chocmodal.Client, grid: chocmodal.Sweep) -> None:
+    table = grid.results()
+    job = client.job(table.loc[2, "job"])
+    assert job.status()["status"] == "failed"
+    with pytest.raises(chocmodal.ChocmodalError) as raised:
+        job.wait(progress=False, timeout=30)
+    assert raised.value.status == 422
+    assert "/inputs/solver/time_step" in str(raised.value)
 
 
 def test_the_calibration_map_marks_runs_valid_below_the_f_err_threshold(grid: chocmodal.Sweep) -> None:
@@ -101,6 +116,9 @@ def test_the_calibration_map_marks_runs_valid_below_the_f_err_threshold(grid: ch
     assert threshold == 0.2
     assert list(calibration.index) == list(table.index)
     for run, cell in calibration.iterrows():
+        if table.loc[run, "status"] == "failed":
+            assert not cell["valid"], "a failed run is not valid"
+            continue
         assert cell["f_err"] == table.loc[run, "comparison.f_err"]
         assert bool(cell["valid"]) == (cell["f_err"] < threshold)
     cheapest = grid.cheapest()
