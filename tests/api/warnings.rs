@@ -130,6 +130,10 @@ async fn the_shipped_examples_get_no_warning() {
             continue;
         }
         let name = entry.file_name().into_string().unwrap();
+        // Only the JSON requests: examples/ also holds the Python client's notebook.
+        if !name.ends_with(".json") {
+            continue;
+        }
         let body = example(&name);
         // A sweep's base inputs are a complete request of its process.
         let (process, inputs) = match body["process"].as_str() {

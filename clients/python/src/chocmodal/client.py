@@ -1,0 +1,237 @@
+"""The entry point: :class:`Client`, one HTTP session to a chocmodal service."""
+
+from __future__ import annotations
+
+import uuid
+from typing import Any, Iterator, Mapping, Optional, Sequence, Union
+
+import httpx
+
+from ._http import RetryPolicy, Transport
+from .jobs import Job
+from .signals import Signal, SignalSource, upload_body
+from .sweeps import Sweep
+
+__all__ = ["Client"]
+
+IDEMPOTENCY_HEADER = "Idempotency-Key"
+REPLAYED_HEADER = "Idempotent-Replayed"
+
+
+class Client:
+    """A chocmodal service at ``url`` (``http://127.0.0.1:8080``).
+
+    ``token``: the tenant's bearer token when the service has an auth file. One
+    ``httpx.Client`` is shared by every call (``close()`` it, or use ``with``).
+    ``retry`` says how requests are retried on 503/507/429 answers and lost
+    connections (:class:`RetryPolicy`); ``timeout`` is per request (s).
+
+    >>> with Client("http://127.0.0.1:8080") as client:          # doctest: +SKIP
+    ...     job = client.submit("cantilever-impact", inputs)
+    ...     results = job.wait()
+    ...     tip = job.history("tip_displacement")
+    """
+
+    def __init__(
+        self,
+        url: str,
+        token: Optional[str] = None,
+        *,
+        timeout: float = 60.0,
+        retry: Optional[RetryPolicy] = None,
+        http_client: Optional[httpx.Client] = None,
+    ):
+        self.url = url.rstrip("/")
+        self._transport = Transport(
+            self.url, token=token, timeout=timeout, retry=retry or RetryPolicy(), http_client=http_client
+        )
+        self._descriptions: dict[str, dict[str, Any]] = {}
+
+    def __enter__(self) -> "Client":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self._transport.close()
+
+    def __repr__(self) -> str:
+        return f"<chocmodal.Client {self.url}>"
+
+    # -- service ------------------------------------------------------------------
+
+    def health(self) -> dict[str, Any]:
+        """``GET /healthz``: ``{"status": "ok", "writable": ...}``."""
+        return dict(self._transport.get_json("/healthz"))
+
+    # -- processes ----------------------------------------------------------------
+
+    def processes(self) -> list[dict[str, Any]]:
+        """The processes the service runs: ``id``, ``title``, ``description``, ``version``,
+        ``jobControlOptions``, ``links``."""
+        return list(self._transport.get_json("/processes")["processes"])
+
+    def process(self, process_id: str) -> dict[str, Any]:
+        """A process's description: the summary plus ``inputs`` (JSON Schema of each
+        input, SI units in the descriptions, defaults and bounds) and ``outputs`` (each
+        with its ``kind``: ``force``, ``displacement``, ``peaks``, ``table``)."""
+        description = dict(self._transport.get_json(f"/processes/{process_id}"))
+        self._descriptions[process_id] = description
+        return description
+
+    def _process_outputs(self, process_id: str) -> dict[str, Any]:
+        if process_id not in self._descriptions:
+            self.process(process_id)
+        return dict(self._descriptions[process_id].get("outputs") or {})
+
+    # -- jobs ---------------------------------------------------------------------
+
+    def submit(self, process: str, inputs: Mapping[str, Any], *, idempotency_key: Optional[str] = None) -> Job:
+        """Validates and queues a run of ``process`` with ``inputs`` (the members of the
+        execution request's ``inputs``, not the ``{"inputs": ...}`` wrapper). Returns
+        its :class:`Job`; refused inputs raise :class:`ChocmodalError` (422, one
+        ``errors`` entry per field with its JSON pointer).
+
+        The request carries an ``Idempotency-Key`` (a new UUID, or ``idempotency_key``)
+        that every retry repeats: a submission whose answer was lost and is sent again
+        gets the same job back (``job.replayed`` is then true), never a second one.
+        """
+        key = idempotency_key or str(uuid.uuid4())
+        response = self._transport.request(
+            "POST",
+            f"/processes/{process}/execution",
+            json_body={"inputs": dict(inputs)},
+            headers={IDEMPOTENCY_HEADER: key, "Accept": "application/json"},
+        )
+        status = response.json()
+        job = Job(self, status["jobID"], status, replayed=_replayed(response))
+        job.idempotency_key = key
+        return job
+
+    def job(self, job_id: str) -> Job:
+        """An existing job by id (its status read now: an unknown id raises 404)."""
+        job = Job(self, job_id)
+        job.status()
+        return job
+
+    def jobs(
+        self,
+        *,
+        status: Union[str, Sequence[str], None] = None,
+        process: Union[str, Sequence[str], None] = None,
+        sweep: Union[str, Sequence[str], None] = None,
+        in_sweep: Optional[bool] = None,
+        limit: Optional[int] = 100,
+    ) -> list[Job]:
+        """Jobs newest first, filtered by ``status``, ``process``, ``sweep`` (runs of these
+        sweeps) and ``in_sweep``; at most ``limit`` of them (``None``: every page)."""
+        params = {"status": status, "processID": process, "sweepID": sweep, "inSweep": in_sweep}
+        return [Job(self, s["jobID"], s) for s in self._pages("/jobs", "jobs", params, limit)]
+
+    # -- sweeps -------------------------------------------------------------------
+
+    def submit_sweep(
+        self,
+        process: str,
+        inputs: Mapping[str, Any],
+        axes: Sequence[Mapping[str, Any]],
+        *,
+        design: Optional[str] = None,
+        samples: Optional[int] = None,
+        seed: Optional[int] = None,
+        policy: Optional[str] = None,
+        invalid_runs: Optional[str] = None,
+        idempotency_key: Optional[str] = None,
+    ) -> Sweep:
+        """Queues a sweep: ``process`` run with ``inputs`` over ``axes`` (see
+        :mod:`chocmodal.axes`). ``design`` (``grid``, ``monte_carlo``,
+        ``latin_hypercube``), ``samples`` (draws per grid cell, with random axes),
+        ``seed``, ``policy`` (``continue`` or ``fail_fast``), ``invalid_runs``
+        (``refuse`` or ``record``): left out, the service's defaults apply."""
+        request: dict[str, Any] = {"process": process, "inputs": dict(inputs), "axes": [dict(a) for a in axes]}
+        options = {"design": design, "samples": samples, "seed": seed, "policy": policy, "invalid_runs": invalid_runs}
+        request.update({k: v for k, v in options.items() if v is not None})
+        return self.submit_sweep_request(request, idempotency_key=idempotency_key)
+
+    def submit_sweep_request(self, request: Mapping[str, Any], *, idempotency_key: Optional[str] = None) -> Sweep:
+        """Queues a sweep from a whole ``POST /sweeps`` document (``process``, ``inputs``,
+        ``axes``, ...), e.g. ``examples/sweep-gaps.json``."""
+        response = self._transport.request(
+            "POST",
+            "/sweeps",
+            json_body=dict(request),
+            headers={IDEMPOTENCY_HEADER: idempotency_key or str(uuid.uuid4()), "Accept": "application/json"},
+        )
+        status = response.json()
+        return Sweep(self, status["sweepID"], status, replayed=_replayed(response))
+
+    def sweep(self, sweep_id: str) -> Sweep:
+        """An existing sweep by id."""
+        sweep = Sweep(self, sweep_id)
+        sweep.status()
+        return sweep
+
+    def sweeps(self, *, limit: Optional[int] = 100) -> list[Sweep]:
+        """Sweeps newest first, at most ``limit`` (``None``: every page)."""
+        return [Sweep(self, s["sweepID"], s) for s in self._pages("/sweeps", "sweeps", {}, limit)]
+
+    # -- signals ------------------------------------------------------------------
+
+    def upload_signal(
+        self,
+        source: SignalSource,
+        *,
+        time_step: Optional[float] = None,
+        time: Optional[Sequence[float]] = None,
+        sampling_rate: Optional[float] = None,
+        idempotency_key: Optional[str] = None,
+    ) -> Signal:
+        """Stores an accelerogram (m/s²) and returns it: a NumPy array with ``time_step``
+        (s), ``sampling_rate`` (Hz) or ``time`` (s); a pandas Series indexed by time;
+        or a file (path or open file) of CSV ``time,acceleration`` (or JSON)."""
+        body, content_type, params = upload_body(source, time_step=time_step, time=time, sampling_rate=sampling_rate)
+        response = self._transport.request(
+            "POST",
+            "/signals",
+            content=body,
+            params=params,
+            headers={
+                "Content-Type": content_type,
+                IDEMPOTENCY_HEADER: idempotency_key or str(uuid.uuid4()),
+                "Accept": "application/json",
+            },
+        )
+        return Signal(self, response.json(), replayed=_replayed(response))
+
+    def signal(self, signal_id: str) -> Signal:
+        """A stored signal by id."""
+        return Signal(self, self._transport.get_json(f"/signals/{signal_id}"))
+
+    def signals(self, *, limit: Optional[int] = 100) -> list[Signal]:
+        """Stored signals newest first, at most ``limit`` (``None``: every page)."""
+        return [Signal(self, s) for s in self._pages("/signals", "signals", {}, limit)]
+
+    # -- paging -------------------------------------------------------------------
+
+    def _pages(self, path: str, member: str, params: Mapping[str, Any], limit: Optional[int]) -> Iterator[dict[str, Any]]:
+        """The items of a list route, following ``rel=next`` links, at most ``limit``."""
+        page_size = 1000 if limit is None else max(1, min(limit, 1000))
+        query: Optional[dict[str, Any]] = {**params, "limit": page_size}
+        url = path
+        seen = 0
+        while True:
+            document = self._transport.get_json(url, params=query)
+            for item in document.get(member) or []:
+                if limit is not None and seen >= limit:
+                    return
+                seen += 1
+                yield item
+            following = next((link["href"] for link in document.get("links") or [] if link.get("rel") == "next"), None)
+            if following is None or (limit is not None and seen >= limit):
+                return
+            url, query = following, None
+
+
+def _replayed(response: httpx.Response) -> bool:
+    return str(response.headers.get(REPLAYED_HEADER, "")).strip().lower() == "true"

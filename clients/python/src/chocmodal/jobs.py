@@ -1,0 +1,266 @@
+"""A job of the service: its status, waiting with a progress bar, its results as Python
+objects and pandas DataFrames, and dismissal."""
+
+from __future__ import annotations
+
+import time
+import warnings
+from typing import TYPE_CHECKING, Any, Optional, Union
+
+import pandas as pd
+
+from . import frames
+from .errors import ChocmodalError, QualityWarning
+from .progress import Poller, progress_bar
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .client import Client
+
+__all__ = ["Job", "ENDED"]
+
+#: Job statuses after which nothing changes any more.
+ENDED = frozenset({"successful", "failed", "dismissed"})
+
+
+class Job:
+    """One job (``/jobs/{jobId}``). Made by :meth:`Client.submit` or :meth:`Client.job`."""
+
+    def __init__(self, client: "Client", job_id: str, status: Optional[dict[str, Any]] = None, *, replayed: bool = False):
+        self._client = client
+        self.id = job_id
+        #: True when the submission was answered with an earlier one's job
+        #: (``Idempotent-Replayed: true``: the same ``Idempotency-Key`` and inputs).
+        self.replayed = replayed
+        #: The ``Idempotency-Key`` the submission was sent with (``None`` for a job
+        #: looked up by id): submit again with it to get this job back.
+        self.idempotency_key: Optional[str] = None
+        self._status = status
+        self._etag: Optional[str] = None
+        self._results: Optional[dict[str, Any]] = None
+
+    def __repr__(self) -> str:
+        state = self._status.get("status") if self._status else "?"
+        return f"<Job {self.id} {self.process_id or ''} {state}>"
+
+    @property
+    def process_id(self) -> Optional[str]:
+        return self._status.get("processID") if self._status else None
+
+    @property
+    def warnings(self) -> list[dict[str, Any]]:
+        """Plausibility warnings (``code``, ``pointer``, ``message``) of the last status read."""
+        return list((self._status or {}).get("warnings") or [])
+
+    # -- status -------------------------------------------------------------------
+
+    def status(self) -> dict[str, Any]:
+        """The statusInfo document (``status``, ``progress`` 0–100, ``message``, times...),
+        read with ``If-None-Match`` so an unchanged status costs an empty 304."""
+        self._poll()
+        assert self._status is not None
+        return dict(self._status)
+
+    def _poll(self) -> Optional[float]:
+        """Refreshes the status; returns the server's ``Retry-After`` (s) if it sent one."""
+        headers = {"Accept": "application/json"}
+        if self._etag and self._status is not None:
+            headers["If-None-Match"] = self._etag
+        response = self._client._transport.request("GET", f"/jobs/{self.id}", headers=headers)
+        if response.status_code != 304:
+            self._status = response.json()
+            self._etag = response.headers.get("ETag")
+        from ._http import retry_after_seconds
+
+        return retry_after_seconds(response.headers.get("Retry-After"))
+
+    def wait(
+        self,
+        *,
+        timeout: Optional[float] = None,
+        progress: bool = True,
+        poll_interval: Optional[float] = None,
+        warn_quality: bool = True,
+    ) -> dict[str, Any]:
+        """Waits until the job ends and returns its results document.
+
+        Shows a tqdm progress bar (0–100 %) unless ``progress`` is false. Polls quickly
+        at first, then at the pace the server asks (``Retry-After``), or every
+        ``poll_interval`` seconds when given. A successful job whose ``quality.verdict``
+        is not ``good`` issues a :class:`QualityWarning` (unless ``warn_quality`` is
+        false); a failed or dismissed job raises :class:`ChocmodalError` with the
+        server's problem (``job-failed``, ``job-dismissed``, ...). ``timeout`` (s):
+        :class:`TimeoutError` if the job has not ended by then (it keeps running).
+        """
+        deadline = None if timeout is None else time.monotonic() + timeout
+        poller = Poller(poll_interval)
+        with progress_bar(progress, total=100, desc=f"job {self.id[:8]}", unit="%") as bar:
+            while True:
+                retry_after = self._poll()
+                assert self._status is not None
+                state = self._status.get("status", "")
+                bar.show(float(self._status.get("progress") or 0), state)
+                if state in ENDED:
+                    break
+                delay = poller.next_delay(retry_after)
+                if deadline is not None and time.monotonic() + delay > deadline:
+                    raise TimeoutError(
+                        f"job {self.id} is still {state} ({self._status.get('progress')} %) after {timeout} s"
+                    )
+                time.sleep(delay)
+        results = self.results()
+        if warn_quality:
+            self._warn_quality(results)
+        return results
+
+    def _warn_quality(self, results: dict[str, Any]) -> None:
+        quality = results.get("quality")
+        if not isinstance(quality, dict):
+            return
+        verdict = quality.get("verdict")
+        if verdict is not None and verdict != "good":
+            warnings.warn(QualityWarning.of(self.id, str(verdict), list(quality.get("reasons") or [])), stacklevel=3)
+
+    def dismiss(self) -> dict[str, Any]:
+        """Dismisses the job (``DELETE``): a queued job never runs, a running one stops
+        within a second, a finished one loses its results. Returns the new status."""
+        response = self._client._transport.request("DELETE", f"/jobs/{self.id}", headers={"Accept": "application/json"})
+        if response.content:
+            self._status = response.json()
+            self._etag = None
+        self._results = None
+        return dict(self._status or {})
+
+    # -- results ------------------------------------------------------------------
+
+    def results(self) -> dict[str, Any]:
+        """The results document as Python objects (kept once read: it never changes).
+        Not finished: :class:`ChocmodalError` ``result-not-ready``; failed: the job's
+        problem (``job-failed``...); dismissed: ``job-dismissed``."""
+        if self._results is None:
+            self._results = self._client._transport.get_json(f"/jobs/{self.id}/results")
+        return self._results
+
+    def inputs(self) -> dict[str, Any]:
+        """The inputs the job was submitted with (``GET /jobs/{jobId}/inputs``)."""
+        return dict(self._client._transport.get_json(f"/jobs/{self.id}/inputs")["inputs"])
+
+    @property
+    def quality(self) -> dict[str, Any]:
+        """The results' ``quality`` section (``verdict``, ``reasons``, measures)."""
+        return dict(self.results().get("quality") or {})
+
+    def outputs(self) -> list[str]:
+        """Names of the job's outputs (histories, their ``_peaks`` envelopes, tables)."""
+        return list((self.results().get("outputs") or {}).keys())
+
+    def _output_kind(self, output: str) -> Optional[str]:
+        process = self.process_id or self.status().get("processID")
+        if process is None:
+            return None
+        described = self._client._process_outputs(process).get(output) or {}
+        return described.get("kind")
+
+    def history(
+        self,
+        output: str,
+        *,
+        t_start: Optional[float] = None,
+        t_end: Optional[float] = None,
+        max_points: Optional[int] = None,
+        series: Union[str, list[str], None] = None,
+    ) -> pd.DataFrame:
+        """One history as a DataFrame indexed by ``time`` (s), a column per series
+        (``c0, c1, ...``, ``p0, ...``, ``numerical, reference``), units in
+        ``attrs["units"]`` and what each column measures in ``attrs["descriptions"]``.
+
+        Read from the CSV form. ``t_start``/``t_end`` (s) cut a window, ``series``
+        picks columns, ``max_points`` thins with min/max buckets that keep the peaks.
+        The service thins any window longer than its ``--max-history-points`` (500 000
+        rows by default): page with ``t_start``/``t_end`` for full resolution."""
+        params = {
+            "format": "csv",
+            "header": "long",
+            "t_start": t_start,
+            "t_end": t_end,
+            "max_points": max_points,
+            "series": series,
+        }
+        response = self._client._transport.request(
+            "GET", f"/jobs/{self.id}/results/{output}", params=params, headers={"Accept": "text/csv"}
+        )
+        return frames.history_frame(response.text, output=output, job_id=self.id)
+
+    def histories(self, *, peaks: bool = True) -> dict[str, pd.DataFrame]:
+        """Every history of the job (tables aside) by output name; without the
+        ``_peaks`` envelopes when ``peaks`` is false."""
+        out: dict[str, pd.DataFrame] = {}
+        for name in self.outputs():
+            kind = self._output_kind(name)
+            if kind == "table" or (kind is None and name == "impacts"):
+                continue
+            if not peaks and (kind == "peaks" or name.endswith("_peaks")):
+                continue
+            out[name] = self.history(name)
+        return out
+
+    def impacts(self, *, contact: Union[int, list[int], None] = None, page_size: int = 100_000) -> pd.DataFrame:
+        """The per-impact table (``/jobs/{jobId}/results/impacts``), one row per impact
+        sorted by start time: ``contact, start, peak_time, peak_force, impulse,
+        duration, approach_velocity, rebounds, dissipated, energy``. Every page is
+        read (``total_rows``, ``next``); ``contact`` filters."""
+        rows: list[dict[str, Any]] = []
+        params: dict[str, Any] = {"format": "json", "limit": page_size, "offset": 0, "contact": contact}
+        if isinstance(contact, int):
+            params["contact"] = str(contact)
+        while True:
+            page = self._client._transport.get_json(f"/jobs/{self.id}/results/impacts", params=params)
+            rows.extend(page.get("rows") or [])
+            if not page.get("next") or not page.get("rows"):
+                break
+            params["offset"] = int(page.get("offset", 0)) + len(page["rows"])
+        frame = frames.impacts_frame(rows)
+        frame.attrs["job"] = self.id
+        return frame
+
+    def contacts(self) -> pd.DataFrame:
+        """The per-contact statistics of the results (``contacts``), indexed by contact
+        k (history column ``c<k>``): ``left``, ``right``, ``height``, ``gap``,
+        ``max_force``, ``max_force_time``, ``impacts``, ``contact_time``, ``impulse``,
+        ``impact_statistics.*``..."""
+        results = self.results()
+        contacts = results.get("contacts")
+        if contacts is None:
+            raise KeyError(f"job {self.id}: its results have no per-contact statistics (`contacts`)")
+        frame = frames.contacts_frame(contacts)
+        frame.attrs["job"] = self.id
+        return frame
+
+    def pins(self) -> pd.DataFrame:
+        """The per-pin extremes of the results (``pins``), indexed by pin."""
+        pins = self.results().get("pins")
+        if pins is None:
+            raise KeyError(f"job {self.id}: its results have no per-pin extremes (`pins`)")
+        frame = frames.pins_frame(pins)
+        frame.attrs["job"] = self.id
+        return frame
+
+    def to_xarray(self, output: str, **history_options: Any) -> Any:
+        """A history as xarray: contact forces as a DataArray over (time, contact), with
+        each contact's ``left``, ``right``, ``height``, ``gap`` as coordinates;
+        deflections over (time, pin, height) (plus ``direction`` x/y for a hexagonal
+        bundle); any other history as a Dataset over time. Needs ``xarray``
+        (``pip install chocmodal[xarray]``)."""
+        from ._xarray import history_to_xarray
+
+        frame = self.history(output, **history_options)
+        contacts = None
+        pin_length = None
+        results = self.results()
+        if results.get("contacts") is not None:
+            contacts = self.contacts()
+        if any(str(c).startswith("p") for c in frame.columns):
+            try:
+                pin_length = float(self.inputs()["pin"]["length"])
+            except (KeyError, TypeError, ValueError, ChocmodalError):
+                pin_length = None
+        return history_to_xarray(frame, contacts=contacts, pin_length=pin_length)
