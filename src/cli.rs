@@ -219,15 +219,22 @@ fn write_histories(dir: &Path, output: &RunOutput) -> Result<(), String> {
 }
 
 /// The results' `contacts`, one row each: `contact` then every scalar of the entry
-/// (its description, its statistics and its impact statistics, dotted), for pandas and
-/// spreadsheets. `None` for a process without a contact list.
+/// (its description, its statistics and its impact statistics, its friction and wear,
+/// dotted), for pandas and spreadsheets. `None` for a process without a contact list.
 fn contacts_csv(document: &serde_json::Value) -> Option<String> {
     let contacts = document["contacts"].as_array().filter(|c| !c.is_empty())?;
     let rows: Vec<Vec<(String, serde_json::Value)>> = contacts
         .iter()
         .map(crate::processes::metrics::flatten_scalars)
         .collect();
-    let header: Vec<&str> = rows[0].iter().map(|(name, _)| name.as_str()).collect();
+    // Every member some contact has (a family's friction or wear), in order of first
+    // appearance: a contact without one leaves its cells empty.
+    let mut header: Vec<&str> = Vec::new();
+    for (name, _) in rows.iter().flatten() {
+        if !header.contains(&name.as_str()) {
+            header.push(name);
+        }
+    }
     let cell = crate::csv_format::cell;
     let mut out = format!("contact,{}\n", header.join(","));
     for (k, row) in rows.iter().enumerate() {

@@ -9,6 +9,7 @@ mod postgres;
 mod skip;
 
 mod capabilities;
+mod contact_laws;
 mod cors;
 mod csv;
 mod dashboard;

@@ -612,3 +612,126 @@ fn settings_dt(settings: &Settings) -> f64 {
         TimeStep::Auto => unreachable!("the tests fix their step"),
     }
 }
+
+/// A power law whose peak passes the force its step was sized for: the verdict says so
+/// (`doubtful`, naming the scale), and `poor` when the step is above the critical step
+/// at the peak's stiffness (or the run stops as diverged).
+#[test]
+fn a_power_law_past_its_force_scale_is_doubtful_and_poor_when_unstable_there() {
+    let basis = basis(20, 1);
+    let (omega, mass) = oscillator(&basis);
+    let (exponent, stiffness, tip) = (1.5, 1e10, 1e-3);
+    // The undamped peak of the release's impact (see the Hertz restitution test).
+    let speed = omega * tip;
+    let depth = ((exponent + 1.0) * mass * speed * speed / (2.0 * stiffness)).powf(1.0 / (exponent + 1.0));
+    let peak = stiffness * depth.powf(exponent);
+    let run_with = |force_scale: f64, of_critical: f64| {
+        let law = Law {
+            exponent,
+            force_scale,
+            ..Law::LINEAR
+        };
+        let model = one_pin(&basis, vec![left_wall(stiffness, 0.0, law)], tip, Loop::Row);
+        let critical = super::step_size::critical_time_step(&model, Scheme::CentralDifference);
+        let settings = settings(
+            Scheme::CentralDifference,
+            of_critical * critical,
+            std::f64::consts::PI / omega,
+        );
+        Plan::new(&model, &settings).and_then(|plan| plan.run(&mut |_| std::ops::ControlFlow::Continue(())))
+    };
+    // (A one-mode basis is far from converged: the verdict judges that too, so the
+    // force scale's part is read from its reason.)
+    let about_the_scale = |quality: &Quality| quality.reasons.iter().any(|r| r.contains("force_scale"));
+    let sized = run_with(2.0 * peak, 0.05).expect("runs");
+    assert!(!about_the_scale(&sized.quality), "{:?}", sized.quality.reasons);
+    let under = run_with(peak / 3.0, 0.05).expect("runs");
+    assert!(about_the_scale(&under.quality), "{:?}", under.quality.reasons);
+    assert_ne!(under.quality.verdict, Verdict::Good);
+    assert_ne!(under.quality.verdict, Verdict::Unchecked);
+    // 3^(1/3) ≈ 1.44 times the scale's tangent stiffness at the peak: ω 1.2 × higher,
+    // above the limit at 0.9 of the scale's critical step.
+    match run_with(peak / 3.0, 0.9) {
+        Ok(unstable) => {
+            assert_eq!(
+                unstable.quality.verdict,
+                Verdict::Poor,
+                "{:?}",
+                unstable.quality.reasons
+            );
+            assert!(
+                unstable
+                    .quality
+                    .reasons
+                    .iter()
+                    .any(|r| r.contains("above the critical step")),
+                "{:?}",
+                unstable.quality.reasons
+            );
+        }
+        Err(error) => assert!(matches!(error, SimulationError::Diverged { .. }), "{error}"),
+    }
+}
+
+/// The step-halving check measures the change of the largest wear work rate (pins in
+/// the plane; none for the row), and the verdict judges it with the peaks: a change
+/// past the tolerance is a reason.
+#[test]
+fn the_step_halving_check_judges_the_wear_work_rate() {
+    let basis = basis(20, 1);
+    let (omega, mass) = oscillator(&basis);
+    let friction = crate::contact::Friction {
+        coefficient: 0.01,
+        tangential_stiffness: 1e3 * omega * omega * mass,
+    };
+    let (model, base) = clamped_in_the_plane(&basis, (1e5, 1.0, friction), 5e-3, (1, None));
+    for per_period in [12.0, 200.0] {
+        let settings = Settings {
+            check: Check::StepHalving,
+            tolerance: 1e-3,
+            ..resolved(
+                &model,
+                &base,
+                per_period,
+                10.0,
+                3.0 * std::f64::consts::TAU / omega,
+            )
+        };
+        let assessed = Plan::new(&model, &settings)
+            .and_then(|plan| plan.run(&mut |_| std::ops::ControlFlow::Continue(())))
+            .expect("runs");
+        let check = assessed.quality.step_halving.expect("checked");
+        let error = check
+            .estimated_wear_work_rate_error
+            .expect("the plane has a wear work rate");
+        assert!(error.is_finite(), "{check:?}");
+        let judged = assessed
+            .quality
+            .reasons
+            .iter()
+            .any(|r| r.contains("wear work rate"));
+        assert_eq!(
+            judged,
+            error > 10.0 * 1e-3,
+            "{per_period} steps per period: {error} {:?}",
+            assessed.quality.reasons
+        );
+    }
+    // The row has none.
+    let row = one_pin(&basis, vec![left_wall(1e5, 0.0, Law::LINEAR)], 1e-3, Loop::Row);
+    let settings = Settings {
+        check: Check::StepHalving,
+        ..resolved(&row, &base, 50.0, 10.0, 0.05)
+    };
+    let assessed = Plan::new(&row, &settings)
+        .and_then(|plan| plan.run(&mut |_| std::ops::ControlFlow::Continue(())))
+        .expect("runs");
+    assert_eq!(
+        assessed
+            .quality
+            .step_halving
+            .expect("checked")
+            .wear_work_rate_change,
+        None
+    );
+}

@@ -103,6 +103,11 @@ pub struct StepHalving {
     pub estimated_peak_force_error: f64,
     /// Estimated relative error of the reported peak deflection.
     pub estimated_peak_displacement_error: f64,
+    /// The relative change of the largest wear work rate of a contact (pins in the
+    /// plane; null for the row): far more sensitive than the peaks, it is judged with
+    /// them, by its estimated error (the same 2ᵖ/(2ᵖ − 1) × its change).
+    pub wear_work_rate_change: Option<f64>,
+    pub estimated_wear_work_rate_error: Option<f64>,
     /// Steps taken by the check.
     pub steps: u64,
     /// Wall time of the check (s).
@@ -161,6 +166,8 @@ pub(super) struct KeyFigures {
     pub peak_force: f64,
     pub peak_displacement: f64,
     pub impacts: u64,
+    /// The largest wear work ∫ F |v_t| dt of a contact (J); `None` for the row.
+    pub peak_wear_work: Option<f64>,
 }
 
 impl KeyFigures {
@@ -177,10 +184,13 @@ impl KeyFigures {
             .flatten()
             .fold(0.0f64, |m, w| m.max(w.abs()));
         let impacts = simulation.contact_statistics.iter().map(|s| s.impacts).sum();
+        let peak_wear_work = (!simulation.wear_work.is_empty())
+            .then(|| simulation.wear_work.iter().copied().fold(0.0, f64::max));
         Self {
             peak_force,
             peak_displacement,
             impacts,
+            peak_wear_work,
         }
     }
 }
@@ -210,7 +220,13 @@ pub(super) fn step_halving(
     let peak_displacement_change = relative_change(run.peak_displacement, halved.peak_displacement);
     let impact_count_change =
         (run.impacts as f64 - halved.impacts as f64).abs() / (halved.impacts.max(1) as f64);
+    let wear_work_rate_change = run
+        .peak_wear_work
+        .zip(halved.peak_wear_work)
+        .map(|(coarse, fine)| relative_change(coarse, fine));
     StepHalving {
+        wear_work_rate_change,
+        estimated_wear_work_rate_error: wear_work_rate_change.map(|change| richardson * change),
         time_step: step.halved().time_step,
         peak_force_change,
         peak_displacement_change,
@@ -223,7 +239,6 @@ pub(super) fn step_halving(
     }
 }
 
-/// The verdict on a run (see the module doc).
 /// A finding of the run's other checks (a power law's peak above the force its step
 /// was sized for): a reason, and whether it makes the result `poor`.
 #[derive(Debug, Clone, PartialEq)]
@@ -232,6 +247,7 @@ pub struct Finding {
     pub reason: String,
 }
 
+/// The verdict on a run (see the module doc).
 pub(super) fn assess(
     simulation: &Simulation,
     step: &StepSize,
@@ -283,6 +299,18 @@ pub(super) fn assess(
                         percent(peak_tolerance)
                     ));
                 }
+            }
+            if let Some(error) = check.estimated_wear_work_rate_error
+                && error > peak_tolerance
+            {
+                poor |= error > POOR_FACTOR * peak_tolerance;
+                reasons.push(format!(
+                    "the largest wear work rate of a contact changes by {} when the step is halved: \
+                     estimated error {} (tolerance {})",
+                    percent(check.wear_work_rate_change.unwrap_or(0.0)),
+                    percent(error),
+                    percent(peak_tolerance)
+                ));
             }
             if check.impact_count_change > IMPACT_COUNT_DOUBT {
                 reasons.push(format!(

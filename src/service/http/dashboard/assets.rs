@@ -94,6 +94,7 @@ pub const EXAMPLES: &[Example] = &[
     example!("sdnl104c.json", Some("bundle-dynamics")),
     example!("hex217.json", Some("hex-bundle-dynamics")),
     example!("hex7-loads.json", Some("hex-bundle-dynamics")),
+    example!("hex7-fretting.json", Some("hex-bundle-dynamics")),
     example!("sweep-calibration.json", None),
     example!("sweep-gaps.json", None),
     example!("sweep-static-correction.json", None),

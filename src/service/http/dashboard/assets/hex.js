@@ -15,9 +15,24 @@ import {linePlot} from './lines.js';
 import {envelope, envelopeSeries, history, qualityBadge, reportedPeak, seriesOf, thinned} from './job.js';
 import {STATISTICS, contactImpacts, impactsCard, statisticPicker} from './impacts.js';
 
-/** What the segments may be coloured by: every impact statistic, and the wear work rate. */
+/**
+ * What the segments may be coloured by: every impact statistic, the wear work rate, and
+ * where the contact laws give them (docs/contact-laws.md) the utilisation, friction's
+ * wear power and slip, and the Archard wear depth.
+ */
 const WEAR = {wear_work_rate: {label: 'wear work rate', unit: 'W', of: (c) => c.wear_work_rate}};
-const MEASURES = {...STATISTICS, ...WEAR};
+const LAWS = {
+  utilisation: {label: 'utilisation (peak / allowable)', unit: '', of: (c) => c.utilisation},
+  wear_depth: {label: 'wear depth', unit: 'm', of: (c) => c.wear?.depth},
+  friction_wear_power: {label: 'friction wear power', unit: 'W', of: (c) => c.friction?.wear_power},
+  slip_distance: {label: 'slip distance', unit: 'm', of: (c) => c.friction?.slip_distance},
+};
+const MEASURES = {...STATISTICS, ...WEAR, ...LAWS};
+
+/** The measures of the laws some contact of the run reports. */
+function lawMeasures(contacts) {
+  return Object.fromEntries(Object.entries(LAWS).filter(([, m]) => contacts.some((c) => m.of(c) !== undefined)));
+}
 const SIZE = 560;
 
 export async function hexBundle(box, id, results) {
@@ -63,7 +78,7 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
   const label = h('span', {class: 'mono'});
   const slider = h('input', {type: 'range', min: 0, max: levels.length - 1, step: 1, value: level,
     'aria-label': 'level', 'data-level-slider': '', oninput: (event) => { level = Number(event.target.value); draw(); }});
-  const colour = statisticPicker((key) => { measure = key; draw(); }, WEAR);
+  const colour = statisticPicker((key) => { measure = key; draw(); }, {...WEAR, ...lawMeasures(contacts)});
   const impactsBox = h('div');
   const draw = () => {
     const z = levels[level];
@@ -82,6 +97,14 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
       ['max force', `${withUnit(c.max_force, 'N')} at ${withUnit(c.max_force_time, 's')}`],
       ['impacts', fmt(c.impacts)], ['time in contact', withUnit(c.contact_time, 's')],
       ['impulse', withUnit(c.impulse, 'N·s')], ['wear work rate', withUnit(c.wear_work_rate, 'W')],
+      ...(c.utilisation === undefined ? [] : [['utilisation', fmt(c.utilisation, 3)]]),
+      ...(c.friction ? [
+        ['tangential force', `mean ${withUnit(c.friction.mean_tangential_force, 'N')}, RMS ` +
+          `${withUnit(c.friction.rms_tangential_force, 'N')}, max ${withUnit(c.friction.max_tangential_force, 'N')}`],
+        ['slip, stick', `${withUnit(c.friction.slip_distance, 'm')} slid, sticking ` +
+          `${fmt(100 * c.friction.stick_fraction, 3)} % of the time closed`],
+        ['friction wear power', withUnit(c.friction.wear_power, 'W')]] : []),
+      ...(c.wear ? [['Archard wear', `${withUnit(c.wear.depth, 'm')} deep, ${withUnit(c.wear.volume, 'm³')}`]] : []),
     ], {class: 'kv wide'}));
     replace(impactsBox, contactImpacts(id, k, c));
     if (!recorded.has(k)) {
