@@ -276,6 +276,22 @@ pub struct NormalForce {
 }
 
 impl NormalLaw {
+    /// The linear spring–dashpot K δ + c δ̇.
+    #[inline(always)]
+    pub const fn linear(stiffness: f64, damping: f64) -> Self {
+        Self {
+            stiffness,
+            damping,
+            exponent: 1.0,
+            hunt_crossley: 0.0,
+        }
+    }
+
+    /// Whether this is the linear spring–dashpot.
+    pub fn is_linear(&self) -> bool {
+        self.exponent == 1.0 && self.hunt_crossley == 0.0
+    }
+
     /// The force of a contact penetrating by δ > 0 at the rate δ̇: never pulling (the
     /// dashpot and the Hunt–Crossley term cannot make it negative).
     #[inline(always)]
@@ -285,7 +301,12 @@ impl NormalLaw {
         } else {
             self.stiffness * penetration.powf(self.exponent)
         };
-        let force = elastic * (1.0 + self.hunt_crossley * rate) + self.damping * rate;
+        let damped = if self.hunt_crossley == 0.0 {
+            elastic
+        } else {
+            elastic * (1.0 + self.hunt_crossley * rate)
+        };
+        let force = damped + self.damping * rate;
         NormalForce {
             force: force.max(0.0),
             elastic,
@@ -304,11 +325,14 @@ impl NormalLaw {
     }
 
     /// The elastic energy K δⁿ⁺¹/(n + 1) stored at penetration δ (J); 0 when open.
+    #[inline]
     pub fn energy(&self, penetration: f64) -> f64 {
-        if penetration > 0.0 {
-            self.stiffness * penetration.powf(self.exponent + 1.0) / (self.exponent + 1.0)
-        } else {
+        if penetration <= 0.0 {
             0.0
+        } else if self.exponent == 1.0 {
+            0.5 * self.stiffness * penetration * penetration
+        } else {
+            self.stiffness * penetration.powf(self.exponent + 1.0) / (self.exponent + 1.0)
         }
     }
 

@@ -735,3 +735,42 @@ fn the_step_halving_check_judges_the_wear_work_rate() {
         None
     );
 }
+
+/// The stick spring of friction stiffens the fastest motion like a normal spring: a
+/// given step that the frictionless clamp allows is refused with friction's critical
+/// step, which the stability analysis finds with k_t along the tangent.
+#[test]
+fn a_step_friction_makes_unstable_is_refused_with_the_step_it_needs() {
+    let basis = basis(20, 1);
+    let (omega, mass) = oscillator(&basis);
+    let stiff = crate::contact::Friction {
+        coefficient: 0.3,
+        tangential_stiffness: 1e4 * omega * omega * mass,
+    };
+    let (frictionless, base) =
+        clamped_in_the_plane(&basis, (1e3, 1.0, crate::contact::Friction::NONE), 0.0, (1, None));
+    let (rubbing, _) = clamped_in_the_plane(&basis, (1e3, 1.0, stiff), 0.0, (1, None));
+    let allowed = super::step_size::critical_time_step(&frictionless, Scheme::CentralDifference);
+    let needed = super::step_size::critical_time_step(&rubbing, Scheme::CentralDifference);
+    // Two stick springs k_t on the tip's apparent mass: ω² = ω₁² + 2 k_t/m along x.
+    let omega_x = (omega * omega + 2.0 * stiff.tangential_stiffness / mass).sqrt();
+    assert!(
+        (needed - 2.0 / omega_x).abs() < 1e-9 * needed,
+        "{needed} vs {}",
+        2.0 / omega_x
+    );
+    let settings = Settings {
+        time_step: TimeStep::Fixed(0.9 * allowed),
+        duration: 0.01,
+        ..base
+    };
+    assert!(Plan::new(&frictionless, &settings).is_ok());
+    match Plan::new(&rubbing, &settings) {
+        Err(SimulationError::TimeStepAboveCritical {
+            critical_time_step, ..
+        }) => {
+            assert!((critical_time_step - needed).abs() < 1e-12 * needed)
+        }
+        other => panic!("the step must be refused: {other:?}"),
+    }
+}

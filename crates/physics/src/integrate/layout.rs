@@ -21,7 +21,7 @@
 use super::kernels::{ContactLanes, Lanes, LevelShapes, PlaneGroups};
 use super::walls::WallLayout;
 use super::{Model, Settings, StepSize};
-use crate::contact::{Body, Contact, Friction, NormalLaw};
+use crate::contact::{Body, Contact, Friction, NormalForce, NormalLaw};
 use crate::stability::Scheme;
 
 /// The fixed data of one run at one step, for one SIMD level.
@@ -57,6 +57,9 @@ pub(super) struct Layout<'m> {
     /// Per lane: what a closed contact needs (its x rows in the plane), and the gap (∞
     /// in empty lanes).
     pub lane_contacts: Vec<LaneContact>,
+    /// Per lane, the normal law with its damping resolved, and friction.
+    pub lane_laws: Vec<NormalLaw>,
+    pub lane_friction: Vec<Friction>,
     pub gaps: Vec<f64>,
     /// The row's contacts (normal +x) or the plane's.
     pub contact_model: ContactModel,
@@ -77,14 +80,17 @@ pub(super) struct Layout<'m> {
     pub walls: Option<WallLayout>,
 }
 
-/// A contact as its lane needs it; offsets are in SIMD vectors.
+/// A contact as its lane needs it; offsets are in SIMD vectors. The record stays as
+/// small as the linear law needs (the closed contacts' pass waits on these scattered
+/// records): a power law, Hunt–Crossley damping and friction live in
+/// [`Layout::lane_laws`] and [`Layout::lane_friction`], read only by the lanes whose
+/// flags say so.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct LaneContact {
-    /// The normal law, its damping resolved (a restitution turned into a dashpot or a
-    /// Hunt–Crossley factor on the model's basis).
-    pub law: NormalLaw,
-    /// Friction (plane contacts only; [`Friction::NONE`] on the row).
-    pub friction: Friction,
+    /// K and c of the linear spring–dashpot, its damping resolved (a restitution turned
+    /// into a dashpot on the model's basis).
+    pub stiffness: f64,
+    pub dashpot: f64,
     /// Offset of ψ at the contact's level in `level_shapes`.
     pub shape: usize,
     /// Offsets of the left and right body's rows in the state (`wall_row` for a wall).
@@ -92,6 +98,26 @@ pub(super) struct LaneContact {
     pub right: usize,
     /// Whether it can push at all (stiffness or dashpot > 0): only those count impacts.
     pub active: bool,
+    /// Whether its law is a power law or has Hunt–Crossley damping (then it is
+    /// `lane_laws[lane]`), whether its force depends on the penetration rate, and
+    /// whether it has friction (`lane_friction[lane]`).
+    pub nonlinear: bool,
+    pub needs_rate: bool,
+    pub friction: bool,
+}
+
+impl LaneContact {
+    /// The force of the contact in `lane`, penetrating by δ > 0 at the rate δ̇: its law
+    /// ([`NormalLaw::force`], the one law of every loop), the linear one inlined from
+    /// this record.
+    #[inline(always)]
+    pub fn force(&self, laws: &[NormalLaw], lane: usize, penetration: f64, rate: f64) -> NormalForce {
+        if self.nonlinear {
+            laws[lane].force(penetration, rate)
+        } else {
+            NormalLaw::linear(self.stiffness, self.dashpot).force(penetration, rate)
+        }
+    }
 }
 
 /// What the contacts need besides [`LaneContact`]: nothing for the row, where every
@@ -293,6 +319,10 @@ impl<'m> Layout<'m> {
                 (row, &settings.output_heights),
             )
         });
+        let laws: Vec<NormalLaw> = contacts
+            .iter()
+            .map(|contact| contact.resolved_law(model.reduced_mass(contact)))
+            .collect();
         Self {
             model,
             scheme: settings.scheme,
@@ -326,16 +356,25 @@ impl<'m> Layout<'m> {
                 &contacts
                     .iter()
                     .enumerate()
-                    .map(|(c, contact)| LaneContact {
-                        law: contact.resolved_law(model.reduced_mass(contact)),
-                        friction: contact.law.friction,
+                    .zip(&laws)
+                    .map(|((c, contact), law)| LaneContact {
+                        stiffness: law.stiffness,
+                        dashpot: law.damping,
                         shape: vectors * contact_level[c],
                         left: state_row(contact.left),
                         right: state_row(contact.right),
-                        active: contact.normal_law().is_active(),
+                        active: law.is_active(),
+                        nonlinear: !law.is_linear(),
+                        needs_rate: law.needs_rate(),
+                        friction: contact.law.friction.is_on(),
                     })
                     .collect::<Vec<_>>(),
                 LaneContact::default(),
+            ),
+            lane_laws: contact_lanes.by_lane(&laws, NormalLaw::default()),
+            lane_friction: contact_lanes.by_lane(
+                &contacts.iter().map(|c| c.law.friction).collect::<Vec<_>>(),
+                Friction::NONE,
             ),
             contact_model,
             wall_row: state_row(Body::Wall),

@@ -28,7 +28,7 @@ use super::layout::{LaneContact, Layout, PlaneLane};
 use super::recorder::record_closed_contact;
 use super::walls::{WallLayout, WallState};
 use super::{ContactStatistics, FrictionStatistics};
-use crate::contact::{NormalForce, force_vector};
+use crate::contact::{Friction, NormalForce, NormalLaw, force_vector};
 use crate::impacts::{ContactImpacts, Impact, ImpactClock, ImpactSink};
 
 /// Closed contacts per chunk of the contact pass: each chunk has its own sums.
@@ -82,6 +82,8 @@ pub(super) fn level_deflections<S: Simd>(
 pub(super) struct ClosedPass<'a, S: Simd> {
     pub simd: S,
     pub lane_contacts: &'a [LaneContact],
+    pub lane_laws: &'a [NormalLaw],
+    pub lane_friction: &'a [Friction],
     pub plane_lanes: &'a [PlaneLane],
     /// ψ at every level, and the dashpot rows v and a of every line (walls' row last).
     pub shapes: &'a [S::f64s],
@@ -216,16 +218,16 @@ impl<S: Simd> ClosedPass<'_, S> {
             }
             let rate = normal_x * rate_x + normal_y * rate_y;
             let sliding = normal_x * rate_y - normal_y * rate_x;
-            let NormalForce { force, elastic } = contact.law.force(penetration, rate);
+            let NormalForce { force, elastic } = contact.force(self.lane_laws, j, penetration, rate);
             let k = j - first;
             out.forces[k] = force;
             let mut dissipation = (force - elastic) * rate;
             let mut wall_power = force * wall_rate;
             let mut slipping = true;
-            if contact.friction.is_on() {
+            if contact.friction {
                 let dt = self.at.2;
                 let previous = if previous > 0.0 { out.tangentials[k] } else { 0.0 };
-                let tangential = contact.friction.step(previous, sliding, dt, force);
+                let tangential = self.lane_friction[j].step(previous, sliding, dt, force);
                 out.tangentials[k] = tangential.force;
                 dissipation += tangential.dissipation;
                 wall_power += tangential.force * wall_sliding;
@@ -327,7 +329,7 @@ fn update_half<S: Simd>(
                 }
                 let (contact, lane) = (layout.lane_contacts[j], loads.plane_lanes[j]);
                 let shape = &shapes[contact.shape..][..n];
-                let tangential = if contact.friction.is_on() {
+                let tangential = if contact.friction {
                     loads.tangentials[j]
                 } else {
                     0.0

@@ -92,15 +92,16 @@ impl State {
             .contacts
             .iter()
             .zip(&layout.contacts.lane)
+            .map(|(c, lane)| (c, *lane as usize))
+            .filter(|(_, lane)| self.penetration[*lane] > 0.0)
             .map(|(c, lane)| {
-                (
-                    c,
-                    self.penetration[*lane as usize],
-                    self.tangential_force[*lane as usize],
-                )
+                let spring = c.normal_law().energy(self.penetration[lane]);
+                if c.law.friction.is_on() {
+                    spring + c.law.friction.energy(self.tangential_force[lane])
+                } else {
+                    spring
+                }
             })
-            .filter(|(_, d, _)| *d > 0.0)
-            .map(|(c, d, t)| c.normal_law().energy(d) + c.law.friction.energy(t))
             .sum()
     }
 

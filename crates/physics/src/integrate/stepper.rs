@@ -299,6 +299,7 @@ impl<'m> Integrator<'m> {
         // Per lane, all of one length (so that one bounds check covers them all).
         let lane_contacts = layout.lane_contacts.as_slice();
         let lanes = lane_contacts.len();
+        let laws = &layout.lane_laws[..lanes];
         let (now, before) = (&state.penetration[..lanes], &state.previous_penetration[..lanes]);
         let (forces, statistics) = (
             &mut state.contact_force[..lanes],
@@ -315,7 +316,7 @@ impl<'m> Integrator<'m> {
             let j = j as usize;
             let contact = lane_contacts[j];
             let (penetration, previous) = (now[j], before[j]);
-            let mut rate = if contact.law.needs_rate() {
+            let mut rate = if contact.needs_rate {
                 let rows = |offset: usize| (&v[offset..], &a[offset..]);
                 let shape = &shapes[contact.shape..][..n];
                 penetration_rate(simd, shape, rows(contact.left), rows(contact.right), lookahead)
@@ -330,7 +331,7 @@ impl<'m> Integrator<'m> {
                 rate += wall_rate;
             }
             // The penetration is positive: the contact's law.
-            let NormalForce { force, elastic } = contact.law.force(penetration, rate);
+            let NormalForce { force, elastic } = contact.force(laws, j, penetration, rate);
             forces[j] = force;
             let dissipation = (force - elastic) * rate;
             dissipation_power += dissipation;
@@ -660,6 +661,7 @@ fn plane_contact_forces<S: Simd>(
     let loads = S::as_mut_simd_f64s(&mut state.force).0;
     let lane_contacts = layout.lane_contacts.as_slice();
     let lanes = lane_contacts.len();
+    let laws = &layout.lane_laws[..lanes];
     let plane_lanes = &plane.lanes[..lanes];
     let (now, before) = (&state.penetration[..lanes], &state.previous_penetration[..lanes]);
     let (forces, statistics) = (
@@ -693,13 +695,13 @@ fn plane_contact_forces<S: Simd>(
         }
         let rate = normal_x * rate_x + normal_y * rate_y;
         let sliding = normal_x * rate_y - normal_y * rate_x;
-        let NormalForce { force, elastic } = contact.law.force(penetration, rate);
+        let NormalForce { force, elastic } = contact.force(laws, j, penetration, rate);
         forces[j] = force;
         let mut dissipation = (force - elastic) * rate;
         let mut slipping = true;
-        if contact.friction.is_on() {
+        if contact.friction {
             let previous = if previous > 0.0 { tangentials[j] } else { 0.0 };
-            let tangential = contact.friction.step(previous, sliding, dt, force);
+            let tangential = layout.lane_friction[j].step(previous, sliding, dt, force);
             tangentials[j] = tangential.force;
             dissipation += tangential.dissipation;
             wall_power += tangential.force * wall_sliding;
@@ -733,11 +735,7 @@ fn plane_contact_forces<S: Simd>(
         let (contact, lane, force) = (lane_contacts[j], plane_lanes[j], forces[j]);
         if force != 0.0 {
             let shape = &shapes[contact.shape..][..n];
-            let tangential = if contact.friction.is_on() {
-                tangentials[j]
-            } else {
-                0.0
-            };
+            let tangential = if contact.friction { tangentials[j] } else { 0.0 };
             let [x, y] = force_vector(force, tangential, lane.normal);
             if contact.left != wall {
                 row_axpy(simd, -x, shape, &mut loads[contact.left..]);
@@ -772,6 +770,8 @@ fn shared_plane_contact_forces<S: Simd>(
     let pass = ClosedPass {
         simd,
         lane_contacts: &layout.lane_contacts,
+        lane_laws: &layout.lane_laws,
+        lane_friction: &layout.lane_friction,
         plane_lanes: &plane.lanes[..lanes],
         shapes: S::as_simd_f64s(&layout.level_shapes).0,
         v: S::as_simd_f64s(&state.v).0,
