@@ -774,3 +774,64 @@ fn a_step_friction_makes_unstable_is_refused_with_the_step_it_needs() {
         other => panic!("the step must be refused: {other:?}"),
     }
 }
+
+/// code_aster sdnd104a (analytic reference): a 1 kg block on a plane with Coulomb
+/// friction (μ = 0.1, N = 10 N, RIGI_TAN = 9e6) whose base moves with A sin(2πt); the
+/// wear power PUIS_USURE = mean of N |v| over [4, 12] s is 15.2671 W for A = 15 m/s²,
+/// 0.409062 for 1.5, 2.26164e-4 for 1.01 and 0 for 0.99 (the block never slides).
+///
+/// The block is the tip of a one-mode pin so soft that its frequency is the block's
+/// (ω² = 3e-5 s⁻²), clamped between two preloaded walls with friction: its tip moves as
+/// x'' = −ψΓ a(t) − ψ² (friction) with the tip's apparent mass 1/ψ². So the base
+/// acceleration is A/(ψΓ), the walls press with N = 10/ψ² in all (two contacts),
+/// k_t = 4.5e6/ψ² each; the wear power of the block is the two contacts' normal work
+/// rate over 1/ψ² (their normal force is 1/ψ² times the block's), over [4, 12] s from
+/// two runs.
+#[test]
+fn a_block_rubbing_on_a_shaken_plane_wears_as_code_aster_sdnd104a() {
+    // The test tube, its Young's modulus scaled down until ω₁² = 3e-5 s⁻² (ω² ∝ E).
+    let spec = |young_modulus: f64| crate::beam::BeamSpec {
+        young_modulus,
+        ..crate::beam::tests::default_tube(8)
+    };
+    let stiff = ModalBasis::compute(&spec(2.1e11), 1).expect("valid beam");
+    let young_modulus = 2.1e11 * 3e-5 / stiff.angular_frequencies()[0].powi(2);
+    let basis = ModalBasis::compute(&spec(young_modulus), 1).expect("valid beam");
+    assert!((basis.angular_frequencies()[0].powi(2) - 3e-5).abs() < 1e-9);
+    let psi = basis.deflection_at(1.0)[0];
+    let gamma = basis.participation()[0];
+    let mass = 1.0 / (psi * psi);
+    for (amplitude, reference, precision) in [
+        (15.0, 15.2671, 5e-4),
+        (1.5, 0.409062, 5e-4),
+        (1.01, 2.26164e-4, 5e-3),
+        (0.99, 0.0, 0.0),
+    ] {
+        let friction = crate::contact::Friction {
+            coefficient: 0.1,
+            tangential_stiffness: 4.5e6 * mass,
+        };
+        let (mut model, base) =
+            clamped_in_the_plane(&basis, (9e6 * mass, 5.0 * mass, friction), 0.0, (1, None));
+        model.base_acceleration = Some(crate::loads::BaseAcceleration::Sine {
+            amplitude: amplitude / (psi * gamma),
+            frequency: 1.0,
+            cycles: 12.0,
+        });
+        let work = |duration: f64| {
+            let settings = Settings {
+                time_step: TimeStep::Fixed(2e-5),
+                output_interval: Some(0.1),
+                duration,
+                ..base.clone()
+            };
+            let result = run(&model, &settings);
+            result.wear_work.iter().sum::<f64>() / mass
+        };
+        let power = (work(12.0) - work(4.0)) / 8.0;
+        assert!(
+            (power - reference).abs() <= precision * reference,
+            "A = {amplitude}: PUIS_USURE {power} W vs {reference}"
+        );
+    }
+}
