@@ -439,7 +439,7 @@ impl Contact {
         }
         require_non_negative(&mut issues, "stiffness", self.stiffness);
         require_non_negative(&mut issues, "damping", self.damping);
-        if self.gap < 0.0 && !(self.stiffness > 0.0) {
+        if self.gap < 0.0 && (self.stiffness.is_nan() || self.stiffness <= 0.0) {
             issues.push(InputIssue::new(
                 "gap",
                 "a negative gap (an interference) needs a stiffness > 0 to carry the preload",
