@@ -79,6 +79,25 @@ CONTACT_UNITS: dict[str, str] = {
     "rebounds_per_impact": "1",
     "mean_impact_energy": "J",
     "max_impact_energy": "J",
+    # Contact laws (docs/contact-laws.md): the law's members, utilisation, friction, wear.
+    "exponent": "1",
+    "hunt_crossley": "s/m",
+    "restitution": "1",
+    "restitution_speed": "m/s",
+    "restitution_mass": "kg",
+    "force_scale": "N",
+    "allowable_force": "N",
+    "tangential_stiffness": "N/m",
+    "utilisation": "1",
+    "mean_tangential_force": "N",
+    "rms_tangential_force": "N",
+    "max_tangential_force": "N",
+    "slip_distance": "m",
+    "stick_fraction": "1",
+    "wear_power": "W",
+    "power": "W",
+    "volume": "m³",
+    "depth": "m",
 }
 
 #: Units of the members of a results document's ``pins`` entries.
