@@ -20,6 +20,7 @@ pub struct Metrics {
     registry: Registry,
     jobs: IntGaugeVec,
     job_duration: HistogramVec,
+    job_verdicts: IntCounterVec,
     queue_wait: HistogramVec,
     jobs_rescued: IntCounter,
     jobs_abandoned: IntCounter,
@@ -58,6 +59,15 @@ impl Metrics {
             )
             .buckets(job_buckets.clone()),
             &["process", "outcome"],
+        )
+        .expect("valid metric");
+        let job_verdicts = IntCounterVec::new(
+            Opts::new(
+                "chocmodal_job_verdicts_total",
+                "Jobs computed to success, by process and quality verdict (good, unchecked, \
+                 doubtful, poor).",
+            ),
+            &["process", "verdict"],
         )
         .expect("valid metric");
         let queue_wait = HistogramVec::new(
@@ -113,6 +123,7 @@ impl Metrics {
         for collector in [
             Box::new(jobs.clone()) as Box<dyn prometheus::core::Collector>,
             Box::new(job_duration.clone()),
+            Box::new(job_verdicts.clone()),
             Box::new(queue_wait.clone()),
             Box::new(jobs_rescued.clone()),
             Box::new(jobs_abandoned.clone()),
@@ -127,6 +138,7 @@ impl Metrics {
             registry,
             jobs,
             job_duration,
+            job_verdicts,
             queue_wait,
             jobs_rescued,
             jobs_abandoned,
@@ -152,6 +164,11 @@ impl Metrics {
         self.job_duration
             .with_label_values(&[process, outcome])
             .observe(duration.as_secs_f64());
+    }
+
+    /// A job of `process` computed to success with the quality verdict `verdict`.
+    pub fn count_verdict(&self, process: &str, verdict: &str) {
+        self.job_verdicts.with_label_values(&[process, verdict]).inc();
     }
 
     pub fn observe_queue_wait(&self, process: &str, wait: Duration) {

@@ -193,3 +193,37 @@ fn the_openapi_document_describes_every_route_and_problem_schema() {
         );
     }
 }
+
+/// Jobs computed to success are counted by their quality verdict: the verdict their
+/// results carry.
+#[tokio::test]
+async fn metrics_count_computed_jobs_by_their_verdict() {
+    let app = crate::helpers::spawn_app_with_processes(
+        vec![std::sync::Arc::new(
+            chocmodal::processes::cantilever_impact::CantileverImpact,
+        )],
+        |_| {},
+    )
+    .await;
+    let response = app
+        .post_execution(
+            "cantilever-impact",
+            &json!({"inputs": {"beam": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
+                "section": {"type": "tube", "outer_diameter": 0.01, "inner_diameter": 0.009},
+                "elements": 10, "modes": 3}, "solver": {"duration": 0.02}}}),
+        )
+        .await;
+    assert_eq!(response.status(), StatusCode::CREATED);
+    let job = response.json::<serde_json::Value>().await.unwrap()["jobID"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    let status = app.wait_until_finished(&job).await;
+    assert_eq!(status["status"], "successful", "{status}");
+    let results = app.get_json(&format!("/jobs/{job}/results")).await;
+    let verdict = results["quality"]["verdict"].as_str().expect("a verdict");
+    let text = app.get("/metrics").await.text().await.unwrap();
+    let line =
+        format!("chocmodal_job_verdicts_total{{process=\"cantilever-impact\",verdict=\"{verdict}\"}} 1");
+    assert!(text.contains(&line), "`{line}` missing from\n{text}");
+}

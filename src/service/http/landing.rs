@@ -166,7 +166,8 @@ pub async fn readyz(State(state): State<AppState>) -> Response {
 /// Prometheus metrics
 ///
 /// Text exposition format: `chocmodal_jobs{status}` (gauge), `chocmodal_job_duration_seconds`
-/// and `chocmodal_job_queue_wait_seconds` (histograms, s), `chocmodal_jobs_rescued_total`,
+/// and `chocmodal_job_queue_wait_seconds` (histograms, s), `chocmodal_job_verdicts_total{process,verdict}`
+/// (jobs computed to success by quality verdict), `chocmodal_jobs_rescued_total`,
 /// `chocmodal_jobs_abandoned_total`, `chocmodal_http_requests_total{method,route,status}`,
 /// `chocmodal_http_request_duration_seconds` (s), `chocmodal_failed_writes_total{cause,during}`
 /// (writes the storage refused).

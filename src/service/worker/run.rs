@@ -211,9 +211,17 @@ pub(super) async fn run_job(
         timed_out: timed_out.then_some(ctx.max_job_time).flatten(),
         reached: control.percent(),
     };
+    // The quality verdict of a result, counted once it is stored.
+    let verdict = match &outcome {
+        Ok(Ok(output)) => output.document["quality"]["verdict"].as_str().map(str::to_owned),
+        _ => None,
+    };
     let outcome_label = finish(ctx, &lease, outcome, ending).await;
     ctx.metrics
         .observe_job(&process_id, outcome_label, started.elapsed());
+    if let (Some(verdict), "successful") = (verdict, outcome_label) {
+        ctx.metrics.count_verdict(&process_id, &verdict);
+    }
     tracing::info!(job = %lease.job_id, outcome = outcome_label, seconds = started.elapsed().as_secs_f64(), "job ended");
 }
 
