@@ -445,7 +445,7 @@ mod tests {
                 ),
                 FieldError::new(
                     "/axes/1/pointer",
-                    "no input `rkk` under /contact; valid: damping, gap, rk, stiffness"
+                    "no input `rkk` under /contact; valid: damping, gap, law, rk, stiffness"
                 ),
             ]
         );

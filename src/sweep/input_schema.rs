@@ -204,7 +204,7 @@ mod tests {
         let cantilever = inputs_schema("cantilever-impact");
         assert_eq!(
             check(&cantilever, "/contact/rkk"),
-            Err("no input `rkk` under /contact; valid: damping, gap, rk, stiffness".to_owned())
+            Err("no input `rkk` under /contact; valid: damping, gap, law, rk, stiffness".to_owned())
         );
         let top = check(&cantilever, "/contcat/rk").unwrap_err();
         assert!(

@@ -436,15 +436,14 @@ impl Contact {
         }
         if !self.gap.is_finite() {
             issues.push(InputIssue::new("gap", "must be a finite number"));
-        }
-        require_non_negative(&mut issues, "stiffness", self.stiffness);
-        require_non_negative(&mut issues, "damping", self.damping);
-        if self.gap < 0.0 && (self.stiffness.is_nan() || self.stiffness <= 0.0) {
+        } else if self.gap < 0.0 && (self.stiffness.is_nan() || self.stiffness <= 0.0) {
             issues.push(InputIssue::new(
                 "gap",
                 "a negative gap (an interference) needs a stiffness > 0 to carry the preload",
             ));
         }
+        require_non_negative(&mut issues, "stiffness", self.stiffness);
+        require_non_negative(&mut issues, "damping", self.damping);
         let mut law = Vec::new();
         self.law.validate(&mut law, self.damping);
         issues.extend(law.into_iter().map(|issue| issue.within("law")));
@@ -506,8 +505,8 @@ mod tests {
             [
                 "left",
                 "height",
-                "stiffness",
                 "gap",
+                "stiffness",
                 "law/exponent",
                 "law/restitution",
                 "law/restitution_mass",
