@@ -83,7 +83,8 @@ fn pointer_of(inputs: &BundleInputs, path: &str, pins_refused: bool) -> Option<S
             // Expanded level by level: wall–0, 0–1, …, (n−1)–wall.
             let place = k % (generator.pins + 1);
             let (_, pointer) = generator.families().of(place == 0 || place == generator.pins);
-            model_check::join(pointer, rest.strip_prefix("law").unwrap_or(rest))
+            let member = rest.strip_prefix("law").unwrap_or(rest).trim_start_matches('/');
+            model_check::join(pointer, member)
         }
         ("contacts", Some(_), _) if generated => "/inputs/bundle".to_owned(),
         ("contacts", Some(_), "left" | "right") if pins_refused => return None,

@@ -80,7 +80,7 @@ pub struct ContactInput {
     /// The rest of the law: power-law exponent, restitution, Hunt–Crossley damping,
     /// allowable force (the linear spring–dashpot when left out).
     #[serde(default, skip_serializing_if = "LawInput::is_default")]
-    #[schema(default = json!({}))]
+    #[schema(schema_with = super::contact_law::row_law_schema, default = json!({}))]
     pub law: LawInput,
 }
 
@@ -202,9 +202,10 @@ pub struct BundleGenerator {
     /// The rest of the law of every contact (of the pin–pin contacts when `wall_law`
     /// is given): exponent, restitution, Hunt–Crossley damping, allowable force.
     #[serde(default)]
-    #[schema(default = json!({}))]
+    #[schema(schema_with = super::contact_law::row_law_schema, default = json!({}))]
     pub law: LawInput,
     /// The law of the wall contacts, instead of `law`.
+    #[schema(schema_with = super::contact_law::row_law_schema)]
     pub wall_law: Option<LawInput>,
     /// Nominal wall–pin gap (m).
     #[schema(minimum = 0.0)]

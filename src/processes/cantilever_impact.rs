@@ -96,7 +96,7 @@ pub struct ContactInput {
     /// allowable force (the linear spring when left out). The reference knows the
     /// linear spring without damping only: another law acts on the numerical model.
     #[serde(default)]
-    #[schema(default = json!({}))]
+    #[schema(schema_with = super::contact_law::row_law_schema, default = json!({}))]
     pub law: LawInput,
 }
 

@@ -14,15 +14,15 @@ use crate::physics::wear::{Wear, WearGeometry};
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LawInput {
-    /// n in F = K δⁿ (K in N/mⁿ): 1 (default) is linear, 1.5 Hertz (a sphere or
-    /// crossed cylinders).
+    /// n in F = K δⁿ (dimensionless; K in N/mⁿ): 1 (default) is linear, 1.5 Hertz (a
+    /// sphere or crossed cylinders).
     #[schema(minimum = 1.0)]
     pub exponent: Option<f64>,
     /// Hunt–Crossley α (s/m): the force K δⁿ (1 + α δ̇), damped in proportion to the
     /// spring, with no jump at first touch; e ≈ 1 − α v₀ at slow approach.
     #[schema(minimum = 0.0)]
     pub hunt_crossley: Option<f64>,
-    /// A coefficient of restitution e in (0, 1] instead of `damping` (and of
+    /// A coefficient of restitution e (dimensionless), in (0, 1], instead of `damping` (and of
     /// `hunt_crossley`): the impact of two free bodies rebounds with e exactly. Linear
     /// law: sets the dashpot c = 2 ζ(e) √(K m), m the reduced mass (`restitution_mass`,
     /// or from each pin's first mode at the contact). Power law: sets α for
@@ -110,7 +110,7 @@ impl WearInput {
                 WearGeometryInput::Flat { radius, width } => WearGeometry::Flat { radius, width },
                 WearGeometryInput::CrossedTubes { radius, angle } => WearGeometry::CrossedTubes {
                     radius,
-                    angle: angle.to_radians(),
+                    angle_degrees: angle,
                 },
                 WearGeometryInput::Bore { radius, length } => WearGeometry::Bore { radius, length },
             },
@@ -156,12 +156,32 @@ impl WearReport {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FrictionInput {
-    /// μ ≥ 0.
+    /// μ (dimensionless), ≥ 0.
     #[schema(minimum = 0.0)]
     pub coefficient: f64,
     /// k_t (N/m) of the stick phase, > 0.
     #[schema(exclusive_minimum = 0.0)]
     pub tangential_stiffness: f64,
+}
+
+/// The schema of `law` where contacts do not slide (pins bending in one plane:
+/// `bundle-dynamics`, `cantilever-impact`): [`LawInput`]'s without `friction` and
+/// `wear`, which those processes refuse with the reason.
+pub fn row_law_schema() -> utoipa::openapi::RefOr<utoipa::openapi::Schema> {
+    use utoipa::PartialSchema;
+    let mut schema = <LawInput as PartialSchema>::schema();
+    if let utoipa::openapi::RefOr::T(utoipa::openapi::Schema::Object(object)) = &mut schema {
+        object.properties.remove("friction");
+        object.properties.remove("wear");
+        object.description = Some(
+            "How a contact's force grows and what it loses, beside its `stiffness` K and `damping` c: \
+             F = max(0, K δⁿ (1 + α δ̇) + c δ̇) while the penetration δ > 0. Every member is optional: \
+             `{}` is the linear spring–dashpot. (Friction and wear need pins bending in the transverse \
+             plane: hex-bundle-dynamics.)"
+                .to_owned(),
+        );
+    }
+    schema
 }
 
 impl LawInput {

@@ -78,6 +78,11 @@ async fn jobs_outliving_the_grace_are_handed_back_and_complete_on_the_next_start
         jobs.push(app.submit(job_of_seconds(2)).await);
     }
     wait_until_running(&app, &jobs[..2]).await;
+    // Running in the database comes with the claim; the run itself starts a moment later.
+    let deadline = std::time::Instant::now() + Duration::from_secs(10);
+    while app.probe.started() < 2 && std::time::Instant::now() < deadline {
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
     assert_eq!(app.probe.started(), 2);
 
     // One request to stop (as one SIGTERM): the 300 ms grace, then the hand-back.

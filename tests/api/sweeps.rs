@@ -266,7 +266,7 @@ async fn an_axis_pointer_that_names_no_input_is_refused_before_any_run_is_queued
     assert_eq!(
         problem["errors"],
         json!([{"pointer": "/axes/0/pointer",
-                "detail": "no input `rkk` under /contact; valid: damping, gap, rk, stiffness"}]),
+                "detail": "no input `rkk` under /contact; valid: damping, gap, law, rk, stiffness"}]),
         "{problem}"
     );
     assert_eq!(app.get_json("/jobs").await["jobs"], json!([]));

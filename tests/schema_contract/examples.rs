@@ -59,10 +59,37 @@ fn base_accelerations() -> Vec<Value> {
     ]
 }
 
+/// The three kinds of contact law, between them every member of `law`: a power law
+/// with a restitution at a speed, Hunt–Crossley damping, and a linear law's restitution
+/// with its mass (docs/contact-laws.md).
+fn laws() -> [Value; 3] {
+    [
+        json!({"exponent": 1.5, "force_scale": 50.0, "restitution": 0.8, "restitution_speed": 0.5,
+               "allowable_force": 100.0}),
+        json!({"hunt_crossley": 0.1, "allowable_force": 100.0}),
+        json!({"restitution": 0.7, "restitution_mass": 0.05}),
+    ]
+}
+
+/// [`laws`] with friction and a wear law of each geometry, for pins in the plane.
+fn plane_laws() -> [Value; 3] {
+    let geometries = [
+        json!({"type": "flat", "radius": 0.00485, "width": 0.002}),
+        json!({"type": "crossed_tubes", "radius": 0.00485, "angle": 10.0}),
+        json!({"type": "bore", "radius": 0.00485, "length": 0.01}),
+    ];
+    let mut laws = laws();
+    for (law, geometry) in laws.iter_mut().zip(geometries) {
+        law["friction"] = json!({"coefficient": 0.3, "tangential_stiffness": 1e5});
+        law["wear"] = json!({"coefficient": 1e-13, "geometry": geometry});
+    }
+    laws
+}
+
 /// `cantilever-impact`: a tube with `rk`, and an explicit section with a stiffness, a
-/// per-mode damping list and the Tchamwa scheme.
+/// per-mode damping list and the Tchamwa scheme; each kind of contact law.
 pub fn cantilever() -> Vec<Value> {
-    vec![
+    let mut examples = vec![
         json!({"beam": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
                         "section": {"type": "tube", "outer_diameter": 0.010, "inner_diameter": 0.009},
                         "added_mass_per_length": 0.1, "elements": 8, "modes": 4, "damping_ratio": 0.01,
@@ -82,7 +109,17 @@ pub fn cantilever() -> Vec<Value> {
                "contact": {"stiffness": 50.0, "gap": 1e-4, "damping": 0.1},
                "solver": {"scheme": "tchamwa", "phi": 1.1, "time_step": "auto", "duration": 0.04},
                "reference": {"modes": 6}}),
-    ]
+    ];
+    for law in laws() {
+        let stiffness = if law.get("exponent").is_some() { 1e8 } else { 50.0 };
+        examples.push(json!({"beam": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
+                                      "section": {"type": "tube", "outer_diameter": 0.010, "inner_diameter": 0.009},
+                                      "elements": 8, "modes": 4},
+                             "contact": {"stiffness": stiffness, "law": law},
+                             "solver": {"duration": 0.02, "check": "none"},
+                             "reference": {"modes": 6}}));
+    }
+    examples
 }
 
 /// A row of two pins between the walls, explicit form.
@@ -132,6 +169,21 @@ pub fn bundle() -> Vec<Value> {
         json!({"type": "per_contact", "values": [1e-4, 1e-4, 1e-4, 1e-4, 0.0, 1e-4, 1e-4, 1e-4]}),
     ];
     let mut examples = vec![explicit, explicit_section];
+    // Each kind of law on an explicit contact, and on each family of the generator.
+    let mut with_laws = explicit_row();
+    for (contact, law) in laws().into_iter().enumerate() {
+        // A restitution sets the damping: none is given beside it.
+        with_laws["contacts"][contact]["damping"] = json!(0.0);
+        with_laws["contacts"][contact]["law"] = law;
+    }
+    examples.push(with_laws);
+    for k in 0..3 {
+        let mut families = generator(json!({"type": "uniform"}), base_accelerations()[0].clone());
+        families["bundle"]["damping"] = json!(0.0);
+        families["bundle"]["law"] = laws()[k].clone();
+        families["bundle"]["wall_law"] = laws()[(k + 1) % 3].clone();
+        examples.push(families);
+    }
     let bases = base_accelerations();
     for (k, base) in bases.iter().enumerate() {
         examples.push(generator(gap_states[k % gap_states.len()].clone(), base.clone()));
@@ -233,6 +285,20 @@ pub fn hex() -> Vec<Value> {
          "force": [0.0, 2.0, 0.0]},
         {"pin": 4, "height": 0.5 * PIN_LENGTH, "time": [0.0, 0.003], "force": [1.0, 0.0]}]});
     let mut examples = vec![first, explicit_section, loaded];
+    // Each kind of law, with friction and each wear geometry, on each family.
+    for k in 0..3 {
+        let mut rubbing = hex_example(
+            gap_states[0].clone(),
+            json!({"base_acceleration": bases[0], "direction": 30.0}),
+            selections[0].clone(),
+        );
+        rubbing["contact"]["damping"] = json!(0.0);
+        rubbing["contact"]["wall_damping"] = json!(0.0);
+        rubbing["contact"]["law"] = plane_laws()[k].clone();
+        rubbing["contact"]["wall_law"] = plane_laws()[(k + 1) % 3].clone();
+        rubbing["output"]["service_time"] = json!(3.15e7);
+        examples.push(rubbing);
+    }
     for (k, base) in bases.iter().enumerate() {
         examples.push(hex_example(
             gap_states[k % gap_states.len()].clone(),

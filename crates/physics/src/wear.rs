@@ -14,9 +14,10 @@ pub enum WearGeometry {
     /// spring or dimple; POST_USURE's TUBE_BAV): V = (4/3) L √(2R) d^{3/2}, the lens
     /// a flat cuts into a cylinder to first order in d/R.
     Flat { radius: f64, width: f64 },
-    /// Two tubes crossing at an angle θ, the other of radius R (wire on clad, tube on
-    /// tube; TUBE_TUBE): V = (8/15) √(2R) d^{5/2}/θ.
-    CrossedTubes { radius: f64, angle: f64 },
+    /// Two tubes crossing at an angle θ (given in degrees, as POST_USURE's ANGL_INCLI),
+    /// the other of radius R (wire on clad, tube on tube; TUBE_TUBE):
+    /// V = (8/15) √(2R) d^{5/2}/θ, θ in radians.
+    CrossedTubes { radius: f64, angle_degrees: f64 },
     /// A tube of radius R in a bore of length L, worn evenly around (a support plate;
     /// TUBE_ALESAGE without the bore's radius): V = 2π R L d.
     Bore { radius: f64, length: f64 },
@@ -46,14 +47,18 @@ impl Wear {
             WearGeometry::Flat { radius, width } => {
                 (1.0 / (2.0 * radius)).powf(1.0 / 3.0) * (3.0 * volume / (4.0 * width)).powf(2.0 / 3.0)
             }
-            WearGeometry::CrossedTubes { radius, angle } => {
+            WearGeometry::CrossedTubes {
+                radius,
+                angle_degrees,
+            } => {
+                let angle = angle_degrees.to_radians();
                 (1.0 / (2.0 * radius)).powf(0.2) * (15.0 * angle * volume / 8.0).powf(0.4)
             }
             WearGeometry::Bore { radius, length } => volume / (std::f64::consts::TAU * length * radius),
         }
     }
 
-    /// Every problem of this law: K ≥ 0, lengths > 0, an angle in (0, π/2].
+    /// Every problem of this law: K ≥ 0, lengths > 0, an angle in (0, 90] degrees.
     pub fn validate(&self) -> Vec<InputIssue> {
         let mut issues = Vec::new();
         crate::require_non_negative(&mut issues, "coefficient", self.coefficient);
@@ -70,9 +75,12 @@ impl Wear {
                 positive("radius", radius);
                 positive("width", width);
             }
-            WearGeometry::CrossedTubes { radius, angle } => {
+            WearGeometry::CrossedTubes {
+                radius,
+                angle_degrees,
+            } => {
                 positive("radius", radius);
-                if !(angle.is_finite() && angle > 0.0 && angle <= std::f64::consts::FRAC_PI_2) {
+                if !(angle_degrees.is_finite() && angle_degrees > 0.0 && angle_degrees <= 90.0) {
                     issues.push(InputIssue::new(
                         "geometry/angle",
                         "the crossing angle must be in (0, 90] degrees (parallel tubes: a flat of the \
@@ -104,7 +112,7 @@ mod tests {
             coefficient: 1.8e-13,
             geometry: WearGeometry::CrossedTubes {
                 radius: 1.0,
-                angle: 7f64.to_radians(),
+                angle_degrees: 7.0,
             },
         };
         for (years, depth) in [
