@@ -25,7 +25,7 @@ pub struct LawInput {
     /// A coefficient of restitution e (dimensionless), in (0, 1], instead of `damping` (and of
     /// `hunt_crossley`): the impact of two free bodies rebounds with e exactly. Linear
     /// law: sets the dashpot c = 2 ζ(e) √(K m), m the reduced mass (`restitution_mass`,
-    /// or from each pin's first mode at the contact). Power law: sets α for
+    /// or from each pin's modal basis at the contact). Power law: sets α for
     /// `restitution_speed`.
     #[schema(exclusive_minimum = 0.0, maximum = 1.0)]
     pub restitution: Option<f64>,
@@ -34,7 +34,8 @@ pub struct LawInput {
     #[schema(exclusive_minimum = 0.0)]
     pub restitution_speed: Option<f64>,
     /// The reduced mass m₁m₂/(m₁ + m₂) (kg) of the linear law's restitution; by default
-    /// each pin's first-mode apparent mass 1/φ₁(z)² at the contact (a wall's infinite).
+    /// each pin's apparent mass 1/Σᵢ φᵢ(z)² on its modal basis at the contact (a wall's
+    /// infinite).
     #[schema(exclusive_minimum = 0.0)]
     pub restitution_mass: Option<f64>,
     /// The largest force (N) a power law (n > 1) is expected to carry: its tangent

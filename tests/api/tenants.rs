@@ -290,8 +290,13 @@ async fn one_tenants_300_queued_jobs_do_not_delay_another_tenants_single_job(bac
     const ALPHA_JOBS: u64 = 300;
     const BETA_STEPS: u64 = 7;
     for k in 0..ALPHA_JOBS {
-        // Distinct inputs: identical ones would reuse results instead of running.
-        As::alpha(&queuing).submit(json!({"steps": 1000 + k})).await;
+        // Distinct inputs: identical ones would reuse results instead of running. Each
+        // runs for a fifth of a second, so that alpha has a run going whenever a worker
+        // claims (instant runs would leave both tenants idle at a claim, and the oldest
+        // job, alpha's, would rightly go first).
+        As::alpha(&queuing)
+            .submit(json!({"steps": 200 + k, "step_ms": 1}))
+            .await;
     }
     let beta_job = As::beta(&queuing).submit(json!({"steps": BETA_STEPS})).await;
     let store = queuing.stop().await;

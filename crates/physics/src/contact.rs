@@ -174,8 +174,8 @@ pub struct Restitution {
     /// with the speed); unused by the linear law, whose e holds at every speed.
     pub speed: f64,
     /// The reduced mass m₁m₂/(m₁+m₂) (kg) of the linear law's two-body impact; `None`:
-    /// from the basis, each pin's first-mode apparent mass 1/φ₁(z)² at the contact (a
-    /// wall has infinite mass).
+    /// from the basis, each pin's apparent mass 1/Σᵢ φᵢ(z)² at the contact (a wall has
+    /// infinite mass).
     pub mass: Option<f64>,
 }
 

@@ -4,7 +4,7 @@
 //! once ([`crate::contact::NormalLaw`]); these check that every loop applies it.
 //!
 //! The impacts are of a one-mode pin: a single-degree-of-freedom oscillator whose mass
-//! at its tip is its first-mode apparent mass 1/ψ₁(L)², the mass a restitution is
+//! at its tip is its apparent mass 1/ψ₁(L)², the mass a restitution is
 //! calibrated with ([`Model::reduced_mass`]). Its contact springs are ~300 times
 //! stiffer than its own, so each impact is that of a free body (to ~(ω₁/ω_c)²).
 
@@ -338,7 +338,7 @@ fn a_preloaded_clamp_holds_below_its_preload_and_opens_above_it_on_every_loop() 
 }
 
 /// A preload with nothing to balance it is refused at its gap, as is a restitution at
-/// a clamped foot (no first-mode mass there) and friction on a row.
+/// a clamped foot (no mode moves there) and friction on a row.
 #[test]
 fn preloads_that_do_not_balance_and_laws_a_model_cannot_carry_are_refused() {
     let basis = basis(20, 2);

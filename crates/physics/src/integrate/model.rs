@@ -223,13 +223,13 @@ impl Model<'_> {
     }
 
     /// The reduced mass m₁m₂/(m₁ + m₂) (kg) of `contact`'s two bodies as a restitution
-    /// sees them: each pin's first-mode apparent mass 1/φ₁(z)² at the contact height
-    /// (the mass-normalised first mode), a wall's infinite. Infinite at a pin's clamped
-    /// foot, where the first mode does not move.
+    /// sees them: each pin's apparent mass at the contact height on its modal basis,
+    /// 1/Σᵢ φᵢ(z)² with mass-normalised modes (an impulse J there changes the pin's
+    /// velocity at z by J Σᵢ φᵢ(z)²), a wall's infinite. Infinite at a pin's clamped
+    /// foot, where no mode moves.
     pub fn reduced_mass(&self, contact: &Contact) -> f64 {
         let shape = self.basis.deflection_at(contact.height);
-        let first = shape.first().copied().unwrap_or(0.0);
-        let pin_mass = 1.0 / (first * first);
+        let pin_mass = 1.0 / shape.iter().map(|phi| phi * phi).sum::<f64>();
         match (contact.left, contact.right) {
             (Body::Pin(_), Body::Pin(_)) => 0.5 * pin_mass,
             _ => pin_mass,
@@ -249,7 +249,7 @@ impl Model<'_> {
             {
                 issues.push(InputIssue::new(
                     format!("contacts/{k}/law/restitution"),
-                    "the first mode does not move at this height (a clamped foot): give the \
+                    "no mode moves at this height (a clamped foot): give the \
                      impact's mass (`restitution_mass`) or a damping",
                 ));
             }
