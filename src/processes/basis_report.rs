@@ -4,6 +4,8 @@
 use serde::Serialize;
 use utoipa::ToSchema;
 
+use super::inputs::BeamInput;
+use crate::physics::discretisation::auto::Choice;
 use crate::physics::integrate::{Model, critical_time_step};
 use crate::physics::modal::ModalBasis;
 use crate::physics::stability::Scheme;
@@ -15,6 +17,13 @@ pub struct BasisReport {
     pub static_correction: &'static str,
     /// Eigenmodes kept (m).
     pub modes: usize,
+    /// Elements of the mesh the basis was computed on.
+    pub elements: usize,
+    /// How `modes` and `elements` were set: `given` or `auto`.
+    pub chosen_by: ChosenBy,
+    /// What `auto` saw when it chose (null when both counts were given): the impact
+    /// probes' estimates for the chosen mesh and basis and the bound they meet.
+    pub auto: Option<AutoReport>,
     /// Their frequencies (Hz), increasing.
     pub mode_frequencies_hz: Vec<f64>,
     /// Distinct contact heights (m) that got a pseudo-mode.
@@ -27,6 +36,29 @@ pub struct BasisReport {
     /// paired with heights.
     pub pseudo_mode_frequencies_hz: Vec<f64>,
     pub cost: BasisCost,
+}
+
+/// How the counts of a basis were set.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct ChosenBy {
+    /// `given` or `auto`.
+    pub modes: &'static str,
+    /// `given` or `auto`.
+    pub elements: &'static str,
+}
+
+/// What `auto` saw when it chose the mesh and the basis.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+pub struct AutoReport {
+    /// The bound every estimate had to meet: 10 × `solver.tolerance` (dimensionless).
+    pub target: f64,
+    /// Estimated relative error of the peak contact force due to the chosen basis, the
+    /// largest over the probed contacts (dimensionless; 3 × the probe's).
+    pub estimated_basis_error: f64,
+    /// The same due to the chosen mesh (dimensionless).
+    pub estimated_mesh_error: f64,
+    /// Distinct contacts (height, spring) probed for the choice (count).
+    pub probed_contacts: usize,
 }
 
 /// What the basis costs the run.
@@ -44,8 +76,14 @@ pub struct BasisCost {
 }
 
 impl BasisReport {
-    /// Report of `model`'s basis; `critical` is the run's critical step (s).
-    pub fn of(model: &Model<'_>, scheme: Scheme, critical: f64) -> Self {
+    /// Report of `model`'s basis; `critical` is the run's critical step (s); `chosen`
+    /// the beam's input and what `auto` chose for it (`None` when both were given).
+    pub fn of(
+        model: &Model<'_>,
+        scheme: Scheme,
+        critical: f64,
+        (beam, choice): (&BeamInput, Option<&Choice>),
+    ) -> Self {
         let basis: &ModalBasis = model.basis;
         let m = basis.eigenmodes();
         let frequencies = basis.frequencies_hz();
@@ -62,6 +100,17 @@ impl BasisReport {
         Self {
             static_correction: if correction.is_some() { "contacts" } else { "none" },
             modes: m,
+            elements: basis.spec().elements,
+            chosen_by: ChosenBy {
+                modes: beam.modes.rule(),
+                elements: beam.elements.rule(),
+            },
+            auto: choice.map(|c| AutoReport {
+                target: c.target,
+                estimated_basis_error: c.basis_error,
+                estimated_mesh_error: c.mesh_error,
+                probed_contacts: c.probed_contacts,
+            }),
             mode_frequencies_hz: frequencies[..m].to_vec(),
             correction_heights: correction.map(|c| c.heights.clone()).unwrap_or_default(),
             dropped_correction_heights: correction.map(|c| c.dropped_heights.clone()).unwrap_or_default(),

@@ -17,6 +17,7 @@ use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::{Body, Contact};
+use crate::physics::discretisation::auto::Choice as BasisChoice;
 use crate::physics::integrate::{self, Model, Settings, StepSize};
 use crate::physics::modal::ModalBasis;
 
@@ -32,6 +33,8 @@ pub struct Plan {
     pins: usize,
     contacts: Vec<Contact>,
     basis: ModalBasis,
+    /// What `auto` chose for the mesh and the basis; `None` when both were given.
+    basis_choice: Option<BasisChoice>,
     settings: Settings,
     step: StepSize,
 }
@@ -448,13 +451,17 @@ impl Simulation for BundleDynamics {
 
         // One static correction per distinct contact height, shared by every pin.
         let contact_heights: Vec<f64> = contacts.iter().map(|c| c.height).collect();
-        let basis = inputs.pin.basis(&contact_heights, "/inputs/pin")?;
+        let (basis, basis_choice) =
+            inputs
+                .pin
+                .basis(&contacts, &contact_heights, settings.tolerance, 0, "/inputs/pin")?;
         let step = inputs::resolve_step(&row_model(&inputs, pins, &contacts, &basis), &settings)?;
         Ok(Plan {
             inputs,
             pins,
             contacts,
             basis,
+            basis_choice,
             settings,
             step,
         })
@@ -465,6 +472,7 @@ impl Simulation for BundleDynamics {
     /// column per pin and output height), and their peaks.
     fn estimate(plan: &Plan) -> WorkEstimate {
         let (stepping, samples) = inputs::stepping(&plan.settings, &plan.step);
+        let stepping = inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "pin");
         let columns = 2 * ((1 + plan.contacts.len()) + (1 + plan.pins * plan.settings.output_heights.len()));
         let generated = plan.inputs.bundle.is_some();
         let (pins, contacts) = if generated {
@@ -589,7 +597,12 @@ impl Simulation for BundleDynamics {
             output_interval: simulation.output_interval,
             quality,
             frequencies_hz: plan.basis.frequencies_hz(),
-            basis: BasisReport::of(&model, plan.settings.scheme, simulation.step.critical_time_step),
+            basis: BasisReport::of(
+                &model,
+                plan.settings.scheme,
+                simulation.step.critical_time_step,
+                (&plan.inputs.pin, plan.basis_choice.as_ref()),
+            ),
             expansion: plan.inputs.bundle.is_some().then(|| Expansion {
                 pins: plan.pins,
                 contacts: plan

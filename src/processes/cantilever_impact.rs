@@ -18,6 +18,7 @@ use super::warnings::{Subject, WarningsInput};
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
+use crate::physics::discretisation::auto::Choice as BasisChoice;
 use crate::physics::integrate::{self, Model, Settings, StepSize};
 use crate::physics::modal::ModalBasis;
 use crate::physics::reference::{CantileverReference, ContactEventKind, MAX_MODES, ReferenceError};
@@ -162,6 +163,8 @@ pub struct OutputInput {
 pub struct Plan {
     inputs: CantileverInputs,
     basis: ModalBasis,
+    /// What `auto` chose for the mesh and the basis; `None` when both were given.
+    basis_choice: Option<BasisChoice>,
     contact_stiffness: f64,
     settings: Settings,
     reference: CantileverReference,
@@ -510,7 +513,11 @@ impl Simulation for CantileverImpact {
         }
 
         // The contact is at the tip: the static correction, if any, is the tip-load shape.
-        let basis = inputs.beam.basis(&[spec.length], "/inputs/beam")?;
+        let tip = tip_model(&inputs, &stand_in.basis, contact_stiffness).contacts;
+        let (basis, basis_choice) =
+            inputs
+                .beam
+                .basis(&tip, &[spec.length], solver.tolerance, 0, "/inputs/beam")?;
         let reference = CantileverReference {
             length: spec.length,
             young_modulus: spec.young_modulus,
@@ -520,7 +527,7 @@ impl Simulation for CantileverImpact {
             added_mass_per_length: spec.added_mass_per_length,
             contact_stiffness,
             gap: inputs.contact.gap,
-            damping_ratios: inputs.beam.damping_ratios(),
+            damping_ratios: inputs.beam.damping_ratios_for(basis.eigenmodes()),
             tip_displacement: inputs.release.tip_displacement,
             duration: solver.duration,
             modes: inputs.reference.modes,
@@ -534,6 +541,7 @@ impl Simulation for CantileverImpact {
         Ok(Plan {
             inputs,
             basis,
+            basis_choice,
             contact_stiffness,
             settings,
             reference,
@@ -545,6 +553,7 @@ impl Simulation for CantileverImpact {
     /// columns (time, numerical, reference).
     fn estimate(plan: &Plan) -> WorkEstimate {
         let (stepping, samples) = inputs::stepping(&plan.settings, &plan.step);
+        let stepping = inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "beam");
         let mut history_drivers = vec![
             "/inputs/solver/duration".to_owned(),
             "/inputs/output/interval".to_owned(),
@@ -657,7 +666,12 @@ impl Simulation for CantileverImpact {
                 frequencies_hz: plan.basis.frequencies_hz(),
                 energy: simulation.energy.into(),
             },
-            basis: BasisReport::of(&model, plan.settings.scheme, simulation.step.critical_time_step),
+            basis: BasisReport::of(
+                &model,
+                plan.settings.scheme,
+                simulation.step.critical_time_step,
+                (&plan.inputs.beam, plan.basis_choice.as_ref()),
+            ),
             reference: ReferenceResults {
                 first_impact_time: solution.first_impact_time(),
                 impacts: solution.impact_count(),

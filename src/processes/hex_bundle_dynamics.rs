@@ -21,6 +21,7 @@ use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
 use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::{Body as RowBody, Contact};
+use crate::physics::discretisation::auto::{self, Choice as BasisChoice};
 use crate::physics::hex::{Aim, Body, HexBundle, HexContact, pair_count};
 use crate::physics::integrate::{self, Model, Plane, Settings, StepSize, WallMotion};
 use crate::physics::loads::BaseAcceleration;
@@ -42,6 +43,8 @@ pub struct Plan {
     walls: Option<WallMotion>,
     loads: PlaneLoads,
     basis: ModalBasis,
+    /// What `auto` chose for the mesh and the basis; `None` when both were given.
+    basis_choice: Option<BasisChoice>,
     settings: Settings,
     step: StepSize,
 }
@@ -304,7 +307,13 @@ impl Simulation for HexBundleDynamics {
     }
 
     fn prepare(inputs: HexInputs) -> Result<Plan, InvalidInputs> {
-        let (length, elements) = (inputs.pin.length, inputs.pin.elements);
+        let length = inputs.pin.length;
+        // `auto` starts from the coarsest mesh with an element between levels (H/6).
+        let coarsest = (6.0 * length / inputs.bundle.wire_lead * (1.0 - 1e-9)).ceil();
+        let elements = inputs.pin.elements.given().unwrap_or_else(|| {
+            let fits = coarsest.is_finite() && coarsest >= 1.0 && coarsest <= auto::MAX_ELEMENTS as f64;
+            auto::START_ELEMENTS.max(if fits { coarsest as usize } else { 0 })
+        });
         let pin_issues = inputs.pin.validate();
         let pin_ok = pin_issues.is_empty();
         let mut errors: Vec<FieldError> = at("/inputs/pin", pin_issues);
@@ -381,7 +390,10 @@ impl Simulation for HexBundleDynamics {
         // One static correction per distinct contact height (one per level), shared by
         // every pin and both directions.
         let levels: Vec<f64> = bundle.levels().iter().map(|l| l.height).collect();
-        let basis = inputs.pin.basis(&levels, "/inputs/pin")?;
+        let (basis, basis_choice) =
+            inputs
+                .pin
+                .basis(&contacts, &levels, solver.tolerance, elements, "/inputs/pin")?;
         let settings = Settings {
             recorded_contacts: Some(recorded),
             impacts: counting,
@@ -422,6 +434,7 @@ impl Simulation for HexBundleDynamics {
             walls,
             loads,
             basis,
+            basis_choice,
             settings,
             step,
         })
@@ -432,6 +445,7 @@ impl Simulation for HexBundleDynamics {
     /// (time + two columns per pin and output height), and their peaks.
     fn estimate(plan: &Plan) -> WorkEstimate {
         let (stepping, samples) = inputs::stepping(&plan.settings, &plan.step);
+        let stepping = inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "pin");
         let lines = 2 * plan.bundle.pin_count();
         let recorded = plan.settings.recorded_contacts.as_ref().map_or(0, Vec::len);
         let columns = 2 * ((1 + recorded) + (1 + lines * plan.settings.output_heights.len()));
@@ -598,7 +612,12 @@ impl Simulation for HexBundleDynamics {
             output_interval: simulation.output_interval,
             quality,
             frequencies_hz: plan.basis.frequencies_hz(),
-            basis: BasisReport::of(&model, plan.settings.scheme, simulation.step.critical_time_step),
+            basis: BasisReport::of(
+                &model,
+                plan.settings.scheme,
+                simulation.step.critical_time_step,
+                (&plan.inputs.pin, plan.basis_choice.as_ref()),
+            ),
         };
         let histories = histories(&plan, simulation);
         Ok(Output { results, histories })

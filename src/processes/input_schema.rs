@@ -17,6 +17,7 @@ use utoipa::openapi::{RefOr, Schema};
 use utoipa::{PartialSchema, ToSchema};
 
 use super::inputs::{DampingInput, SolverDefaults, SolverInput, TimeStepInput};
+use crate::physics::beam::MAX_ELEMENTS;
 
 /// A self-contained JSON schema of `T`: component references inlined, the keywords
 /// written beside a reference kept over the component's.
@@ -189,6 +190,62 @@ impl PartialSchema for TimeStepInput {
 }
 
 impl ToSchema for TimeStepInput {}
+
+/// `"auto"`, with what it chooses.
+fn auto_count(what: &str) -> ObjectBuilder {
+    ObjectBuilder::new()
+        .schema_type(Type::String)
+        .enum_values(Some(["auto"]))
+        .description(Some(format!(
+            "`auto`: the {what} whose impact probes put the peak contact force within 10 × \
+             `solver.tolerance` (docs/accuracy.md)."
+        )))
+}
+
+/// The schema of `elements`: a count from 1 to 400, or `"auto"`.
+#[derive(Debug)]
+#[allow(dead_code)] // a schema only: read as a `CountInput`
+pub struct ElementsInput;
+
+impl PartialSchema for ElementsInput {
+    fn schema() -> RefOr<Schema> {
+        OneOfBuilder::new()
+            .item(
+                ObjectBuilder::new()
+                    .schema_type(Type::Integer)
+                    .minimum(Some(1.0))
+                    .maximum(Some(MAX_ELEMENTS as f64))
+                    .description(Some("Elements (count).")),
+            )
+            .item(auto_count("coarsest mesh, doubling from 40 up to 200,"))
+            .description(Some("A number of elements (count), or `\"auto\"`."))
+            .into()
+    }
+}
+
+impl ToSchema for ElementsInput {}
+
+/// The schema of `modes`: a count from 1, or `"auto"`.
+#[derive(Debug)]
+#[allow(dead_code)] // a schema only: read as a `CountInput`
+pub struct ModesInput;
+
+impl PartialSchema for ModesInput {
+    fn schema() -> RefOr<Schema> {
+        OneOfBuilder::new()
+            .item(
+                ObjectBuilder::new()
+                    .schema_type(Type::Integer)
+                    .minimum(Some(1.0))
+                    .description(Some("Modes (count), at most the free DOFs of the mesh.")),
+            )
+            .item(auto_count("fewest modes"))
+            .description(Some("A number of modes (count), or `\"auto\"`."))
+            .into()
+    }
+}
+
+impl ToSchema for ModesInput {}
 
 #[cfg(test)]
 mod tests {

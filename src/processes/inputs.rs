@@ -12,6 +12,9 @@ use utoipa::ToSchema;
 use super::{FieldError, InvalidInputs};
 use crate::physics::InputIssue;
 use crate::physics::beam::{BeamSpec, Section, Support};
+use crate::physics::contact::Contact;
+use crate::physics::discretisation::auto::{self, Count};
+use crate::physics::integrate::quality::PEAK_TOLERANCE_FACTOR;
 use crate::physics::integrate::{Check, DEFAULT_TOLERANCE, Settings, TimeStep};
 use crate::physics::stability::Scheme;
 
@@ -37,16 +40,20 @@ pub struct BeamInput {
     #[serde(default)]
     #[schema(default = 0.0, minimum = 0.0, maximum = 1e9)]
     pub added_mass_per_length: f64,
-    /// Number of Hermite beam elements along the length.
+    /// Number of Hermite beam elements along the length (count, 1 to 400), or `"auto"`:
+    /// the coarsest mesh, doubling from 40 up to 200, whose impact probes put the peak
+    /// contact force within 10 × `solver.tolerance` (docs/accuracy.md, "`auto` mesh and
+    /// basis").
     #[serde(default = "default_elements")]
-    #[schema(default = 40, minimum = 1, maximum = 400)]
-    pub elements: usize,
-    /// Number of modes kept in the modal basis: at most the free degrees of freedom of
-    /// the mesh (two per node, less those the supports hold: 2 × `elements` for a
-    /// clamped foot and a free top).
+    #[schema(value_type = super::input_schema::ElementsInput, default = 40)]
+    pub elements: CountInput,
+    /// Number of modes kept in the modal basis (count): at most the free degrees of
+    /// freedom of the mesh (two per node, less those the supports hold: 2 × `elements`
+    /// for a clamped foot and a free top); or `"auto"`: the fewest modes whose impact
+    /// probes put the peak contact force within 10 × `solver.tolerance`.
     #[serde(default = "default_modes")]
-    #[schema(default = 10, minimum = 1)]
-    pub modes: usize,
+    #[schema(value_type = super::input_schema::ModesInput, default = 10)]
+    pub modes: CountInput,
     /// Modal damping ratio ξ (dimensionless, in [0, 1)): one value for every mode, or
     /// one per mode (a shorter list repeats its last value; pseudo-modes take the last).
     #[serde(default = "default_damping")]
@@ -79,11 +86,46 @@ pub enum StaticCorrectionInput {
     Contacts,
 }
 
-fn default_elements() -> usize {
-    40
+/// A count (of elements, of modes) given as a number, or `"auto"` (its schemas:
+/// [`super::input_schema`]).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(untagged, expecting = "a count or \"auto\"")]
+pub enum CountInput {
+    Given(usize),
+    Keyword(AutoKeyword),
 }
-fn default_modes() -> usize {
-    10
+
+impl CountInput {
+    /// The count of the physics' choice.
+    pub fn count(self) -> Count {
+        match self {
+            CountInput::Given(n) => Count::Given(n),
+            CountInput::Keyword(AutoKeyword::Auto) => Count::Auto,
+        }
+    }
+
+    /// The number given, `None` for `auto`.
+    pub fn given(self) -> Option<usize> {
+        match self {
+            CountInput::Given(n) => Some(n),
+            CountInput::Keyword(_) => None,
+        }
+    }
+
+    /// `given` or `auto`, as the results say it.
+    pub fn rule(self) -> &'static str {
+        match self {
+            CountInput::Given(_) => "given",
+            CountInput::Keyword(_) => "auto",
+        }
+    }
+}
+
+fn default_elements() -> CountInput {
+    CountInput::Given(40)
+}
+fn default_modes() -> CountInput {
+    CountInput::Given(10)
 }
 fn default_damping() -> DampingInput {
     DampingInput::Uniform(0.01)
@@ -200,54 +242,45 @@ impl BeamInput {
                 SectionInput::Explicit { area, inertia } => Section::Explicit { area, inertia },
             },
             added_mass_per_length: self.added_mass_per_length,
-            elements: self.elements,
+            elements: self.elements.given().unwrap_or(auto::START_ELEMENTS),
             foot: self.supports.foot.into(),
             top: self.supports.top.into(),
         }
     }
 
-    /// Damping ratio of every mode of the basis.
-    pub fn damping_ratios(&self) -> Vec<f64> {
+    /// Damping ratio of each of the `basis_modes` entries of the basis actually used
+    /// (eigenmodes, then pseudo-modes): a uniform ratio everywhere; a list one per mode
+    /// in order, its last value repeated past its end.
+    pub fn damping_ratios_for(&self, basis_modes: usize) -> Vec<f64> {
         match &self.damping_ratio {
-            DampingInput::Uniform(xi) => vec![*xi; self.modes],
+            DampingInput::Uniform(xi) => vec![*xi; basis_modes],
             DampingInput::PerMode(list) => {
                 let last = list.last().copied().unwrap_or(0.0);
-                (0..self.modes)
+                (0..basis_modes)
                     .map(|i| list.get(i).copied().unwrap_or(last))
                     .collect()
             }
         }
     }
 
-    /// Damping ratio of each of the `basis_modes` entries of the basis actually used
-    /// (eigenmodes, then pseudo-modes): the rule of [`Self::damping_ratios`] continued
-    /// past the eigenmodes (a uniform ratio everywhere; a list's last value repeats).
-    pub fn damping_ratios_for(&self, basis_modes: usize) -> Vec<f64> {
-        let mut ratios = self.damping_ratios();
-        let last = match &self.damping_ratio {
-            DampingInput::Uniform(xi) => *xi,
-            DampingInput::PerMode(list) => list.last().copied().unwrap_or(0.0),
-        };
-        ratios.resize(basis_modes, last);
-        ratios
-    }
-
-    /// The modal basis of this beam with its static correction at `contact_heights`
-    /// (m) when asked for; a failure is a 422 under `pointer` (the beam's own pointer).
+    /// The modal basis of this beam for `contacts` (the model's, on pins of this beam),
+    /// with its static correction at `correction_heights` (m) when asked; `elements` and
+    /// `modes` chosen by [`auto::choose`] where they are `auto`, for the verdict's bound
+    /// 10 × `tolerance`, from `min_elements` at least (the coarsest mesh the model
+    /// admits). A failure is a 422 under `pointer` (the beam's own pointer). The choice
+    /// is `None` when both counts are given.
     pub fn basis(
         &self,
-        contact_heights: &[f64],
+        contacts: &[Contact],
+        correction_heights: &[f64],
+        tolerance: f64,
+        min_elements: usize,
         pointer: &str,
-    ) -> Result<crate::physics::modal::ModalBasis, InvalidInputs> {
-        use crate::physics::modal::{ModalBasis, ModalError};
+    ) -> Result<(crate::physics::modal::ModalBasis, Option<auto::Choice>), InvalidInputs> {
+        use crate::physics::modal::ModalError;
         let spec = self.spec();
-        let basis = match self.static_correction {
-            StaticCorrectionInput::None => ModalBasis::compute(&spec, self.modes),
-            StaticCorrectionInput::Contacts => {
-                ModalBasis::compute_with_static_correction(&spec, self.modes, contact_heights)
-            }
-        };
-        basis.map_err(|e| {
+        let correction = self.static_correction == StaticCorrectionInput::Contacts;
+        let modal_error = |e: ModalError| {
             let field = match e {
                 ModalError::StaticCorrection(_) => format!("{pointer}/supports"),
                 _ => format!("{pointer}/modes"),
@@ -261,14 +294,50 @@ impl BeamInput {
                 _ => e.to_string(),
             };
             InvalidInputs(vec![FieldError::new(field, detail)])
-        })
+        };
+        let automatic = self.elements.given().is_none() || self.modes.given().is_none();
+        let choice = if automatic {
+            let request = auto::Request {
+                elements: self.elements.count(),
+                min_elements,
+                modes: self.modes.count(),
+                static_correction: correction,
+                target: PEAK_TOLERANCE_FACTOR * tolerance,
+            };
+            let probes = auto::design_contacts(contacts, spec.length);
+            Some(
+                auto::choose(&spec, &request, &probes, correction_heights).map_err(|e| match e {
+                    auto::AutoError::Modal(e) => modal_error(e),
+                    mesh @ auto::AutoError::Mesh { .. } => InvalidInputs(vec![FieldError::new(
+                        format!("{pointer}/elements"),
+                        format!(
+                            "auto: {mesh}; raise solver.tolerance (the bound is 10 × it) or give \
+                             elements and modes (the verdict then judges them)"
+                        ),
+                    )]),
+                })?,
+            )
+        } else {
+            None
+        };
+        let (elements, modes) = match choice {
+            Some(c) => (c.elements, c.modes),
+            None => (spec.elements, self.modes.given().unwrap_or(0)),
+        };
+        let spec = crate::physics::beam::BeamSpec { elements, ..spec };
+        let basis =
+            auto::basis_of(&spec, modes, correction.then_some(correction_heights)).map_err(modal_error)?;
+        Ok((basis, choice))
     }
 
     /// Every problem with the beam and its truncation, as physics issues relative to it.
     pub fn validate(&self) -> Vec<InputIssue> {
         let spec = self.spec();
         let mut issues = spec.validate();
-        if spec.elements >= 1 && (self.modes == 0 || self.modes > spec.free_dof_count()) {
+        if let CountInput::Given(modes) = self.modes
+            && spec.elements >= 1
+            && (modes == 0 || modes > spec.free_dof_count())
+        {
             issues.push(InputIssue::new(
                 "modes",
                 format!(
@@ -607,6 +676,23 @@ pub fn stepping(
         ..super::WorkEstimate::default()
     };
     (estimate, samples)
+}
+
+/// `estimate` with, when `auto` chose the mesh or the basis, what it chose and why
+/// added to its refusals (`beam`: the member name, `pin` or `beam`).
+pub fn with_auto_note(
+    mut estimate: super::WorkEstimate,
+    choice: Option<&auto::Choice>,
+    beam: &str,
+) -> super::WorkEstimate {
+    if let Some(c) = choice {
+        estimate.step_note.push_str(&format!(
+            " ({beam}.modes/elements \"auto\" chose {} modes on {} elements to keep the peak \
+             contact force within {:e} (10 × solver.tolerance): a larger tolerance needs fewer)",
+            c.modes, c.elements, c.target
+        ));
+    }
+    estimate
 }
 
 /// What to add to a "too many steps" refusal: under `auto`, what set the step and what

@@ -144,6 +144,7 @@ pub fn join(prefix: &str, rest: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::physics::integrate::DEFAULT_TOLERANCE;
     use crate::processes::inputs::{SupportInput, SupportsInput};
 
     fn pin(foot: SupportInput, top: SupportInput) -> BeamInput {
@@ -172,7 +173,9 @@ mod tests {
         ] {
             let pin = pin(foot, top);
             assert_eq!(pin.supports, SupportsInput { foot, top });
-            let real = pin.basis(&[], "/inputs/pin").expect("a valid pin has a basis");
+            let (real, _) = pin
+                .basis(&[], &[], DEFAULT_TOLERANCE, 0, "/inputs/pin")
+                .expect("a valid pin has a basis");
             let stand_in = StandIn::of(&pin);
             assert!(stand_in.length_known);
             assert_eq!(stand_in.basis.length(), real.length(), "{foot:?}-{top:?}");

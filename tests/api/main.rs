@@ -8,6 +8,7 @@ mod helpers;
 mod postgres;
 mod skip;
 
+mod auto_basis;
 mod capabilities;
 mod contact_laws;
 mod cors;

@@ -31,7 +31,7 @@
 //! measurements that compare them with converged runs.
 
 use crate::beam::BeamSpec;
-use crate::contact::Body;
+use crate::contact::{Body, Contact};
 use crate::integrate::Model;
 use crate::modal::{ModalBasis, ModalError};
 
@@ -245,6 +245,16 @@ impl MeshProbes {
             .collect()
     }
 
+    /// The contacts probed (those where the first mode moves).
+    pub fn len(&self) -> usize {
+        self.probes.len()
+    }
+
+    /// Whether no contact could be probed.
+    pub fn is_empty(&self) -> bool {
+        self.probes.is_empty()
+    }
+
     /// The largest mesh error over the contacts (dimensionless).
     pub fn mesh_error(&self) -> f64 {
         self.probes
@@ -291,21 +301,46 @@ pub struct BasisErrors {
     pub probed_contacts: usize,
 }
 
-/// The probe of one contact of `model`: its height with Kc at a wall and 2 Kc between
-/// two pins; `None` for a contact without stiffness (it never pushes).
-fn probe_contact(model: &Model<'_>, contact: usize) -> Option<ProbeContact> {
-    let c = &model.contacts[contact];
-    let pushes = c.stiffness > 0.0;
-    let spring = c.stability_stiffness();
-    if !pushes {
-        return None;
+impl ProbeContact {
+    /// The probe of `contact` on pins of `length` (m): its height (to
+    /// [`HEIGHT_RESOLUTION`] of the length) with Kc at a wall and 2 Kc between two pins
+    /// (Kc the law's stiffness at its force scale); `None` for a contact without
+    /// stiffness (it never pushes).
+    pub fn of(contact: &Contact, length: f64) -> Option<Self> {
+        let pushes = contact.stiffness > 0.0;
+        let spring = contact.stability_stiffness();
+        if !pushes {
+            return None;
+        }
+        let between_pins = matches!((contact.left, contact.right), (Body::Pin(_), Body::Pin(_)));
+        let resolution = HEIGHT_RESOLUTION * length;
+        Some(ProbeContact {
+            height: (contact.height / resolution).round() * resolution,
+            stiffness: if between_pins { 2.0 * spring } else { spring },
+        })
     }
-    let between_pins = matches!((c.left, c.right), (Body::Pin(_), Body::Pin(_)));
-    let resolution = HEIGHT_RESOLUTION * model.basis.length();
-    Some(ProbeContact {
-        height: (c.height / resolution).round() * resolution,
-        stiffness: if between_pins { 2.0 * spring } else { spring },
-    })
+}
+
+impl BasisErrors {
+    /// No probe: every estimate 0 at no height (a run in which no contact pushed, or
+    /// whose probes could not be computed; the verdict says which).
+    pub fn unmeasured() -> Self {
+        let none = ProbeError {
+            estimated_peak_force_error: 0.0,
+            height: None,
+            probed_stiffness: None,
+        };
+        Self {
+            modal_truncation: none,
+            mesh: none,
+            probed_contacts: 0,
+        }
+    }
+}
+
+/// The probe of one contact of `model` ([`ProbeContact::of`]).
+fn probe_contact(model: &Model<'_>, contact: usize) -> Option<ProbeContact> {
+    ProbeContact::of(&model.contacts[contact], model.basis.length())
 }
 
 /// The distinct probes of the contacts of `model` that pushed in the run (`peaks`: each
@@ -368,6 +403,8 @@ fn relative(value: f64, reference: f64) -> f64 {
         (value - reference).abs() / reference.abs()
     }
 }
+
+pub mod auto;
 
 #[cfg(test)]
 mod tests;

@@ -113,13 +113,21 @@ impl<'a> Plan<'a> {
             .iter()
             .map(|s| s.max_force)
             .collect();
-        let basis = crate::discretisation::assess(model, &peaks).map_err(|e| {
-            SimulationError::InvalidModel(vec![InputIssue::new(
-                "modes",
-                format!("the impact probes of the basis and the mesh failed: {e}"),
-            )])
-        })?;
-        let findings = force_scales(model, settings, step, &peaks);
+        let mut findings = force_scales(model, settings, step, &peaks);
+        // A probe that cannot be computed (the dense eigensolver on the complete basis of
+        // a very fine mesh) leaves the basis and the mesh unmeasured: the run stands, its
+        // verdict cannot be `good`.
+        let basis = crate::discretisation::assess(model, &peaks).unwrap_or_else(|e| {
+            findings.push(quality::Finding {
+                poor: false,
+                reason: format!(
+                    "the errors due to the modal basis and the mesh were not measured: their \
+                     impact probes (the complete basis of this mesh and of one twice as fine) \
+                     could not be computed ({e}); fewer elements can be probed"
+                ),
+            });
+            crate::discretisation::BasisErrors::unmeasured()
+        });
         let quality = quality::assess(
             &simulation,
             step,

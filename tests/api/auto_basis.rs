@@ -1,0 +1,121 @@
+//! `modes: "auto"` and `elements: "auto"` over HTTP: the results say what was chosen and
+//! why, the run's own probes then find the basis and the mesh within the bound the
+//! choice met (10 × the tolerance), a given count is reported as given, and a bound no
+//! mesh can meet is refused up front at `elements` with the numbers.
+
+use std::time::Duration;
+
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use crate::helpers::{Backend, TestApp, spawn_app_with_shipped_processes_on};
+
+/// The public cantilever case, 0.05 s, without the step-halving check (cheap).
+fn cantilever(beam: Value, tolerance: f64) -> Value {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/cantilever-impact.json"
+    ))
+    .unwrap();
+    let mut body: Value = serde_json::from_str(&text).unwrap();
+    for (key, value) in beam.as_object().unwrap() {
+        body["inputs"]["beam"][key] = value.clone();
+    }
+    let solver = &mut body["inputs"]["solver"];
+    solver["duration"] = json!(0.05);
+    solver["check"] = json!("none");
+    solver["time_step"] = json!("auto");
+    solver["tolerance"] = json!(tolerance);
+    body
+}
+
+async fn results_of(app: &TestApp, body: &Value) -> Value {
+    let response = app.post_execution("cantilever-impact", body).await;
+    let code = response.status();
+    let status: Value = response.json().await.unwrap();
+    assert_eq!(code, StatusCode::CREATED, "{status}");
+    let id = status["jobID"].as_str().unwrap().to_owned();
+    let status = app
+        .wait_for(&id, &["successful", "failed"], Duration::from_secs(120))
+        .await;
+    assert_eq!(status["status"], "successful", "{status}");
+    app.get_json(&format!("/jobs/{id}/results")).await
+}
+
+#[tokio::test]
+async fn auto_chooses_a_basis_and_mesh_that_the_runs_own_probes_find_within_the_bound() {
+    let app = spawn_app_with_shipped_processes_on(Backend::Sqlite).await;
+    let tolerance = 1e-3;
+    let auto = results_of(
+        &app,
+        &cantilever(json!({"modes": "auto", "elements": "auto"}), tolerance),
+    )
+    .await;
+    let basis = &auto["basis"];
+    assert_eq!(
+        basis["chosen_by"],
+        json!({"modes": "auto", "elements": "auto"}),
+        "{basis}"
+    );
+    let bound = 10.0 * tolerance;
+    assert_eq!(basis["auto"]["target"].as_f64().unwrap(), bound);
+    for key in ["estimated_basis_error", "estimated_mesh_error"] {
+        let estimate = basis["auto"][key].as_f64().unwrap();
+        assert!((0.0..=bound).contains(&estimate), "{key}: {basis}");
+    }
+    // The run probes the contacts that pushed, a subset of those the choice probed.
+    let quality = &auto["quality"];
+    for key in ["modal_truncation", "mesh"] {
+        let estimate = quality[key]["estimated_peak_force_error"].as_f64().unwrap();
+        assert!(estimate <= bound, "{key}: {quality}");
+    }
+    let modes = basis["modes"].as_u64().unwrap();
+    let elements = basis["elements"].as_u64().unwrap();
+    assert!(modes >= 1 && elements >= 40, "{basis}");
+
+    // A looser bound never needs more.
+    let loose = results_of(
+        &app,
+        &cantilever(json!({"modes": "auto", "elements": "auto"}), 1e-2),
+    )
+    .await;
+    assert!(
+        loose["basis"]["modes"].as_u64().unwrap() <= modes,
+        "{}",
+        loose["basis"]
+    );
+
+    // Given counts are reported as given, with no `auto` entry.
+    let given = results_of(&app, &cantilever(json!({"modes": 5, "elements": 20}), tolerance)).await;
+    assert_eq!(
+        given["basis"]["chosen_by"],
+        json!({"modes": "given", "elements": "given"})
+    );
+    assert_eq!(given["basis"]["auto"], Value::Null);
+    assert_eq!(given["basis"]["elements"], 20);
+}
+
+#[tokio::test]
+async fn a_bound_no_mesh_can_meet_is_refused_at_elements_with_the_numbers() {
+    let app = spawn_app_with_shipped_processes_on(Backend::Sqlite).await;
+    let body = cantilever(json!({"elements": "auto"}), 1e-9);
+    let response = app.post_execution("cantilever-impact", &body).await;
+    assert_eq!(response.status(), StatusCode::UNPROCESSABLE_ENTITY);
+    let problem: Value = response.json().await.unwrap();
+    let text = problem.to_string();
+    assert!(text.contains("/inputs/beam/elements"), "{text}");
+    assert!(
+        text.contains("400 elements") && text.contains("solver.tolerance"),
+        "{text}"
+    );
+
+    // A word other than `auto` is named.
+    let body = cantilever(json!({"modes": "many"}), 1e-3);
+    let response = app.post_execution("cantilever-impact", &body).await;
+    assert_eq!(response.status(), StatusCode::UNPROCESSABLE_ENTITY);
+    let text = response.text().await.unwrap();
+    assert!(
+        text.contains("/inputs/beam/modes") && text.contains("auto"),
+        "{text}"
+    );
+}
