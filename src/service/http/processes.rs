@@ -12,11 +12,33 @@ use super::error::ApiError;
 use super::extract::ExecutionInputs;
 use super::idempotency::{IdempotencyHeader, key_reused, mark_replayed};
 use super::models::{ExecuteRequest, Link, ProcessDescription, ProcessList, ProcessSummary, StatusInfo};
+use crate::json_body::ExecutionRequest;
 use crate::problem::Problem;
 use crate::processes::Process;
 use crate::service::auth::Tenant;
+use crate::service::callbacks::Subscriber;
 use crate::service::queue::Admission;
 use crate::service::queue::idempotency::{KeyedRequest, Kind, RequestHash};
+
+/// The idempotency hash of an execution request: its inputs alone without a subscriber
+/// (as before subscribers were stored), else its inputs and subscriber, so that a key
+/// reused with another subscriber is a conflict.
+fn request_hash(
+    process_id: &str,
+    inputs: &serde_json::Value,
+    subscriber: Option<&Subscriber>,
+) -> RequestHash {
+    match subscriber {
+        None => RequestHash::of_json(Kind::Job, process_id, inputs),
+        Some(subscriber) => {
+            let request = serde_json::Map::from_iter([
+                ("inputs".to_owned(), inputs.clone()),
+                ("subscriber".to_owned(), subscriber.to_json()),
+            ]);
+            RequestHash::of_json(Kind::Job, process_id, &serde_json::Value::Object(request))
+        }
+    }
+}
 
 fn summary(process: &dyn Process) -> ProcessSummary {
     let href = format!("/processes/{}", process.id());
@@ -92,7 +114,7 @@ pub async fn describe(
         (status = 404, description = "No such process", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 413, description = "Body over the size limit", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 415, description = "Body not declared as JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
-        (status = 422, description = "Invalid inputs (`invalid-inputs`), or a run above the cost ceilings (`too-costly`), with `errors` pointers; or an `Idempotency-Key` first sent with another request (`idempotency-key-reused`)",
+        (status = 422, description = "Invalid inputs (`invalid-inputs`; a `subscriber` URI that is not absolute http(s) or whose host the operator does not allow is refused at its pointer, e.g. `/subscriber/successUri`), or a run above the cost ceilings (`too-costly`), with `errors` pointers; or an `Idempotency-Key` first sent with another request (`idempotency-key-reused`)",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 429, description = "Too many queued jobs (`too-many-queued-jobs`)", body = super::openapi::ProblemSchema,
             content_type = "application/problem+json", headers(("Retry-After" = String, description = "s"))),
@@ -112,11 +134,16 @@ pub async fn execute(
         .registry
         .get(&process_id)
         .ok_or_else(|| Problem::no_such_process(&process_id))?;
-    let ExecutionInputs(inputs) = body?;
+    let ExecutionInputs(ExecutionRequest { inputs, subscriber }) = body?;
+    let subscriber = Subscriber::parse(subscriber.as_ref(), &state.callbacks, tenant.as_str());
     let keyed = key.map(|key| KeyedRequest {
         key,
         kind: Kind::Job,
-        hash: RequestHash::of_json(Kind::Job, &process_id, &inputs),
+        hash: request_hash(
+            &process_id,
+            &inputs,
+            subscriber.as_ref().ok().and_then(Option::as_ref),
+        ),
     });
     // The stored signals the inputs refer to, the tenant's only: resolved now, so that an
     // unknown or foreign id is refused at its pointer before anything is queued.
@@ -129,7 +156,15 @@ pub async fn execute(
             .await
             .map_err(|e| ApiError::Internal(format!("validation panicked: {e}")))?
     };
-    let validated = validated.map_err(|invalid| Problem::invalid_inputs(&invalid))?;
+    // Every refusal at once: the inputs' and the subscriber's.
+    let (validated, subscriber) = match (validated, subscriber) {
+        (Ok(validated), Ok(subscriber)) => (validated, subscriber),
+        (Err(mut invalid), Err(refused)) => {
+            invalid.0.extend(refused.0);
+            return Err(Problem::invalid_inputs(&invalid).into());
+        }
+        (Err(invalid), Ok(_)) | (Ok(_), Err(invalid)) => return Err(Problem::invalid_inputs(&invalid).into()),
+    };
     state
         .limits
         .check(&validated.estimate)
@@ -143,13 +178,14 @@ pub async fn execute(
             &validated.warnings,
             state.max_queued_jobs,
             keyed.as_ref(),
+            subscriber.as_ref(),
         )
         .await?;
     let mut headers = HeaderMap::new();
     let job = match admission {
         Admission::Admitted(job) => {
             state.wake.notify_one();
-            tracing::info!(job = %job.id, process = %process_id, %tenant, "job queued");
+            tracing::info!(job = %job.id, process = %process_id, %tenant, callbacks = subscriber.is_some(), "job queued");
             job
         }
         Admission::Replayed(job) => {
