@@ -8,6 +8,7 @@ mod helpers;
 mod postgres;
 mod skip;
 
+mod callbacks;
 mod capabilities;
 mod contact_laws;
 mod cors;

@@ -40,6 +40,24 @@ fn request_hash(
     }
 }
 
+/// `Preference-Applied` (RFC 7240): which `Prefer` preference the answer honours.
+const PREFERENCE_APPLIED: header::HeaderName = header::HeaderName::from_static("preference-applied");
+
+/// Whether the request's `Prefer` headers ask for `respond-async` (OGC API – Processes:
+/// the server says it applied it). Every execution is asynchronous, so `respond-sync`
+/// is not applied: the answer is a job all the same, without the header.
+fn prefers_async(headers: &HeaderMap) -> bool {
+    headers
+        .get_all("prefer")
+        .iter()
+        .filter_map(|value| value.to_str().ok())
+        .flat_map(|value| value.split(','))
+        .any(|preference| {
+            let token = preference.split(';').next().unwrap_or_default().trim();
+            token.eq_ignore_ascii_case("respond-async")
+        })
+}
+
 fn summary(process: &dyn Process) -> ProcessSummary {
     let href = format!("/processes/{}", process.id());
     ProcessSummary {
@@ -105,11 +123,13 @@ pub async fn describe(
 /// full: 507 `storage-full` with `Retry-After`, nothing queued.
 #[utoipa::path(post, path = "/processes/{processId}/execution", operation_id = "execute", tag = "Processes",
     params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`", example = "cantilever-impact"),
+        ("Prefer" = Option<String>, Header, description = "`respond-async` is applied (`Preference-Applied: respond-async`); `respond-sync` is not: every execution is asynchronous, answered with a job"),
         ("Idempotency-Key" = Option<String>, Header, description = "Optional, 1 to 255 visible ASCII characters: a retry with the same key and the same request gets the same resource back (same id, `201`, same `Location`, plus `Idempotent-Replayed: true`) instead of creating another; the same key with another request is a 422 `idempotency-key-reused`. Keys are per tenant and kept as long as the resource they created.")),
     request_body(content = ExecuteRequest, description = "`{\"inputs\": {...}}`, see the process description"),
     responses(
-        (status = 201, description = "Job queued", body = StatusInfo,
-            headers(("Location" = String, description = "`/jobs/{jobId}`"))),
+        (status = 201, description = "Job queued (with `Prefer: respond-sync` too: every execution is a job)", body = StatusInfo,
+            headers(("Location" = String, description = "`/jobs/{jobId}`"),
+                ("Preference-Applied" = String, description = "`respond-async` when the request's `Prefer` asked for it (RFC 7240)"))),
         (status = 400, description = "Malformed JSON, or an invalid `Idempotency-Key` (`invalid-header`)", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 404, description = "No such process", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 413, description = "Body over the size limit", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
@@ -127,6 +147,7 @@ pub async fn execute(
     Extension(tenant): Extension<Tenant>,
     Path(process_id): Path<String>,
     IdempotencyHeader(key): IdempotencyHeader,
+    request_headers: HeaderMap,
     body: Result<ExecutionInputs, ApiError>,
 ) -> Result<Response, ApiError> {
     // An unknown process is reported before anything about the body.
@@ -206,5 +227,32 @@ pub async fn execute(
         header::LOCATION,
         HeaderValue::from_str(&format!("/jobs/{}", job.id)).expect("uuid is a valid header value"),
     );
+    if prefers_async(&request_headers) {
+        headers.insert(PREFERENCE_APPLIED, HeaderValue::from_static("respond-async"));
+    }
     Ok((StatusCode::CREATED, headers, Json(StatusInfo::from_record(&job))).into_response())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn prefer(values: &[&str]) -> HeaderMap {
+        let mut headers = HeaderMap::new();
+        for value in values {
+            headers.append("prefer", HeaderValue::from_str(value).unwrap());
+        }
+        headers
+    }
+
+    #[test]
+    fn respond_async_is_found_among_other_preferences() {
+        assert!(prefers_async(&prefer(&["respond-async"])));
+        assert!(prefers_async(&prefer(&[
+            "return=minimal, Respond-Async; wait=10"
+        ])));
+        assert!(prefers_async(&prefer(&["wait=5", "respond-async"])));
+        assert!(!prefers_async(&prefer(&["respond-sync"])));
+        assert!(!prefers_async(&prefer(&[])));
+    }
 }
