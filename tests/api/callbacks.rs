@@ -496,3 +496,31 @@ async fn a_tenant_without_a_secret_cannot_subscribe() {
     );
     app.stop().await;
 }
+
+/// A retry with the same `Idempotency-Key` gets the same job only with the same
+/// subscriber: another subscriber is another request.
+#[tokio::test]
+async fn an_idempotency_key_covers_the_subscriber() {
+    let app = spawn_app_on(Backend::Sqlite, |config| {
+        allow_loopback(config);
+        config.workers = 0;
+    })
+    .await;
+    let post = |subscriber: Value| {
+        app.client
+            .post(app.url(&format!("/processes/{}/execution", counting::ID)))
+            .header("content-type", "application/json")
+            .header("Idempotency-Key", "campaign-7")
+            .body(json!({"inputs": {"steps": 2}, "subscriber": subscriber}).to_string())
+            .send()
+    };
+    let first = post(json!({"successUri": "http://127.0.0.1:9/a"})).await.unwrap();
+    assert_eq!(first.status(), StatusCode::CREATED);
+    let job: Value = first.json().await.unwrap();
+    let again = post(json!({"successUri": "http://127.0.0.1:9/a"})).await.unwrap();
+    assert_eq!(again.status(), StatusCode::CREATED);
+    assert_eq!(again.json::<Value>().await.unwrap()["jobID"], job["jobID"]);
+    let other = post(json!({"successUri": "http://127.0.0.1:9/b"})).await.unwrap();
+    assert_problem(other, StatusCode::UNPROCESSABLE_ENTITY, "idempotency-key-reused").await;
+    app.stop().await;
+}
