@@ -35,6 +35,21 @@ pub fn uri_columns(subscriber: &Subscriber) -> [Option<String>; 3] {
     .map(|uri| uri.as_ref().map(|u| u.to_string()))
 }
 
+/// Whether any outcome is due (parameter: now): a read, so that an idle deliverer never
+/// takes SQLite's write lock (nor writes to a full disk) to claim nothing.
+const ANY_OUTCOME_DUE: &str = "SELECT EXISTS ( \
+    SELECT 1 FROM job_callbacks c JOIN jobs j ON j.id = c.job_id \
+    WHERE c.final_state = 'pending' AND c.next_attempt_at <= $1 \
+        AND j.status IN ('successful', 'failed', 'dismissed'))";
+
+/// Whether any progress is due (parameter: the latest time a last progress may have
+/// been sent at).
+const ANY_PROGRESS_DUE: &str = "SELECT EXISTS ( \
+    SELECT 1 FROM job_callbacks c JOIN jobs j ON j.id = c.job_id \
+    WHERE c.final_state = 'pending' AND c.in_progress_uri IS NOT NULL AND j.status = 'running' \
+        AND (c.progress_sent_at IS NULL OR c.progress_sent_at <= $1) \
+        AND (c.progress_sent IS NULL OR c.progress_sent <> j.progress))";
+
 const CLAIM_OUTCOMES_SQLITE: &str = "\
     UPDATE job_callbacks SET next_attempt_at = $1, claimed_by = $2 \
     WHERE job_id IN ( \
@@ -133,6 +148,10 @@ impl Outbox {
         let sql = self.db.choose(CLAIM_OUTCOMES_SQLITE, CLAIM_OUTCOMES_POSTGRES);
         let limit = i64::try_from(limit).unwrap_or(i64::MAX);
         with_pool!(&self.db, pool => {
+            let due: bool = sqlx::query_scalar(ANY_OUTCOME_DUE).bind(now).fetch_one(pool).await?;
+            if !due {
+                return Ok(Vec::new());
+            }
             let mut tx = pool.begin().await?;
             let rows = sqlx::query(sql)
                 .bind(until)
@@ -166,11 +185,16 @@ impl Outbox {
         let now = self.now();
         let sql = self.db.choose(CLAIM_PROGRESS_SQLITE, CLAIM_PROGRESS_POSTGRES);
         let limit = i64::try_from(limit).unwrap_or(i64::MAX);
+        let sent_before = now - duration_ms(interval);
         with_pool!(&self.db, pool => {
+            let due: bool = sqlx::query_scalar(ANY_PROGRESS_DUE).bind(sent_before).fetch_one(pool).await?;
+            if !due {
+                return Ok(Vec::new());
+            }
             let mut tx = pool.begin().await?;
             let rows = sqlx::query(sql)
                 .bind(now)
-                .bind(now - duration_ms(interval))
+                .bind(sent_before)
                 .bind(limit)
                 .fetch_all(&mut *tx)
                 .await?;

@@ -121,7 +121,7 @@ mod tests {
     #[test]
     fn a_bad_line_is_named_without_its_secret() {
         for (text, line, words) in [
-            ("alpha\n", 1, "2 fields"),
+            ("alpha\n", 1, "`<tenant> <secret>`, found 1 fields"),
             ("# c\nalpha short\n", 2, "shorter than 16"),
             ("al/pha 0123456789abcdef0123\n", 1, "tenant name"),
         ] {

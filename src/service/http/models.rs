@@ -175,13 +175,14 @@ pub struct ExecuteRequest {
     /// to these URIs, signed (`Chocmodal-Signature`, see docs/service.md "Job callbacks").
     /// Only hosts the operator allows (`--callback-allow`) are accepted.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub subscriber: Option<SubscriberSchema>,
+    pub subscriber: Option<SubscriberDocument>,
 }
 
 /// Where a job's outcome and progress are POSTed (each URI optional; absolute `http` or
 /// `https` URIs of hosts the operator allows).
 #[derive(Debug, Serialize, ToSchema)]
-pub struct SubscriberSchema {
+#[schema(as = Subscriber)]
+pub struct SubscriberDocument {
     /// Receives the status document once the job is `successful`.
     #[serde(rename = "successUri", skip_serializing_if = "Option::is_none")]
     #[schema(format = "uri", example = "https://hooks.example.com/chocmodal/done")]
