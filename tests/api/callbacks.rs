@@ -177,6 +177,28 @@ fn outbox(app: &TestApp) -> Outbox {
     Outbox::new(app.queue.database().clone(), app.queue.clock().clone())
 }
 
+/// The outcome's delivery state once it is no longer `pending`: (state, attempts, last
+/// error). The deliverer records an attempt after the receiver answered, so a test that
+/// saw the POST arrive waits here for its record.
+async fn settled(app: &TestApp, job: &str) -> (String, i64, Option<String>) {
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let state = outbox(app)
+            .state(job)
+            .await
+            .unwrap()
+            .expect("the job has a subscriber");
+        if state.0 != "pending" {
+            return state;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the callback of {job} is still pending: {state:?}"
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+}
+
 /// The value of `chocmodal_callback_deliveries_total{uri, outcome}` in `/metrics`.
 async fn deliveries(app: &TestApp, uri: &str, outcome: &str) -> f64 {
     let text = app.get("/metrics").await.text().await.unwrap();
@@ -217,7 +239,7 @@ async fn a_successful_job_posts_its_signed_status_document_within_a_second(backe
         "the body is GET /jobs/{{id}}'s document"
     );
     assert_signed(callback);
-    let (state, attempts, _) = outbox(&app).state(&job).await.unwrap().unwrap();
+    let (state, attempts, _) = settled(&app, &job).await;
     assert_eq!((state.as_str(), attempts), ("delivered", 1));
     assert_eq!(deliveries(&app, "success", "delivered").await, 1.0);
     assert_eq!(receiver.received().len(), 1, "delivered once, nothing to /failed");
@@ -254,15 +276,7 @@ async fn a_receiver_that_fails_twice_gets_it_on_the_third_try_after_growing_wait
         assert_eq!(callback.document()["status"], "successful");
         assert_signed(callback);
     }
-    // The record of the third attempt follows its answer closely.
-    let deadline = Instant::now() + Duration::from_secs(5);
-    let (state, attempts, error) = loop {
-        let state = outbox(&app).state(&job).await.unwrap().unwrap();
-        if state.0 != "pending" || Instant::now() > deadline {
-            break state;
-        }
-        tokio::time::sleep(Duration::from_millis(20)).await;
-    };
+    let (state, attempts, error) = settled(&app, &job).await;
     assert_eq!((state.as_str(), attempts, error), ("delivered", 3, None));
     assert_eq!(deliveries(&app, "success", "failed").await, 2.0);
     assert_eq!(deliveries(&app, "success", "delivered").await, 1.0);
@@ -522,5 +536,39 @@ async fn an_idempotency_key_covers_the_subscriber() {
     assert_eq!(again.json::<Value>().await.unwrap()["jobID"], job["jobID"]);
     let other = post(json!({"successUri": "http://127.0.0.1:9/b"})).await.unwrap();
     assert_problem(other, StatusCode::UNPROCESSABLE_ENTITY, "idempotency-key-reused").await;
+    app.stop().await;
+}
+
+/// A receiver that never answers 2xx: the outcome is retried until its next attempt
+/// would fall beyond the give-up time after the job's end, then abandoned for good.
+#[tokio::test]
+async fn an_outcome_never_accepted_is_abandoned_after_the_give_up_time() {
+    let receiver = Receiver::start(&[500; 20]).await;
+    let app = spawn_app_on(Backend::Sqlite, |config| {
+        allow_loopback(config);
+        config.callbacks.first_retry = Duration::from_millis(300);
+        config.callbacks.give_up_after = Duration::from_secs(1);
+        config.callbacks.poll_interval = Duration::from_millis(50);
+    })
+    .await;
+    let job = submit_with(
+        &app,
+        json!({"steps": 2}),
+        json!({"successUri": receiver.url("/done")}),
+    )
+    .await;
+    app.wait_until_finished(&job).await;
+    let (state, attempts, error) = settled(&app, &job).await;
+    assert_eq!(state, "abandoned");
+    // Waits of 0.3 s, 0.6 s, 1.2 s: the third would end past 1 s after the job.
+    assert!((2..=3).contains(&attempts), "{attempts} attempts");
+    let error = error.unwrap();
+    assert!(
+        error.contains("answered 500") && error.contains("gave up"),
+        "{error}"
+    );
+    assert_eq!(receiver.received().len() as i64, attempts);
+    assert_eq!(deliveries(&app, "success", "abandoned").await, 1.0);
+    assert_eq!(deliveries(&app, "success", "failed").await, (attempts - 1) as f64);
     app.stop().await;
 }
