@@ -39,7 +39,7 @@ pub enum Command {
     /// Run one execution request in-process and print its results document.
     Run(RunArgs),
     /// Serve the HTTP API and run jobs (SQLite by default, or PostgreSQL).
-    Serve(crate::service::ServeArgs),
+    Serve(Box<crate::service::ServeArgs>),
     /// Run jobs from the queue without serving the API (scale-out on PostgreSQL).
     Worker(crate::service::WorkerArgs),
 }

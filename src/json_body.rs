@@ -42,10 +42,27 @@ pub fn parse(text: &str) -> Result<Value, Problem> {
     Ok(value)
 }
 
+/// The members of an execution request the service reads: `inputs`, and `subscriber`
+/// as given (the service checks it against its callback policy). `outputs` and
+/// `response` are accepted and ignored (every execution is asynchronous, every output
+/// is returned).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExecutionRequest {
+    /// The `inputs` object.
+    pub inputs: Value,
+    /// The `subscriber` member, if present.
+    pub subscriber: Option<Value>,
+}
+
 /// Parses an execution request body and returns its `inputs` object.
-pub fn parse_envelope(text: &str) -> Result<serde_json::Value, Problem> {
+pub fn parse_envelope(text: &str) -> Result<Value, Problem> {
+    parse_execution_request(text).map(|request| request.inputs)
+}
+
+/// Parses an execution request body into its `inputs` and `subscriber`.
+pub fn parse_execution_request(text: &str) -> Result<ExecutionRequest, Problem> {
     let body = parse(text)?;
-    let serde_json::Value::Object(mut map) = body else {
+    let Value::Object(mut map) = body else {
         return Err(Problem::malformed_body(
             "the body must be a JSON object `{\"inputs\": {...}}`",
         ));
@@ -55,13 +72,14 @@ pub fn parse_envelope(text: &str) -> Result<serde_json::Value, Problem> {
         .find(|k| !matches!(k.as_str(), "inputs" | "outputs" | "response" | "subscriber"))
     {
         let invalid = InvalidInputs(vec![FieldError::new(
-            format!("/{unknown}"),
+            format!("/{}", crate::pointer::escape(unknown)),
             "unknown member of the execution request",
         )]);
         return Err(Problem::invalid_inputs(&invalid));
     }
+    let subscriber = map.remove("subscriber");
     match map.remove("inputs") {
-        Some(inputs @ serde_json::Value::Object(_)) => Ok(inputs),
+        Some(inputs @ Value::Object(_)) => Ok(ExecutionRequest { inputs, subscriber }),
         Some(_) => Err(Problem::invalid_inputs(&InvalidInputs(vec![FieldError::new(
             "/inputs",
             "must be an object",
@@ -84,6 +102,18 @@ mod tests {
         assert_eq!(problem.errors[0].pointer, "/inputs/beam/modes/1");
         let problem = parse(r#"{"a/b": 1e999}"#).unwrap_err();
         assert_eq!(problem.errors[0].pointer, "/a~1b");
+    }
+
+    #[test]
+    fn the_subscriber_is_kept_as_given_and_unknown_members_refused() {
+        let request = parse_execution_request(
+            r#"{"inputs": {"a": 1}, "subscriber": {"successUri": "x"}, "response": "document"}"#,
+        )
+        .unwrap();
+        assert_eq!(request.inputs, serde_json::json!({"a": 1}));
+        assert_eq!(request.subscriber, Some(serde_json::json!({"successUri": "x"})));
+        let problem = parse_execution_request(r#"{"inputs": {}, "callback/uri": "x"}"#).unwrap_err();
+        assert_eq!(problem.errors[0].pointer, "/callback~1uri");
     }
 
     #[test]

@@ -16,3 +16,8 @@ pub fn pointer_of(path: &serde_path_to_error::Path) -> String {
     }
     pointer
 }
+
+/// One reference token of a JSON pointer: `~` → `~0`, `/` → `~1`.
+pub fn escape(token: &str) -> String {
+    token.replace('~', "~0").replace('/', "~1")
+}

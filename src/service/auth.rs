@@ -83,7 +83,7 @@ fn digest(token: &str) -> [u8; 32] {
     Sha256::digest(token.as_bytes()).into()
 }
 
-fn valid_tenant(name: &str) -> bool {
+pub(crate) fn valid_tenant(name: &str) -> bool {
     !name.is_empty()
         && name.len() <= MAX_TENANT_LENGTH
         && name

@@ -7,6 +7,10 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::auth::{AuthFileError, TokenTable};
+use super::callbacks::{
+    AllowList, CallbackPolicy, CallbackSecrets, CallbackSettings, DEFAULT_GIVE_UP_SECONDS,
+    DEFAULT_PROGRESS_SECONDS, HostPattern, SecretsFileError,
+};
 use super::clock::{SharedClock, SystemClock};
 use super::db::DatabaseUrl;
 use super::http::cors::CorsOrigin;
@@ -134,6 +138,31 @@ pub struct ServeArgs {
     /// next request on a kept-alive connection; the connection is closed after that.
     #[arg(long, env = "CHOCMODAL_HEADER_TIMEOUT_SECONDS", default_value_t = 10)]
     pub header_timeout_seconds: u64,
+    /// Hosts job callbacks (an execution request's `subscriber`) may be sent to:
+    /// `hooks.example.com`, `*.example.com` (its subdomains), `10.0.0.7`, `[::1]`, each
+    /// optionally with `:port`; repeat the flag or separate with commas. Default: none
+    /// (subscribers are refused with a 422 that names this option).
+    #[arg(
+        long = "callback-allow",
+        env = "CHOCMODAL_CALLBACK_ALLOW",
+        value_name = "HOST",
+        value_delimiter = ','
+    )]
+    pub callback_allow: Vec<HostPattern>,
+    /// The tenants' callback signing secrets, one `<tenant> <secret>` per line (`#`
+    /// comments; the tenant is `default` without an auth file): each callback carries
+    /// `Chocmodal-Signature`, an HMAC-SHA256 of its body with its tenant's secret. A
+    /// tenant without a secret cannot subscribe.
+    #[arg(long, env = "CHOCMODAL_CALLBACK_SECRETS", value_name = "PATH")]
+    pub callback_secrets: Option<PathBuf>,
+    /// A job callback not delivered this long after its job finished is abandoned (s).
+    #[arg(long, env = "CHOCMODAL_CALLBACK_GIVE_UP_SECONDS", default_value_t = DEFAULT_GIVE_UP_SECONDS,
+        value_parser = clap::value_parser!(u64).range(1..))]
+    pub callback_give_up_seconds: u64,
+    /// Least time between two progress callbacks of one job (s).
+    #[arg(long, env = "CHOCMODAL_CALLBACK_PROGRESS_SECONDS", default_value_t = DEFAULT_PROGRESS_SECONDS,
+        value_parser = clap::value_parser!(u64).range(1..))]
+    pub callback_progress_seconds: u64,
 }
 
 fn positive_number(text: &str) -> Result<f64, String> {
@@ -214,6 +243,8 @@ pub struct ServiceConfig {
     pub request_timeout: Duration,
     /// Longest time a client may take to send request headers.
     pub header_read_timeout: Duration,
+    /// Job callbacks: allowed hosts, signing secrets, retries (API role only).
+    pub callbacks: CallbackSettings,
     /// The queue's clock.
     pub clock: SharedClock,
 }
@@ -275,6 +306,7 @@ impl ServiceConfig {
             max_job_time: Some(Duration::from_secs(900)),
             request_timeout: Duration::from_secs(30),
             header_read_timeout: Duration::from_secs(10),
+            callbacks: CallbackSettings::default(),
             clock: Arc::new(SystemClock),
         }
     }
@@ -308,9 +340,16 @@ impl ServiceConfig {
 pub const SQLITE_FILE: &str = "chocmodal.sqlite";
 
 impl ServiceConfig {
-    /// The settings of `chocmodal serve`'s flags; fails when the auth file is unusable.
-    pub fn from_args(args: &ServeArgs) -> Result<Self, AuthFileError> {
+    /// The settings of `chocmodal serve`'s flags; fails when the auth file or the
+    /// callback secrets file is unusable.
+    pub fn from_args(args: &ServeArgs) -> Result<Self, ConfigError> {
         let auth = args.auth_file.as_deref().map(TokenTable::load).transpose()?;
+        let secrets = args
+            .callback_secrets
+            .as_deref()
+            .map(CallbackSecrets::load)
+            .transpose()?
+            .unwrap_or_default();
         Ok(Self {
             bind: args.bind,
             max_body_bytes: args.max_body_bytes,
@@ -333,9 +372,27 @@ impl ServiceConfig {
             max_queued_jobs: (args.max_queued_jobs > 0).then_some(args.max_queued_jobs),
             request_timeout: Duration::from_secs(args.request_timeout_seconds.max(1)),
             header_read_timeout: Duration::from_secs(args.header_timeout_seconds.max(1)),
+            callbacks: CallbackSettings {
+                policy: CallbackPolicy {
+                    allow: AllowList::new(args.callback_allow.clone()),
+                    secrets,
+                },
+                give_up_after: Duration::from_secs(args.callback_give_up_seconds),
+                progress_interval: Duration::from_secs(args.callback_progress_seconds),
+                ..CallbackSettings::default()
+            },
             ..Self::from_queue_args(&args.queue)
         })
     }
+}
+
+/// Why `chocmodal serve`'s flags cannot be used (the service refuses to start).
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error(transparent)]
+    Auth(#[from] AuthFileError),
+    #[error(transparent)]
+    CallbackSecrets(#[from] SecretsFileError),
 }
 
 impl From<&WorkerArgs> for ServiceConfig {

@@ -14,6 +14,11 @@ use prometheus::{
 use super::queue::JobStatus;
 use super::storage_health::StorageHealth;
 
+/// The `uri` labels of `chocmodal_callback_deliveries_total`.
+pub const CALLBACK_URIS: [&str; 3] = ["success", "failed", "in_progress"];
+/// Its `outcome` labels.
+pub const CALLBACK_OUTCOMES: [&str; 3] = ["delivered", "failed", "abandoned"];
+
 /// The service's metrics.
 #[derive(Clone)]
 pub struct Metrics {
@@ -27,6 +32,7 @@ pub struct Metrics {
     threads: IntGauge,
     http_requests: IntCounterVec,
     http_duration: HistogramVec,
+    callback_deliveries: IntCounterVec,
     storage: StorageHealth,
 }
 
@@ -120,6 +126,22 @@ impl Metrics {
             &["cause", "during"],
         )
         .expect("valid metric");
+        let callback_deliveries = IntCounterVec::new(
+            Opts::new(
+                "chocmodal_callback_deliveries_total",
+                "Job callback attempts, by subscriber URI (success, failed, in_progress) and \
+                 outcome (delivered: a 2xx answer; failed: another answer or none, retried \
+                 later unless a progress callback; abandoned: given up, never retried).",
+            ),
+            &["uri", "outcome"],
+        )
+        .expect("valid metric");
+        // Every series exists from the start, so rates and alerts see a zero, not nothing.
+        for uri in CALLBACK_URIS {
+            for outcome in CALLBACK_OUTCOMES {
+                callback_deliveries.with_label_values(&[uri, outcome]);
+            }
+        }
         for collector in [
             Box::new(jobs.clone()) as Box<dyn prometheus::core::Collector>,
             Box::new(job_duration.clone()),
@@ -131,6 +153,7 @@ impl Metrics {
             Box::new(http_requests.clone()),
             Box::new(http_duration.clone()),
             Box::new(failed_writes.clone()),
+            Box::new(callback_deliveries.clone()),
         ] {
             registry.register(collector).expect("metric names are unique");
         }
@@ -145,6 +168,7 @@ impl Metrics {
             threads,
             http_requests,
             http_duration,
+            callback_deliveries,
             storage: StorageHealth::new(failed_writes),
         }
     }
@@ -189,6 +213,12 @@ impl Metrics {
         self.http_duration
             .with_label_values(&[method, route])
             .observe(duration.as_secs_f64());
+    }
+
+    /// One attempt at a job callback to the subscriber's `uri` member (`success`,
+    /// `failed`, `in_progress`) ended with `outcome` (`delivered`, `failed`, `abandoned`).
+    pub fn count_callback(&self, uri: &str, outcome: &str) {
+        self.callback_deliveries.with_label_values(&[uri, outcome]).inc();
     }
 
     /// The Prometheus text exposition, with the job counts given.

@@ -8,6 +8,7 @@
 //! request ([`thinning`]), and their spectra ([`spectrum_table`]).
 
 pub mod auth;
+pub mod callbacks;
 pub mod clock;
 pub mod config;
 pub mod db;

@@ -19,6 +19,7 @@ use tokio::sync::{Notify, oneshot};
 use tokio::task::JoinHandle;
 use tokio::time::Instant;
 
+use super::callbacks::Deliverer;
 use super::config::ServiceConfig;
 use super::db::{self, Database};
 use super::http::streamed::ResponseMemory;
@@ -42,6 +43,8 @@ pub enum StartupError {
         address: SocketAddr,
         source: std::io::Error,
     },
+    #[error(transparent)]
+    Callbacks(#[from] super::callbacks::deliverer::ClientError),
     #[error(
         "refusing to listen on {address} without an auth file: anyone who can reach it could \
          run and read every job; give `--auth-file`, bind a loopback address, or pass `--insecure`"
@@ -144,6 +147,7 @@ impl Engine {
             signals: self.queue.signals(),
             max_signal_bytes: config.max_signal_bytes,
             max_signal_samples: config.max_signal_samples,
+            callbacks: Arc::new(config.callbacks.policy.clone()),
         }
     }
 
@@ -242,6 +246,13 @@ impl Application {
         let (listener, address) = bind(config.bind).await?;
         let shutdown = ShutdownHandle::default();
         engine.start(&config, registry.clone(), &shutdown);
+        // Callbacks go out from the API processes, whose flags hold the policy.
+        let deliverer = Deliverer::new(
+            engine.queue.clone(),
+            engine.metrics.clone(),
+            config.callbacks.clone(),
+        )?;
+        engine.background.push(tokio::spawn(deliverer.run()));
         let tenants = config.auth.as_ref().map_or(0, |table| table.len());
         let router = http::router(
             engine.state(registry, &config, &shutdown),

@@ -96,3 +96,32 @@ async fn queued_jobs_run_oldest_first(backend: Backend) {
     }
     assert_eq!(*app.probe.runs.lock().unwrap(), vec![11, 12, 13, 14]);
 }
+
+/// OGC API – Processes clients (OWSLib) send `Prefer: respond-async` and expect to be
+/// told it was applied; `respond-sync` is not, but the answer is a job all the same.
+#[tokio::test]
+async fn prefer_respond_async_is_applied_and_respond_sync_still_gets_a_job() {
+    let app = spawn_app_on(Backend::Sqlite, |config| config.workers = 0).await;
+    for (prefer, applied) in [
+        (Some("respond-async"), Some("respond-async")),
+        (Some("wait=10, respond-async"), Some("respond-async")),
+        (Some("respond-sync"), None),
+        (None, None),
+    ] {
+        let mut request = app
+            .client
+            .post(app.url("/processes/count-steps/execution"))
+            .header("content-type", "application/json")
+            .body(json!({"inputs": {"steps": 3}}).to_string());
+        if let Some(prefer) = prefer {
+            request = request.header("prefer", prefer);
+        }
+        let response = request.send().await.unwrap();
+        assert_eq!(response.status(), StatusCode::CREATED, "Prefer: {prefer:?}");
+        let header = response
+            .headers()
+            .get("preference-applied")
+            .map(|v| v.to_str().unwrap().to_owned());
+        assert_eq!(header.as_deref(), applied, "Prefer: {prefer:?}");
+    }
+}

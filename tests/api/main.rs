@@ -9,6 +9,7 @@ mod postgres;
 mod skip;
 
 mod auto_basis;
+mod callbacks;
 mod capabilities;
 mod contact_laws;
 mod cors;

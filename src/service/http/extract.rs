@@ -8,22 +8,23 @@ use axum::http::{StatusCode, header};
 use serde::de::DeserializeOwned;
 
 use super::error::ApiError;
-use crate::json_body::parse_envelope;
+use crate::json_body::{ExecutionRequest, parse_execution_request};
 use crate::problem::Problem;
 
-/// The `inputs` object of an execution request body `{"inputs": {...}}`.
+/// The `inputs` object and the `subscriber` member of an execution request body
+/// `{"inputs": {...}, "subscriber": {...}}`.
 ///
 /// Rejections: 413 over the body limit, 415 when the body is declared as something else
 /// than JSON, 400 when it is not JSON, 422 when it is not the expected envelope.
 #[derive(Debug)]
-pub struct ExecutionInputs(pub serde_json::Value);
+pub struct ExecutionInputs(pub ExecutionRequest);
 
 impl<S: Send + Sync> FromRequest<S> for ExecutionInputs {
     type Rejection = ApiError;
 
     async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
         let text = json_text(req, state, "the execution request").await?;
-        Ok(Self(parse_envelope(&text)?))
+        Ok(Self(parse_execution_request(&text)?))
     }
 }
 

@@ -44,6 +44,7 @@ use tower_http::trace::{DefaultMakeSpan, DefaultOnResponse, TraceLayer};
 use tracing::Level;
 
 use super::auth::TokenTable;
+use super::callbacks::CallbackPolicy;
 use super::db::fault::StorageFault;
 use super::metrics::Metrics;
 use super::queue::JobQueue;
@@ -83,6 +84,8 @@ pub struct AppState {
     pub max_signal_bytes: usize,
     /// Most samples of one stored signal.
     pub max_signal_samples: usize,
+    /// What a job's `subscriber` is checked against (allowed hosts, tenants' secrets).
+    pub callbacks: Arc<CallbackPolicy>,
 }
 
 /// Settings of the layers around the routes.

@@ -171,6 +171,31 @@ pub struct ExecuteRequest {
     /// `cantilever-impact`, `BundleInputs` for `bundle-dynamics`.
     #[schema(value_type = Object)]
     pub inputs: serde_json::Value,
+    /// Job callbacks (OGC API – Processes): the service POSTs the job's status document
+    /// to these URIs, signed (`Chocmodal-Signature`, see docs/service.md "Job callbacks").
+    /// Only hosts the operator allows (`--callback-allow`) are accepted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subscriber: Option<SubscriberDocument>,
+}
+
+/// Where a job's outcome and progress are POSTed (each URI optional; absolute `http` or
+/// `https` URIs of hosts the operator allows).
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(as = Subscriber)]
+pub struct SubscriberDocument {
+    /// Receives the status document once the job is `successful`.
+    #[serde(rename = "successUri", skip_serializing_if = "Option::is_none")]
+    #[schema(format = "uri", example = "https://hooks.example.com/chocmodal/done")]
+    pub success_uri: Option<String>,
+    /// Receives it once the job is `failed` or `dismissed`.
+    #[serde(rename = "failedUri", skip_serializing_if = "Option::is_none")]
+    #[schema(format = "uri")]
+    pub failed_uri: Option<String>,
+    /// Receives it while the job runs, when its progress changed, at most once per
+    /// progress interval (`--callback-progress-seconds`, default 5 s).
+    #[serde(rename = "inProgressUri", skip_serializing_if = "Option::is_none")]
+    #[schema(format = "uri")]
+    pub in_progress_uri: Option<String>,
 }
 
 /// A results document: the process's summary figures plus `outputs` links to its

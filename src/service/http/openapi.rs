@@ -260,6 +260,7 @@ impl Modify for ResourceLinks {
         models::ProcessList,
         models::ProcessDescription,
         models::ExecuteRequest,
+        models::SubscriberDocument,
         models::Results,
         crate::processes::report::QualityReport,
         crate::processes::report::StepHalvingReport,

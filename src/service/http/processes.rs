@@ -12,11 +12,51 @@ use super::error::ApiError;
 use super::extract::ExecutionInputs;
 use super::idempotency::{IdempotencyHeader, key_reused, mark_replayed};
 use super::models::{ExecuteRequest, Link, ProcessDescription, ProcessList, ProcessSummary, StatusInfo};
+use crate::json_body::ExecutionRequest;
 use crate::problem::Problem;
 use crate::processes::Process;
 use crate::service::auth::Tenant;
+use crate::service::callbacks::Subscriber;
 use crate::service::queue::Admission;
 use crate::service::queue::idempotency::{KeyedRequest, Kind, RequestHash};
+
+/// The idempotency hash of an execution request: its inputs alone without a subscriber
+/// (as before subscribers were stored), else its inputs and subscriber, so that a key
+/// reused with another subscriber is a conflict.
+fn request_hash(
+    process_id: &str,
+    inputs: &serde_json::Value,
+    subscriber: Option<&Subscriber>,
+) -> RequestHash {
+    match subscriber {
+        None => RequestHash::of_json(Kind::Job, process_id, inputs),
+        Some(subscriber) => {
+            let request = serde_json::Map::from_iter([
+                ("inputs".to_owned(), inputs.clone()),
+                ("subscriber".to_owned(), subscriber.to_json()),
+            ]);
+            RequestHash::of_json(Kind::Job, process_id, &serde_json::Value::Object(request))
+        }
+    }
+}
+
+/// `Preference-Applied` (RFC 7240): which `Prefer` preference the answer honours.
+const PREFERENCE_APPLIED: header::HeaderName = header::HeaderName::from_static("preference-applied");
+
+/// Whether the request's `Prefer` headers ask for `respond-async` (OGC API – Processes:
+/// the server says it applied it). Every execution is asynchronous, so `respond-sync`
+/// is not applied: the answer is a job all the same, without the header.
+fn prefers_async(headers: &HeaderMap) -> bool {
+    headers
+        .get_all("prefer")
+        .iter()
+        .filter_map(|value| value.to_str().ok())
+        .flat_map(|value| value.split(','))
+        .any(|preference| {
+            let token = preference.split(';').next().unwrap_or_default().trim();
+            token.eq_ignore_ascii_case("respond-async")
+        })
+}
 
 fn summary(process: &dyn Process) -> ProcessSummary {
     let href = format!("/processes/{}", process.id());
@@ -83,16 +123,18 @@ pub async fn describe(
 /// full: 507 `storage-full` with `Retry-After`, nothing queued.
 #[utoipa::path(post, path = "/processes/{processId}/execution", operation_id = "execute", tag = "Processes",
     params(("processId" = String, Path, description = "Process id, e.g. `cantilever-impact`", example = "cantilever-impact"),
+        ("Prefer" = Option<String>, Header, description = "`respond-async` is applied (`Preference-Applied: respond-async`); `respond-sync` is not: every execution is asynchronous, answered with a job"),
         ("Idempotency-Key" = Option<String>, Header, description = "Optional, 1 to 255 visible ASCII characters: a retry with the same key and the same request gets the same resource back (same id, `201`, same `Location`, plus `Idempotent-Replayed: true`) instead of creating another; the same key with another request is a 422 `idempotency-key-reused`. Keys are per tenant and kept as long as the resource they created.")),
     request_body(content = ExecuteRequest, description = "`{\"inputs\": {...}}`, see the process description"),
     responses(
-        (status = 201, description = "Job queued", body = StatusInfo,
-            headers(("Location" = String, description = "`/jobs/{jobId}`"))),
+        (status = 201, description = "Job queued (with `Prefer: respond-sync` too: every execution is a job)", body = StatusInfo,
+            headers(("Location" = String, description = "`/jobs/{jobId}`"),
+                ("Preference-Applied" = String, description = "`respond-async` when the request's `Prefer` asked for it (RFC 7240)"))),
         (status = 400, description = "Malformed JSON, or an invalid `Idempotency-Key` (`invalid-header`)", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 404, description = "No such process", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 413, description = "Body over the size limit", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 415, description = "Body not declared as JSON", body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
-        (status = 422, description = "Invalid inputs (`invalid-inputs`), or a run above the cost ceilings (`too-costly`), with `errors` pointers; or an `Idempotency-Key` first sent with another request (`idempotency-key-reused`)",
+        (status = 422, description = "Invalid inputs (`invalid-inputs`; a `subscriber` URI that is not absolute http(s) or whose host the operator does not allow is refused at its pointer, e.g. `/subscriber/successUri`), or a run above the cost ceilings (`too-costly`), with `errors` pointers; or an `Idempotency-Key` first sent with another request (`idempotency-key-reused`)",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 429, description = "Too many queued jobs (`too-many-queued-jobs`)", body = super::openapi::ProblemSchema,
             content_type = "application/problem+json", headers(("Retry-After" = String, description = "s"))),
@@ -105,6 +147,7 @@ pub async fn execute(
     Extension(tenant): Extension<Tenant>,
     Path(process_id): Path<String>,
     IdempotencyHeader(key): IdempotencyHeader,
+    request_headers: HeaderMap,
     body: Result<ExecutionInputs, ApiError>,
 ) -> Result<Response, ApiError> {
     // An unknown process is reported before anything about the body.
@@ -112,11 +155,16 @@ pub async fn execute(
         .registry
         .get(&process_id)
         .ok_or_else(|| Problem::no_such_process(&process_id))?;
-    let ExecutionInputs(inputs) = body?;
+    let ExecutionInputs(ExecutionRequest { inputs, subscriber }) = body?;
+    let subscriber = Subscriber::parse(subscriber.as_ref(), &state.callbacks, tenant.as_str());
     let keyed = key.map(|key| KeyedRequest {
         key,
         kind: Kind::Job,
-        hash: RequestHash::of_json(Kind::Job, &process_id, &inputs),
+        hash: request_hash(
+            &process_id,
+            &inputs,
+            subscriber.as_ref().ok().and_then(Option::as_ref),
+        ),
     });
     // The stored signals the inputs refer to, the tenant's only: resolved now, so that an
     // unknown or foreign id is refused at its pointer before anything is queued.
@@ -129,7 +177,15 @@ pub async fn execute(
             .await
             .map_err(|e| ApiError::Internal(format!("validation panicked: {e}")))?
     };
-    let validated = validated.map_err(|invalid| Problem::invalid_inputs(&invalid))?;
+    // Every refusal at once: the inputs' and the subscriber's.
+    let (validated, subscriber) = match (validated, subscriber) {
+        (Ok(validated), Ok(subscriber)) => (validated, subscriber),
+        (Err(mut invalid), Err(refused)) => {
+            invalid.0.extend(refused.0);
+            return Err(Problem::invalid_inputs(&invalid).into());
+        }
+        (Err(invalid), Ok(_)) | (Ok(_), Err(invalid)) => return Err(Problem::invalid_inputs(&invalid).into()),
+    };
     state
         .limits
         .check(&validated.estimate)
@@ -143,13 +199,14 @@ pub async fn execute(
             &validated.warnings,
             state.max_queued_jobs,
             keyed.as_ref(),
+            subscriber.as_ref(),
         )
         .await?;
     let mut headers = HeaderMap::new();
     let job = match admission {
         Admission::Admitted(job) => {
             state.wake.notify_one();
-            tracing::info!(job = %job.id, process = %process_id, %tenant, "job queued");
+            tracing::info!(job = %job.id, process = %process_id, %tenant, callbacks = subscriber.is_some(), "job queued");
             job
         }
         Admission::Replayed(job) => {
@@ -170,5 +227,32 @@ pub async fn execute(
         header::LOCATION,
         HeaderValue::from_str(&format!("/jobs/{}", job.id)).expect("uuid is a valid header value"),
     );
+    if prefers_async(&request_headers) {
+        headers.insert(PREFERENCE_APPLIED, HeaderValue::from_static("respond-async"));
+    }
     Ok((StatusCode::CREATED, headers, Json(StatusInfo::from_record(&job))).into_response())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn prefer(values: &[&str]) -> HeaderMap {
+        let mut headers = HeaderMap::new();
+        for value in values {
+            headers.append("prefer", HeaderValue::from_str(value).unwrap());
+        }
+        headers
+    }
+
+    #[test]
+    fn respond_async_is_found_among_other_preferences() {
+        assert!(prefers_async(&prefer(&["respond-async"])));
+        assert!(prefers_async(&prefer(&[
+            "return=minimal, Respond-Async; wait=10"
+        ])));
+        assert!(prefers_async(&prefer(&["wait=5", "respond-async"])));
+        assert!(!prefers_async(&prefer(&["respond-sync"])));
+        assert!(!prefers_async(&prefer(&[])));
+    }
 }

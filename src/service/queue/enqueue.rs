@@ -15,6 +15,7 @@
 use super::content_hash::content_hash;
 use super::idempotency::{IdempotencyStore, KeyedRequest, Prior, is_key_taken};
 use super::{Admission, JobQueue, JobRecord, record_columns};
+use crate::service::callbacks::{Subscriber, outbox};
 use crate::service::db::{TenantQueueLock, with_pool};
 
 /// `BEGIN` of a creation that may look up a key before it writes (SQLite: take the
@@ -24,7 +25,8 @@ pub(crate) const BEGIN_WRITE_POSTGRES: &str = "BEGIN";
 
 impl JobQueue {
     /// Inserts an accepted job of `tenant` for `process_id` with its (already validated)
-    /// inputs and their plausibility warnings, unless `tenant` already has `max_queued`
+    /// inputs and their plausibility warnings (and its `subscriber`, stored in the same
+    /// transaction: [`crate::service::callbacks`]), unless `tenant` already has `max_queued`
     /// accepted jobs. With `key`, a job the key already created for the same request is
     /// returned instead ([`Admission::Replayed`]), and another request with that key is
     /// refused ([`Admission::KeyConflict`]).
@@ -36,14 +38,15 @@ impl JobQueue {
         warnings: &[crate::processes::Warning],
         max_queued: Option<u64>,
         key: Option<&KeyedRequest>,
+        subscriber: Option<&Subscriber>,
     ) -> Result<Admission<JobRecord>, sqlx::Error> {
         match self
-            .enqueue_once(tenant, process_id, inputs, warnings, max_queued, key)
+            .enqueue_once(tenant, process_id, inputs, warnings, max_queued, key, subscriber)
             .await
         {
             // A concurrent first use of the same key won: this one now finds it.
             Err(error) if key.is_some() && is_key_taken(&error) => {
-                self.enqueue_once(tenant, process_id, inputs, warnings, max_queued, key)
+                self.enqueue_once(tenant, process_id, inputs, warnings, max_queued, key, subscriber)
                     .await
             }
             outcome => outcome,
@@ -58,6 +61,7 @@ impl JobQueue {
         warnings: &[crate::processes::Warning],
         max_queued: Option<u64>,
         key: Option<&KeyedRequest>,
+        subscriber: Option<&Subscriber>,
     ) -> Result<Admission<JobRecord>, sqlx::Error> {
         let warnings = serde_json::to_string(warnings).expect("warnings serialize");
         let id = uuid::Uuid::new_v4().to_string();
@@ -102,6 +106,18 @@ impl JobQueue {
             .await?;
             if let (Some(record), Some(request)) = (&inserted, key) {
                 tx.store_key(tenant, request, &record.id, now).await?;
+            }
+            if let (Some(record), Some(subscriber)) = (&inserted, subscriber) {
+                let [success, failed, in_progress] = outbox::uri_columns(subscriber);
+                sqlx::query(outbox::INSERT)
+                    .bind(&record.id)
+                    .bind(tenant)
+                    .bind(success)
+                    .bind(failed)
+                    .bind(in_progress)
+                    .bind(now)
+                    .execute(&mut *tx)
+                    .await?;
             }
             tx.commit().await?;
             inserted

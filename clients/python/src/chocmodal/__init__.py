@@ -14,6 +14,7 @@ from . import axes
 from ._http import RetryPolicy
 from ._version import __version__
 from ._xarray import history_to_xarray
+from .callbacks import SIGNATURE_HEADER, verify_signature
 from .client import Client
 from .errors import ChocmodalConnectionError, ChocmodalError, FieldError, ProblemDocument, QualityWarning
 from .jobs import Job
@@ -34,4 +35,6 @@ __all__ = [
     "QualityWarning",
     "axes",
     "history_to_xarray",
+    "verify_signature",
+    "SIGNATURE_HEADER",
 ]

@@ -87,7 +87,14 @@ class Client:
 
     # -- jobs ---------------------------------------------------------------------
 
-    def submit(self, process: str, inputs: Mapping[str, Any], *, idempotency_key: Optional[str] = None) -> Job:
+    def submit(
+        self,
+        process: str,
+        inputs: Mapping[str, Any],
+        *,
+        idempotency_key: Optional[str] = None,
+        subscriber: Optional[Mapping[str, str]] = None,
+    ) -> Job:
         """Validates and queues a run of ``process`` with ``inputs`` (the members of the
         execution request's ``inputs``, not the ``{"inputs": ...}`` wrapper). Returns
         its :class:`Job`; refused inputs raise :class:`ChocmodalError` (422, one
@@ -96,12 +103,22 @@ class Client:
         The request carries an ``Idempotency-Key`` (a new UUID, or ``idempotency_key``)
         that every retry repeats: a submission whose answer was lost and is sent again
         gets the same job back (``job.replayed`` is then true), never a second one.
+
+        ``subscriber`` asks for job callbacks (OGC API – Processes): any of
+        ``successUri``, ``failedUri``, ``inProgressUri``, absolute http(s) URIs the
+        service POSTs the job's status document to, signed (``Chocmodal-Signature``,
+        see :func:`chocmodal.verify_signature`). The service's operator must allow their
+        hosts (``--callback-allow``): others are refused with a 422 at
+        ``/subscriber/successUri`` (...).
         """
         key = idempotency_key or str(uuid.uuid4())
+        body: dict[str, Any] = {"inputs": dict(inputs)}
+        if subscriber is not None:
+            body["subscriber"] = dict(subscriber)
         response = self._transport.request(
             "POST",
             f"/processes/{process}/execution",
-            json_body={"inputs": dict(inputs)},
+            json_body=body,
             headers={IDEMPOTENCY_HEADER: key, "Accept": "application/json"},
         )
         status = response.json()
