@@ -57,6 +57,13 @@ async fn conformance_claims_core_job_list_and_dismiss() {
             "{class} missing"
         );
     }
+    // The API definition is OpenAPI 3.1: the 3.0 class is not claimed.
+    assert!(
+        !classes
+            .iter()
+            .any(|c| c.as_str().unwrap().ends_with("conf/oas30")),
+        "{classes:?}"
+    );
 }
 
 #[tokio::test]

@@ -10,12 +10,13 @@ use super::error::ApiError;
 use super::models::{Conformance, Health, LandingPage, Link, Readiness};
 use super::openapi;
 
+/// The classes claimed. Not `oas30`: the API definition is OpenAPI 3.1 (utoipa's), and
+/// a client of the 3.0 class (OWSLib's `api()`) looks for a 3.0 document.
 const OGC_CONFORMANCE: &[&str] = &[
     "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/core",
     "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/ogc-process-description",
     "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/json",
     "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/html",
-    "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/oas30",
     "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/job-list",
     "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/dismiss",
 ];
