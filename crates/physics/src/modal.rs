@@ -78,6 +78,78 @@ pub struct SupportTransport {
     pub participation: Vec<f64>,
 }
 
+/// The first `modes` eigenpairs (ω², M-normalised vectors over the free DOFs,
+/// increasing) of K φ = ω² M φ in the stiffness form: M = L Lᵀ, the standard problem
+/// (L⁻¹ K L⁻ᵀ) y = ω² y, φ = L⁻ᵀ y. `None` when one of them comes out non-positive
+/// (the rounding of the form, ~ε × the highest eigenvalue, above the lowest).
+fn stiffness_form(
+    stiffness: &Mat<f64>,
+    mass: &Mat<f64>,
+    modes: usize,
+) -> Result<Option<(Vec<f64>, Mat<f64>)>, ModalError> {
+    let n = stiffness.nrows();
+    let cholesky = mass
+        .llt(Side::Lower)
+        .map_err(|_| ModalError::MassNotPositiveDefinite)?;
+    let lower = cholesky.L();
+    // A = L⁻¹ K L⁻ᵀ: X = L⁻¹ K, then A = L⁻¹ Xᵀ (K symmetric).
+    let mut x = stiffness.clone();
+    solve_lower_triangular_in_place(lower, x.as_mut(), Par::Seq);
+    let mut a = x.transpose().to_owned();
+    solve_lower_triangular_in_place(lower, a.as_mut(), Par::Seq);
+    let a = Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+    let eigen = a
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|_| ModalError::EigenSolverFailed)?;
+    let values: Vec<f64> = (0..modes).map(|i| eigen.S().column_vector()[i]).collect();
+    if !values.iter().all(|v| v.is_finite() && *v > 0.0) {
+        return Ok(None);
+    }
+    let mut vectors = eigen.U().get(.., 0..modes).to_owned();
+    solve_upper_triangular_in_place(lower.transpose(), vectors.as_mut(), Par::Seq);
+    Ok(Some((values, vectors)))
+}
+
+/// The same eigenpairs in the flexibility form: K = L Lᵀ, (L⁻¹ M L⁻ᵀ) y = μ y with
+/// μ = 1/ω², whose rounding (~ε × the largest μ, the lowest mode's) leaves the lowest
+/// modes exact to ~1e-7 on meshes of 800 elements where the stiffness form fails;
+/// φ = L⁻ᵀ y / √μ is M-normalised. Needs K positive definite (supports that hold the
+/// beam); the highest modes of a fine mesh come out less accurate than the lowest.
+fn flexibility_form(
+    stiffness: &Mat<f64>,
+    mass: &Mat<f64>,
+    modes: usize,
+) -> Result<(Vec<f64>, Mat<f64>), ModalError> {
+    let n = stiffness.nrows();
+    let cholesky = stiffness
+        .llt(Side::Lower)
+        .map_err(|_| ModalError::EigenSolverFailed)?;
+    let lower = cholesky.L();
+    let mut x = mass.clone();
+    solve_lower_triangular_in_place(lower, x.as_mut(), Par::Seq);
+    let mut b = x.transpose().to_owned();
+    solve_lower_triangular_in_place(lower, b.as_mut(), Par::Seq);
+    let b = Mat::from_fn(n, n, |i, j| 0.5 * (b[(i, j)] + b[(j, i)]));
+    let eigen = b
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|_| ModalError::EigenSolverFailed)?;
+    // μ increasing: the lowest modes are the last columns.
+    let columns: Vec<usize> = (0..modes).map(|i| n - 1 - i).collect();
+    let mu: Vec<f64> = columns.iter().map(|&c| eigen.S().column_vector()[c]).collect();
+    if !mu.iter().all(|v| v.is_finite() && *v > 0.0) {
+        return Err(ModalError::EigenSolverFailed);
+    }
+    let mut vectors = Mat::from_fn(n, modes, |r, i| eigen.U()[(r, columns[i])]);
+    solve_upper_triangular_in_place(lower.transpose(), vectors.as_mut(), Par::Seq);
+    for (i, m) in mu.iter().enumerate() {
+        let scale = 1.0 / m.sqrt();
+        for r in 0..n {
+            vectors[(r, i)] *= scale;
+        }
+    }
+    Ok((mu.iter().map(|m| 1.0 / m).collect(), vectors))
+}
+
 impl ModalBasis {
     /// First `modes` modes of a valid beam ([`BeamSpec::validate`]).
     pub fn compute(spec: &BeamSpec, modes: usize) -> Result<Self, ModalError> {
@@ -111,31 +183,17 @@ impl ModalBasis {
         let stiffness = Mat::from_fn(n, n, |i, j| model.stiffness[free[i] * dofs + free[j]]);
         let mass = Mat::from_fn(n, n, |i, j| model.mass[free[i] * dofs + free[j]]);
 
-        let cholesky = mass
-            .llt(Side::Lower)
-            .map_err(|_| ModalError::MassNotPositiveDefinite)?;
-        let lower = cholesky.L();
-        // A = L⁻¹ K L⁻ᵀ: X = L⁻¹ K, then A = L⁻¹ Xᵀ (K symmetric).
-        let mut x = stiffness.clone();
-        solve_lower_triangular_in_place(lower, x.as_mut(), Par::Seq);
-        let mut a = x.transpose().to_owned();
-        solve_lower_triangular_in_place(lower, a.as_mut(), Par::Seq);
-        let a = Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
-        let eigen = a
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|_| ModalError::EigenSolverFailed)?;
-        let eigenvalues = eigen.S().column_vector();
-        let mut vectors = eigen.U().get(.., 0..modes).to_owned();
-        solve_upper_triangular_in_place(lower.transpose(), vectors.as_mut(), Par::Seq);
+        let (eigenvalues, vectors) = match stiffness_form(&stiffness, &mass, modes)? {
+            Some(pairs) => pairs,
+            // Past a few hundred elements the stiffness form's rounding (relative to its
+            // highest eigenvalue) swamps the lowest: the flexibility form keeps them.
+            None => flexibility_form(&stiffness, &mass, modes)?,
+        };
 
         let mut angular_frequencies = Vec::with_capacity(modes);
         let mut shapes = vec![0.0; modes * dofs];
         for i in 0..modes {
-            let eigenvalue = eigenvalues[i];
-            if !(eigenvalue.is_finite() && eigenvalue > 0.0) {
-                return Err(ModalError::EigenSolverFailed);
-            }
-            angular_frequencies.push(eigenvalue.sqrt());
+            angular_frequencies.push(eigenvalues[i].sqrt());
             let row = &mut shapes[i * dofs..(i + 1) * dofs];
             for (k, &d) in free.iter().enumerate() {
                 row[d] = vectors[(k, i)];

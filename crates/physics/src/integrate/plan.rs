@@ -114,9 +114,9 @@ impl<'a> Plan<'a> {
             .map(|s| s.max_force)
             .collect();
         let mut findings = force_scales(model, settings, step, &peaks);
-        // A probe that cannot be computed (the dense eigensolver on the complete basis of
-        // a very fine mesh) leaves the basis and the mesh unmeasured: the run stands, its
-        // verdict cannot be `good`.
+        // A probe that cannot be computed (the complete basis of a mesh that neither form
+        // of the eigenproblem solves) leaves the basis and the mesh unmeasured: the run
+        // stands, its verdict cannot be `good`.
         let basis = crate::discretisation::assess(model, &peaks).unwrap_or_else(|e| {
             findings.push(quality::Finding {
                 poor: false,
