@@ -191,15 +191,21 @@ impl PartialSchema for TimeStepInput {
 
 impl ToSchema for TimeStepInput {}
 
-/// `"auto"`, with what it chooses.
-fn auto_count(what: &str) -> ObjectBuilder {
-    ObjectBuilder::new()
+/// A count (`integer`: its bounds and description) or `"auto"`, the `what` it chooses;
+/// `noun` names the count in the member's description.
+fn count_or_auto(integer: ObjectBuilder, what: &str, noun: &str) -> RefOr<Schema> {
+    let auto = ObjectBuilder::new()
         .schema_type(Type::String)
         .enum_values(Some(["auto"]))
         .description(Some(format!(
             "`auto`: the {what} whose impact probes put the peak contact force within 10 × \
              `solver.tolerance` (docs/accuracy.md)."
-        )))
+        )));
+    OneOfBuilder::new()
+        .item(integer.schema_type(Type::Integer).minimum(Some(1.0)))
+        .item(auto)
+        .description(Some(format!("A number of {noun} (count), or `\"auto\"`.")))
+        .into()
 }
 
 /// The schema of `elements`: a count from 1 to 400, or `"auto"`.
@@ -209,17 +215,13 @@ pub struct ElementsInput;
 
 impl PartialSchema for ElementsInput {
     fn schema() -> RefOr<Schema> {
-        OneOfBuilder::new()
-            .item(
-                ObjectBuilder::new()
-                    .schema_type(Type::Integer)
-                    .minimum(Some(1.0))
-                    .maximum(Some(MAX_ELEMENTS as f64))
-                    .description(Some("Elements (count).")),
-            )
-            .item(auto_count("coarsest mesh, doubling from 40 up to 200,"))
-            .description(Some("A number of elements (count), or `\"auto\"`."))
-            .into()
+        count_or_auto(
+            ObjectBuilder::new()
+                .maximum(Some(MAX_ELEMENTS as f64))
+                .description(Some("Elements (count).")),
+            "coarsest mesh, doubling from 40 up to 200,",
+            "elements",
+        )
     }
 }
 
@@ -232,16 +234,11 @@ pub struct ModesInput;
 
 impl PartialSchema for ModesInput {
     fn schema() -> RefOr<Schema> {
-        OneOfBuilder::new()
-            .item(
-                ObjectBuilder::new()
-                    .schema_type(Type::Integer)
-                    .minimum(Some(1.0))
-                    .description(Some("Modes (count), at most the free DOFs of the mesh.")),
-            )
-            .item(auto_count("fewest modes"))
-            .description(Some("A number of modes (count), or `\"auto\"`."))
-            .into()
+        count_or_auto(
+            ObjectBuilder::new().description(Some("Modes (count), at most the free DOFs of the mesh.")),
+            "fewest modes",
+            "modes",
+        )
     }
 }
 

@@ -141,14 +141,14 @@ impl Law {
 
     /// The damping of a contact of stiffness K that this law's restitution sets: (c, α)
     /// for the linear law, c = 2 ζ(e) √(K m) with the reduced mass m
-    /// (`reduced_mass` when the restitution gives none), and for n > 1 the
+    /// (`reduced_mass()`, asked only when the restitution gives none), and for n > 1 the
     /// Hunt–Crossley α = a(n, e)/v₀ ([`restitution`]). Without a restitution: as given.
-    pub fn damping(&self, stiffness: f64, damping: f64, reduced_mass: f64) -> (f64, f64) {
+    pub fn damping(&self, stiffness: f64, damping: f64, reduced_mass: impl FnOnce() -> f64) -> (f64, f64) {
         let Some(restitution) = &self.restitution else {
             return (damping, self.hunt_crossley);
         };
         if self.exponent == 1.0 {
-            let mass = restitution.mass.unwrap_or(reduced_mass);
+            let mass = restitution.mass.unwrap_or_else(reduced_mass);
             let zeta = linear_damping_ratio(restitution.coefficient);
             (2.0 * zeta * (stiffness * mass).sqrt(), 0.0)
         } else {
@@ -359,7 +359,7 @@ impl Contact {
 
     /// The normal law with its damping resolved for bodies of reduced mass
     /// `reduced_mass` ([`Law::damping`]): what the step loops evaluate.
-    pub fn resolved_law(&self, reduced_mass: f64) -> NormalLaw {
+    pub fn resolved_law(&self, reduced_mass: impl FnOnce() -> f64) -> NormalLaw {
         let (damping, hunt_crossley) = self.law.damping(self.stiffness, self.damping, reduced_mass);
         NormalLaw {
             damping,

@@ -97,17 +97,9 @@ impl Deliverer {
         }
         let outcomes = inner.outbox.claim_outcomes(&inner.owner, room).await?;
         for due in outcomes {
-            let permit = inner
-                .in_flight
-                .clone()
-                .acquire_owned()
-                .await
-                .expect("never closed");
             let this = self.clone();
-            tokio::spawn(async move {
-                this.deliver_outcome(due).await;
-                drop(permit);
-            });
+            self.spawn_held(async move { this.deliver_outcome(due).await })
+                .await;
         }
         let room = inner.in_flight.available_permits();
         if room == 0 {
@@ -118,19 +110,26 @@ impl Deliverer {
             .claim_progress(inner.settings.progress_interval, room)
             .await?;
         for due in progress {
-            let permit = inner
-                .in_flight
-                .clone()
-                .acquire_owned()
-                .await
-                .expect("never closed");
             let this = self.clone();
-            tokio::spawn(async move {
-                this.deliver_progress(due).await;
-                drop(permit);
-            });
+            self.spawn_held(async move { this.deliver_progress(due).await })
+                .await;
         }
         Ok(())
+    }
+
+    /// Runs `send` on a task of its own holding one of the in-flight permits.
+    async fn spawn_held(&self, send: impl std::future::Future<Output = ()> + Send + 'static) {
+        let permit = self
+            .inner
+            .in_flight
+            .clone()
+            .acquire_owned()
+            .await
+            .expect("never closed");
+        tokio::spawn(async move {
+            send.await;
+            drop(permit);
+        });
     }
 
     async fn deliver_outcome(&self, due: DueOutcome) {

@@ -8,7 +8,7 @@ use super::*;
 use crate::beam::{Section, Support};
 
 /// A fuel-pin-like tube, 1.5 m, 8.5/7.4 mm (the row).
-fn pin(elements: usize) -> BeamSpec {
+pub(super) fn pin(elements: usize) -> BeamSpec {
     BeamSpec {
         length: 1.5,
         young_modulus: 1.0e11,

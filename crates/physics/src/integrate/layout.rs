@@ -321,18 +321,7 @@ impl<'m> Layout<'m> {
         });
         let laws: Vec<NormalLaw> = contacts
             .iter()
-            .map(|contact| {
-                // Only a linear law's restitution without its own mass reads the pin's
-                // apparent mass (a deflection at the height: not for every contact).
-                let law = &contact.law;
-                let needs_mass =
-                    law.exponent == 1.0 && law.restitution.as_ref().is_some_and(|r| r.mass.is_none());
-                contact.resolved_law(if needs_mass {
-                    model.reduced_mass(contact)
-                } else {
-                    f64::NAN
-                })
-            })
+            .map(|contact| contact.resolved_law(|| model.reduced_mass(contact)))
             .collect();
         Self {
             model,

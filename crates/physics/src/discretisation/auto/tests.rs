@@ -7,28 +7,11 @@
 use std::ops::ControlFlow;
 
 use super::*;
-use crate::beam::{Section, Support};
 use crate::contact::{Body, Contact, Law};
+use crate::discretisation::tests::pin;
 use crate::integrate::{Check, Model, Settings, TimeStep, simulate};
 use crate::loads::BaseAcceleration;
 use crate::stability::Scheme;
-
-/// The slender pin: 1.5 m, tube 8.5/7.4 mm, E 1e11 Pa, with a fuel column.
-fn pin(elements: usize) -> BeamSpec {
-    BeamSpec {
-        length: 1.5,
-        young_modulus: 1.0e11,
-        density: 6550.0,
-        section: Section::Tube {
-            outer_diameter: 0.0085,
-            inner_diameter: 0.0074,
-        },
-        added_mass_per_length: 0.4,
-        elements,
-        foot: Support::Clamped,
-        top: Support::Free,
-    }
-}
 
 /// A wall at `height` on the +x side of pin 0, touching it (gap 0), linear `stiffness`.
 fn wall(height: f64, stiffness: f64) -> Contact {
