@@ -4,7 +4,7 @@
 use serde::Serialize;
 use utoipa::ToSchema;
 
-use super::inputs::BeamInput;
+use super::common_inputs::BeamInput;
 use crate::physics::discretisation::auto::Choice;
 use crate::physics::integrate::{Model, critical_time_step};
 use crate::physics::modal::ModalBasis;

@@ -214,7 +214,7 @@ impl LawInput {
     /// with a `restitution`, a valid wear law.
     pub fn check(&self, pointer: &str, errors: &mut Vec<super::FieldError>) {
         if let Some(wear) = &self.wear {
-            errors.extend(super::inputs::at(
+            errors.extend(super::common_inputs::at(
                 &format!("{pointer}/wear"),
                 wear.wear().validate(),
             ));

@@ -16,7 +16,7 @@ use utoipa::openapi::schema::{ArrayBuilder, ObjectBuilder, OneOfBuilder, Type};
 use utoipa::openapi::{RefOr, Schema};
 use utoipa::{PartialSchema, ToSchema};
 
-use super::inputs::{DampingInput, SolverDefaults, SolverInput, TimeStepInput};
+use super::common_inputs::{DampingInput, SolverDefaults, SolverInput, TimeStepInput};
 use crate::physics::beam::MAX_ELEMENTS;
 
 /// A self-contained JSON schema of `T`: component references inlined, the keywords

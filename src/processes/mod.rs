@@ -6,25 +6,30 @@
 //! time histories. It knows nothing about HTTP, the queue or the database: the service
 //! and the CLI drive it through [`Process`].
 
-pub mod basis_report;
+// The processes, one folder each (inputs, pipeline, tests): a process uses the shared
+// modules below and never another process's module (`src/architecture_tests.rs`).
 pub mod bundle_dynamics;
-pub mod bundle_inputs;
 pub mod cantilever_impact;
+pub mod hex_bundle_dynamics;
+
+// What the processes share.
+pub mod basis_report;
 /// What each column of a history is: name, unit, what it measures.
 pub mod columns;
+/// The inputs every process shares: the beam, the solver, the step, parsing helpers.
+pub mod common_inputs;
 pub mod contact_law;
 pub mod cost;
-pub mod hex_bundle_dynamics;
-pub mod hex_inputs;
-/// Point forces and tip releases of `hex-bundle-dynamics`, per deflection line.
-pub mod hex_loads;
+/// The excitations the processes share (base accelerations, signals in the plane).
+pub mod excitation;
 pub mod impact_report;
 pub mod input_schema;
-pub mod inputs;
 pub mod metrics;
 /// The member at fault when a tagged object fails to parse.
 pub mod misfit;
 pub mod model_check;
+/// The laws of random gaps the generators share.
+pub mod random_gaps;
 /// The shared parts of results documents (quality, energy) as serialized types.
 pub mod report;
 /// Every missing member at once, with the other problems of the inputs.

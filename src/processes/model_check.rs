@@ -8,10 +8,10 @@
 //! length, its mode count and whether its top is free to be released from; so they run
 //! on a [`StandIn`] with the pin's length and top support, before and whatever else is
 //! wrong with the pin. The real model is checked once more when its step is resolved
-//! ([`super::inputs::resolve_step`]).
+//! ([`super::common_inputs::resolve_step`]).
 
 use super::FieldError;
-use super::inputs::{BeamInput, DampingInput};
+use super::common_inputs::{BeamInput, DampingInput};
 use crate::physics::InputIssue;
 use crate::physics::beam::{BeamSpec, Section, Support};
 use crate::physics::integrate::{Model, Settings};
@@ -145,7 +145,7 @@ pub fn join(prefix: &str, rest: &str) -> String {
 mod tests {
     use super::*;
     use crate::physics::integrate::DEFAULT_TOLERANCE;
-    use crate::processes::inputs::{SupportInput, SupportsInput};
+    use crate::processes::common_inputs::{SupportInput, SupportsInput};
 
     fn pin(foot: SupportInput, top: SupportInput) -> BeamInput {
         serde_json::from_value(serde_json::json!({

@@ -15,7 +15,7 @@ use serde::de::DeserializeOwned;
 use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::{FieldError, InvalidInputs, inputs};
+use super::{FieldError, InvalidInputs, common_inputs};
 
 /// Parses `json` as `I` and prepares it with `prepare`; a parse failure with members
 /// missing reports all of them, with every other problem `prepare` finds.
@@ -23,7 +23,7 @@ pub fn prepare<I: DeserializeOwned + ToSchema, P>(
     json: &Value,
     prepare: impl FnOnce(I) -> Result<P, InvalidInputs>,
 ) -> Result<P, InvalidInputs> {
-    let first = match inputs::parse::<I>(json) {
+    let first = match common_inputs::parse::<I>(json) {
         Ok(parsed) => return prepare(parsed),
         Err(error) => error,
     };
@@ -38,7 +38,7 @@ pub fn prepare<I: DeserializeOwned + ToSchema, P>(
     if missing.is_empty() {
         return Err(first);
     }
-    let others = match inputs::parse::<I>(&filled) {
+    let others = match common_inputs::parse::<I>(&filled) {
         Ok(parsed) => prepare(parsed).err().map(|e| e.0).unwrap_or_default(),
         Err(error) => error.0,
     };

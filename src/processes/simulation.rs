@@ -5,7 +5,7 @@
 //! same types), how inputs become a validated [`Simulation::Plan`] (every problem with
 //! its JSON pointer), what a plan costs, and how it runs. The adapter does the rest, the
 //! same way for every process: strict parsing with pointer repair
-//! ([`super::inputs::parse`]), the absolute cost ceilings ([`CostLimits::ABSOLUTE`]),
+//! ([`super::common_inputs::parse`]), the absolute cost ceilings ([`CostLimits::ABSOLUTE`]),
 //! the OGC descriptions of inputs and outputs, the plausibility warnings
 //! ([`super::warnings`]), the results document and its schema.
 
@@ -159,7 +159,7 @@ impl<S: Simulation> Process for S {
 
     fn threads(&self, inputs: &serde_json::Value) -> usize {
         if S::SHARES_STEPS {
-            super::inputs::requested_threads(inputs)
+            super::common_inputs::requested_threads(inputs)
         } else {
             1
         }

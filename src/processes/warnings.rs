@@ -13,7 +13,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use super::inputs::{BeamInput, SectionInput};
+use super::common_inputs::{BeamInput, SectionInput};
 use crate::physics::integrate::Model;
 use crate::physics::modal::ModalBasis;
 use crate::physics::number;

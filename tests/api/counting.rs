@@ -143,7 +143,7 @@ impl Process for CountSteps {
 
     /// As a process that shares its steps: what `solver.threads` asks.
     fn threads(&self, inputs: &Value) -> usize {
-        chocmodal::processes::inputs::requested_threads(inputs)
+        chocmodal::processes::common_inputs::requested_threads(inputs)
     }
 
     fn inputs_description(&self) -> Value {

@@ -100,7 +100,7 @@ fn query_error(text: &str) -> String {
         )
         .replace("number too large to fit in target type", "is too large")
         .replace("invalid float literal", "must be a number");
-    crate::processes::inputs::plain(&plain)
+    crate::processes::common_inputs::plain(&plain)
 }
 
 #[cfg(test)]

@@ -6,18 +6,18 @@
 //! radians). Flats are numbered 0..6 counter-clockwise, flat k's outward normal at
 //! k·60° + 30°; pins from the centre outward, ring by ring (docs/hex-bundle.md).
 
-use super::contact_law::{Families, LawInput};
+use crate::processes::contact_law::{Families, LawInput};
 use serde::Deserialize;
 use utoipa::ToSchema;
 
-use super::bundle_inputs::{BaseAccelerationInput, DistributionInput};
-use super::hex_loads::{HexInitialInput, HexPointForceInput};
-use super::impact_report::ImpactsInput;
-use super::input_schema::NonNegativeNumber;
-use super::inputs::{BeamInput, SectionInput, SolverInput};
-use super::warnings::WarningsInput;
-use crate::physics::bundle::GapDistribution;
+use super::loads::{HexInitialInput, HexPointForceInput};
 use crate::physics::hex::{FlatOffset, Handedness, HexGapState, HexGaps, HexLayout, PinZone, ZoneClosure};
+use crate::processes::common_inputs::{BeamInput, SectionInput, SolverInput};
+use crate::processes::excitation::BaseAccelerationInput;
+use crate::processes::impact_report::ImpactsInput;
+use crate::processes::input_schema::NonNegativeNumber;
+use crate::processes::random_gaps::DistributionInput;
+use crate::processes::warnings::WarningsInput;
 
 /// Inputs of `hex-bundle-dynamics`.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
@@ -53,7 +53,7 @@ pub struct HexInputs {
     pub excitation: HexExcitationInput,
     /// Explicit integration.
     #[serde(default)]
-    #[schema(schema_with = super::input_schema::auto_solver_schema, default = json!({}))]
+    #[schema(schema_with = crate::processes::input_schema::auto_solver_schema, default = json!({}))]
     pub solver: SolverInput,
     /// History sampling and selection, impact counting.
     #[serde(default)]
@@ -165,21 +165,20 @@ impl HexContactInput {
 
     /// Every problem of the two laws, at their pointers: the physics' own check of a
     /// law ([`crate::physics::contact::Law::validate`]) and the inputs' ([`Families::check`]).
-    pub fn check_laws(&self, errors: &mut Vec<super::FieldError>, service_time: Option<f64>) {
+    pub fn check_laws(&self, errors: &mut Vec<crate::processes::FieldError>, service_time: Option<f64>) {
         self.families().check(errors);
         match (self.families().wears(), service_time) {
-            (true, None) => errors.push(super::FieldError::new(
+            (true, None) => errors.push(crate::processes::FieldError::new(
                 "/inputs/output/service_time",
                 "a contact law has a `wear`: give the service time (s) it wears over",
             )),
-            (false, Some(_)) => errors.push(super::FieldError::new(
+            (false, Some(_)) => errors.push(crate::processes::FieldError::new(
                 "/inputs/output/service_time",
                 "is the time the contact laws' `wear` wears over, and no law has one",
             )),
-            (_, Some(time)) if !(time.is_finite() && time > 0.0) => errors.push(super::FieldError::new(
-                "/inputs/output/service_time",
-                "must be a time > 0 (s)",
-            )),
+            (_, Some(time)) if !(time.is_finite() && time > 0.0) => errors.push(
+                crate::processes::FieldError::new("/inputs/output/service_time", "must be a time > 0 (s)"),
+            ),
             _ => {}
         }
         let mut families = vec![false];
@@ -190,7 +189,7 @@ impl HexContactInput {
             let (_, damping, law, pointer) = self.family(wall);
             let mut issues = Vec::new();
             law.law().validate(&mut issues, damping);
-            errors.extend(super::inputs::at(pointer, issues));
+            errors.extend(crate::processes::common_inputs::at(pointer, issues));
         }
     }
 }
@@ -316,7 +315,7 @@ pub struct HexExcitationInput {
 
 impl HexExcitationInput {
     /// The stored signals referenced, with their pointers.
-    pub fn signal_references(&mut self) -> Vec<super::signal_input::SignalSlot<'_>> {
+    pub fn signal_references(&mut self) -> Vec<crate::processes::signal_input::SignalSlot<'_>> {
         [
             ("base_acceleration", &mut self.base_acceleration),
             ("base_acceleration_x", &mut self.base_acceleration_x),
@@ -450,10 +449,7 @@ impl HexInputs {
                     seed,
                     relative,
                 } => HexGapState::Random {
-                    distribution: match *distribution {
-                        DistributionInput::Uniform { low, high } => GapDistribution::Uniform { low, high },
-                        DistributionInput::Normal { mean, std } => GapDistribution::Normal { mean, std },
-                    },
+                    distribution: distribution.physics(),
                     seed: *seed,
                     relative: *relative,
                 },

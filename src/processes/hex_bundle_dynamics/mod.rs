@@ -6,16 +6,19 @@
 //! shapes (`hex_loads`). Statistics for every contact, full force histories for a
 //! selection.
 
+/// The inputs of `hex-bundle-dynamics`.
+pub mod inputs;
+/// Point forces and tip releases of `hex-bundle-dynamics`, per deflection line.
+pub mod loads;
+
 use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
-use super::bundle_dynamics::{PeakDeflectionResult, PeakForce};
+use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::{self, FrictionReport, LawInput, Utilisation, WearDepth, WearReport};
-use super::hex_inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
-use super::hex_loads::{self, PlaneLoads};
+use super::excitation::{PlaneSignal, plane_signal};
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
-use super::inputs::{self, SolverDefaults, at};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
@@ -27,6 +30,9 @@ use crate::physics::integrate::{self, Model, Plane, Settings, StepSize, WallMoti
 use crate::physics::loads::BaseAcceleration;
 use crate::physics::modal::ModalBasis;
 use crate::physics::{InputIssue, require_non_negative};
+use crate::processes::bundle_dynamics::{PeakDeflectionResult, PeakForce};
+use inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
+use loads::PlaneLoads;
 
 /// Default history interval (s).
 pub const DEFAULT_OUTPUT_INTERVAL: f64 = 1e-4;
@@ -341,9 +347,9 @@ impl Simulation for HexBundleDynamics {
         );
         let excitation = excitation(&inputs.excitation, &mut errors);
         let walls = wrapper_motion(&inputs.excitation, &excitation, &mut errors);
-        let loads = hex_loads::plane_loads(&inputs, &mut errors);
-        let solver = inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
-        inputs::check_output_interval(inputs.output.interval, &mut errors);
+        let loads = loads::plane_loads(&inputs, &mut errors);
+        let solver = common_inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
+        common_inputs::check_output_interval(inputs.output.interval, &mut errors);
         let counting = impact_report::counting(inputs.output.impacts.as_ref(), inputs.output.blocks);
         errors.extend(impact_report::errors(&counting));
         let heights = output_heights(&inputs, &mut errors);
@@ -423,7 +429,7 @@ impl Simulation for HexBundleDynamics {
                 return Err(InvalidInputs(refused));
             }
         }
-        let step = inputs::resolve_step(&model, &settings)?;
+        let step = common_inputs::resolve_step(&model, &settings)?;
         Ok(Plan {
             inputs,
             bundle,
@@ -444,8 +450,8 @@ impl Simulation for HexBundleDynamics {
     /// `contact_forces` (time + one column per recorded contact) and `displacements`
     /// (time + two columns per pin and output height), and their peaks.
     fn estimate(plan: &Plan) -> WorkEstimate {
-        let (stepping, samples) = inputs::stepping(&plan.settings, &plan.step);
-        let stepping = inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "pin");
+        let (stepping, samples) = common_inputs::stepping(&plan.settings, &plan.step);
+        let stepping = common_inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "pin");
         let lines = 2 * plan.bundle.pin_count();
         let recorded = plan.settings.recorded_contacts.as_ref().map_or(0, Vec::len);
         let columns = 2 * ((1 + recorded) + (1 + lines * plan.settings.output_heights.len()));
@@ -718,82 +724,6 @@ fn wrapper_motion(
     ))
 }
 
-/// A signal in the plane as the request gives it: one signal along a direction, or two
-/// components (member names and values).
-struct PlaneSignal<'a> {
-    single: (
-        &'static str,
-        &'a Option<super::bundle_inputs::BaseAccelerationInput>,
-    ),
-    /// The direction member, its value (given or defaulted), and whether it was given.
-    direction: (&'static str, Option<f64>, bool),
-    x: (
-        &'static str,
-        &'a Option<super::bundle_inputs::BaseAccelerationInput>,
-    ),
-    y: (
-        &'static str,
-        &'a Option<super::bundle_inputs::BaseAccelerationInput>,
-    ),
-}
-
-/// The (x, y) components of a [`PlaneSignal`], or the errors: one signal with an
-/// optional direction, or two components, not both.
-fn plane_signal(
-    signal: PlaneSignal<'_>,
-    errors: &mut Vec<FieldError>,
-) -> (Option<BaseAcceleration>, Option<BaseAcceleration>) {
-    let pointer = "/inputs/excitation";
-    let component = |(member, signal): (&str, &Option<super::bundle_inputs::BaseAccelerationInput>),
-                     errors: &mut Vec<FieldError>| {
-        signal.as_ref().map(|s| {
-            errors.extend(at(&format!("{pointer}/{member}"), s.validate()));
-            s.physics()
-        })
-    };
-    let single = component(signal.single, errors);
-    let x = component(signal.x, errors);
-    let y = component(signal.y, errors);
-    let (direction_member, direction, direction_given) = signal.direction;
-    if let Some(direction) = direction
-        && !direction.is_finite()
-    {
-        errors.push(FieldError::new(
-            format!("{pointer}/{direction_member}"),
-            "must be a finite angle in degrees",
-        ));
-    }
-    let (single_member, x_member, y_member) = (signal.single.0, signal.x.0, signal.y.0);
-    match single {
-        Some(one) => {
-            if x.is_some() || y.is_some() {
-                let field = if x.is_some() { x_member } else { y_member };
-                errors.push(FieldError::new(
-                    format!("{pointer}/{field}"),
-                    format!(
-                        "give either {single_member} (with {direction_member}) or the components \
-                         {x_member} and {y_member}, not both"
-                    ),
-                ));
-            }
-            let angle = direction.unwrap_or(0.0).to_radians();
-            (Some(one.scaled(angle.cos())), Some(one.scaled(angle.sin())))
-        }
-        None => {
-            if direction_given {
-                errors.push(FieldError::new(
-                    format!("{pointer}/{direction_member}"),
-                    format!(
-                        "is the direction of {single_member}, which is not given (the components \
-                         {x_member} and {y_member} need none)"
-                    ),
-                ));
-            }
-            (x, y)
-        }
-    }
-}
-
 fn output_heights(inputs: &HexInputs, errors: &mut Vec<FieldError>) -> Vec<f64> {
     let length = inputs.pin.length;
     let heights = inputs.output.heights.clone().unwrap_or_else(|| vec![length]);
@@ -989,5 +919,4 @@ fn histories(plan: &Plan, simulation: integrate::Simulation) -> Vec<History> {
 }
 
 #[cfg(test)]
-#[path = "hex_bundle_dynamics_tests.rs"]
 mod tests;

@@ -3,14 +3,17 @@
 //! released from bent shapes. The generator form is expanded to the explicit contact
 //! list, which the results echo.
 
+/// The inputs of `bundle-dynamics`: the explicit row or its generator.
+pub mod inputs;
+
 use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
-use super::bundle_inputs::{BaseAccelerationInput, BodyInput, BundleInputs, ContactInput};
+use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::{self, LawInput, Utilisation};
+use super::excitation::BaseAccelerationInput;
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
-use super::inputs::{self, SolverDefaults, at};
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
@@ -20,6 +23,7 @@ use crate::physics::contact::{Body, Contact};
 use crate::physics::discretisation::auto::Choice as BasisChoice;
 use crate::physics::integrate::{self, Model, Settings, StepSize};
 use crate::physics::modal::ModalBasis;
+use inputs::{BodyInput, BundleInputs, ContactInput};
 
 /// Most pins in one row.
 pub const MAX_PINS: usize = 2000;
@@ -395,8 +399,8 @@ impl Simulation for BundleDynamics {
             ));
         }
 
-        let solver = inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
-        inputs::check_output_interval(inputs.output.interval, &mut errors);
+        let solver = common_inputs::solver(&inputs.solver, SolverDefaults::AUTO, &mut errors);
+        common_inputs::check_output_interval(inputs.output.interval, &mut errors);
         let heights = inputs.output.heights.clone().unwrap_or_else(|| vec![length]);
         if heights.is_empty() {
             errors.push(FieldError::new(
@@ -455,7 +459,7 @@ impl Simulation for BundleDynamics {
             inputs
                 .pin
                 .basis(&contacts, &contact_heights, settings.tolerance, 0, "/inputs/pin")?;
-        let step = inputs::resolve_step(&row_model(&inputs, pins, &contacts, &basis), &settings)?;
+        let step = common_inputs::resolve_step(&row_model(&inputs, pins, &contacts, &basis), &settings)?;
         Ok(Plan {
             inputs,
             pins,
@@ -471,8 +475,8 @@ impl Simulation for BundleDynamics {
     /// `contact_forces` (time + one column per contact) and `displacements` (time + one
     /// column per pin and output height), and their peaks.
     fn estimate(plan: &Plan) -> WorkEstimate {
-        let (stepping, samples) = inputs::stepping(&plan.settings, &plan.step);
-        let stepping = inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "pin");
+        let (stepping, samples) = common_inputs::stepping(&plan.settings, &plan.step);
+        let stepping = common_inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "pin");
         let columns = 2 * ((1 + plan.contacts.len()) + (1 + plan.pins * plan.settings.output_heights.len()));
         let generated = plan.inputs.bundle.is_some();
         let (pins, contacts) = if generated {
@@ -687,5 +691,4 @@ fn histories(prepared: &Plan, simulation: crate::physics::integrate::Simulation)
 }
 
 #[cfg(test)]
-#[path = "bundle_dynamics_tests.rs"]
 mod tests;

@@ -5,14 +5,16 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use super::contact_law::{Families, LawInput};
-use super::impact_report::ImpactsInput;
-use super::input_schema::{NonNegativeNumber, PositiveNumber};
-use super::inputs::{BeamInput, SolverInput};
-use super::warnings::WarningsInput;
-use crate::physics::bundle::{BundleLayout, GapDistribution, GapState, Levels, LocalClosure};
+use crate::physics::bundle::{BundleLayout, GapState, Levels, LocalClosure};
 use crate::physics::contact::{Body, Contact};
-use crate::physics::loads::{BaseAcceleration, PointForce, Pulse, Table};
+use crate::physics::loads::{PointForce, Table};
+use crate::processes::common_inputs::{BeamInput, SolverInput};
+use crate::processes::contact_law::{Families, LawInput};
+use crate::processes::excitation::BaseAccelerationInput;
+use crate::processes::impact_report::ImpactsInput;
+use crate::processes::input_schema::{NonNegativeNumber, PositiveNumber};
+use crate::processes::random_gaps::DistributionInput;
+use crate::processes::warnings::WarningsInput;
 
 /// Inputs of `bundle-dynamics`: give either `pins` and `contacts`, or `bundle`.
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
@@ -37,7 +39,7 @@ pub struct BundleInputs {
     pub excitation: ExcitationInput,
     /// Explicit integration.
     #[serde(default)]
-    #[schema(schema_with = super::input_schema::auto_solver_schema, default = json!({}))]
+    #[schema(schema_with = crate::processes::input_schema::auto_solver_schema, default = json!({}))]
     pub solver: SolverInput,
     /// History sampling and impact counting.
     #[serde(default)]
@@ -80,7 +82,7 @@ pub struct ContactInput {
     /// The rest of the law: power-law exponent, restitution, Hunt–Crossley damping,
     /// allowable force (the linear spring–dashpot when left out).
     #[serde(default, skip_serializing_if = "LawInput::is_default")]
-    #[schema(schema_with = super::contact_law::row_law_schema, default = json!({}))]
+    #[schema(schema_with = crate::processes::contact_law::row_law_schema, default = json!({}))]
     pub law: LawInput,
 }
 
@@ -202,10 +204,10 @@ pub struct BundleGenerator {
     /// The rest of the law of every contact (of the pin–pin contacts when `wall_law`
     /// is given): exponent, restitution, Hunt–Crossley damping, allowable force.
     #[serde(default)]
-    #[schema(schema_with = super::contact_law::row_law_schema, default = json!({}))]
+    #[schema(schema_with = crate::processes::contact_law::row_law_schema, default = json!({}))]
     pub law: LawInput,
     /// The law of the wall contacts, instead of `law`.
-    #[schema(schema_with = super::contact_law::row_law_schema)]
+    #[schema(schema_with = crate::processes::contact_law::row_law_schema)]
     pub wall_law: Option<LawInput>,
     /// Nominal wall–pin gap (m).
     #[schema(minimum = 0.0)]
@@ -310,32 +312,6 @@ impl Default for GapsInput {
     }
 }
 
-/// Law of random gaps (m, or factors on the nominal gaps when `relative`): `uniform` or
-/// `normal`.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
-pub enum DistributionInput {
-    /// Uniform law on [low, high].
-    Uniform {
-        /// Lowest value (m; dimensionless for `relative` gaps).
-        #[schema(minimum = 0.0)]
-        low: f64,
-        /// Highest value, at least `low` (m; dimensionless for `relative` gaps).
-        #[schema(minimum = 0.0)]
-        high: f64,
-    },
-    /// Normal law truncated at 0 (resampled, a true truncated normal).
-    Normal {
-        /// Mean of the law before truncation (m; dimensionless for `relative` gaps), at
-        /// least −30 × `std` (and at least 0 when `std` is 0).
-        mean: f64,
-        /// Standard deviation of the law before truncation (m; dimensionless for
-        /// `relative` gaps).
-        #[schema(minimum = 0.0)]
-        std: f64,
-    },
-}
-
 /// Gaps of the contacts in levels first_level..=last_level touching a pin in
 /// first_pin..=last_pin are multiplied by `factor` (0 closes them).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
@@ -378,10 +354,7 @@ impl BundleGenerator {
                     seed,
                     relative,
                 } => GapState::Random {
-                    distribution: match *distribution {
-                        DistributionInput::Uniform { low, high } => GapDistribution::Uniform { low, high },
-                        DistributionInput::Normal { mean, std } => GapDistribution::Normal { mean, std },
-                    },
+                    distribution: distribution.physics(),
                     seed: *seed,
                     relative: *relative,
                 },
@@ -441,7 +414,7 @@ pub struct ExcitationInput {
 
 impl ExcitationInput {
     /// The stored signals referenced, with their pointers.
-    pub fn signal_references(&mut self) -> Vec<super::signal_input::SignalSlot<'_>> {
+    pub fn signal_references(&mut self) -> Vec<crate::processes::signal_input::SignalSlot<'_>> {
         [
             ("base_acceleration", &mut self.base_acceleration),
             ("wall_acceleration", &mut self.wall_acceleration),
@@ -488,152 +461,6 @@ impl ExcitationInput {
                 y: None,
             }
         })
-    }
-}
-
-/// Base acceleration a(t) (m/s²), positive toward the right wall (the +x axis of a
-/// hexagonal bundle's direction), starting at t = 0.
-#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
-pub enum BaseAccelerationInput {
-    /// amplitude · sin(π t / duration) during `duration`, then 0.
-    HalfSine {
-        /// Peak acceleration (m/s²), signed.
-        amplitude: f64,
-        /// Length of the pulse (s).
-        #[schema(exclusive_minimum = 0.0)]
-        duration: f64,
-    },
-    /// amplitude · sin(2π frequency t) for `cycles` periods, then 0.
-    Sine {
-        /// Peak acceleration (m/s²), signed.
-        amplitude: f64,
-        /// Frequency (Hz).
-        #[schema(exclusive_minimum = 0.0)]
-        frequency: f64,
-        /// Number of periods (dimensionless; a fraction ends mid-period).
-        #[schema(exclusive_minimum = 0.0)]
-        cycles: f64,
-    },
-    /// Samples, linear between them, 0 after the last.
-    Table {
-        /// Sample times (s), at least two, ≥ 0 and strictly increasing.
-        #[schema(value_type = Vec<NonNegativeNumber>)]
-        time: Vec<f64>,
-        /// Acceleration at each time (m/s²).
-        acceleration: Vec<f64>,
-    },
-    /// amplitude · sin²(π t / duration) during `duration`, then 0 (velocity change
-    /// amplitude · duration / 2).
-    Haversine {
-        /// Peak acceleration (m/s²), signed.
-        amplitude: f64,
-        /// Length of the pulse (s).
-        #[schema(exclusive_minimum = 0.0)]
-        duration: f64,
-    },
-    /// amplitude · t / duration during `duration`, then 0 at once (velocity change
-    /// amplitude · duration / 2).
-    TerminalPeakSawtooth {
-        /// Peak acceleration (m/s²), signed.
-        amplitude: f64,
-        /// Length of the pulse (s).
-        #[schema(exclusive_minimum = 0.0)]
-        duration: f64,
-    },
-    /// Linear rise to `amplitude` in `rise`, `plateau` at it, linear fall to 0 in `fall`;
-    /// a ramp or the plateau may be 0, not all three (velocity change amplitude ·
-    /// (rise/2 + plateau + fall/2)).
-    Trapezoid {
-        /// Plateau acceleration (m/s²), signed.
-        amplitude: f64,
-        /// Duration of the rise (s).
-        #[schema(minimum = 0.0)]
-        rise: f64,
-        /// Duration of the plateau (s).
-        #[schema(minimum = 0.0)]
-        plateau: f64,
-        /// Duration of the fall (s).
-        #[schema(minimum = 0.0)]
-        fall: f64,
-    },
-    /// A synthetic earthquake matching a target response spectrum, drawn from a seed.
-    SpectrumCompatible(super::synthetic_input::SpectrumCompatibleInput),
-    /// A stored accelerogram (`POST /signals`) by its `id`, times `scale` (default 1).
-    Signal(super::signal_input::SignalInput),
-}
-
-impl BaseAccelerationInput {
-    /// Every problem (fields relative to the excitation object).
-    pub fn validate(&self) -> Vec<crate::physics::InputIssue> {
-        match self {
-            Self::SpectrumCompatible(synthetic) => synthetic.validate(),
-            Self::Signal(signal) => signal.validate(),
-            other => other.physics().validate(),
-        }
-    }
-
-    /// Whether this signal is checked as its own inputs ([`Self::validate`]) rather than
-    /// through the table the integrator sees: a synthetic record (generated from them)
-    /// and a stored signal (checked when it was uploaded). Problems the model check
-    /// finds in their tables would only restate those, at members the request lacks.
-    pub fn is_checked_apart(&self) -> bool {
-        matches!(self, Self::SpectrumCompatible(_) | Self::Signal(_))
-    }
-
-    /// The stored signal this refers to, if it is one.
-    pub fn signal_mut(&mut self) -> Option<&mut super::signal_input::SignalInput> {
-        match self {
-            Self::Signal(signal) => Some(signal),
-            _ => None,
-        }
-    }
-
-    /// The excitation the integrator sees (a synthetic record or a stored signal as its
-    /// table).
-    pub fn physics(&self) -> BaseAcceleration {
-        match self {
-            Self::SpectrumCompatible(synthetic) => BaseAcceleration::Table(synthetic.table()),
-            Self::Signal(signal) => BaseAcceleration::Table(signal.table()),
-            Self::HalfSine { amplitude, duration } => BaseAcceleration::HalfSine {
-                amplitude: *amplitude,
-                duration: *duration,
-            },
-            Self::Sine {
-                amplitude,
-                frequency,
-                cycles,
-            } => BaseAcceleration::Sine {
-                amplitude: *amplitude,
-                frequency: *frequency,
-                cycles: *cycles,
-            },
-            Self::Table { time, acceleration } => BaseAcceleration::Table(Table {
-                time: time.clone(),
-                values: acceleration.clone(),
-            }),
-            Self::Haversine { amplitude, duration } => BaseAcceleration::Pulse(Pulse::Haversine {
-                amplitude: *amplitude,
-                duration: *duration,
-            }),
-            Self::TerminalPeakSawtooth { amplitude, duration } => {
-                BaseAcceleration::Pulse(Pulse::TerminalPeakSawtooth {
-                    amplitude: *amplitude,
-                    duration: *duration,
-                })
-            }
-            Self::Trapezoid {
-                amplitude,
-                rise,
-                plateau,
-                fall,
-            } => BaseAcceleration::Pulse(Pulse::Trapezoid {
-                amplitude: *amplitude,
-                rise: *rise,
-                plateau: *plateau,
-                fall: *fall,
-            }),
-        }
     }
 }
 

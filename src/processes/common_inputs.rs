@@ -841,7 +841,7 @@ mod plain_tests {
     use serde_json::json;
 
     use super::parse;
-    use crate::processes::bundle_inputs::BundleInputs;
+    use crate::processes::bundle_dynamics::inputs::BundleInputs;
 
     fn detail(inputs: serde_json::Value) -> (String, String) {
         let error = parse::<BundleInputs>(&inputs).expect_err("refused").0.remove(0);

@@ -8,9 +8,9 @@ use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
 use super::columns::{self, Column};
+use super::common_inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::contact_law::{self, LawInput};
 use super::impact_report::{self, ContactImpacts, ImpactSummary, ImpactsInput};
-use super::inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
@@ -489,8 +489,8 @@ impl Simulation for CantileverImpact {
         let spec = inputs.beam.spec();
         let tip_stiffness = 3.0 * spec.bending_stiffness() / spec.length.powi(3);
         let contact_stiffness = contact_stiffness(&inputs.contact, tip_stiffness, &mut errors);
-        let solver = inputs::solver(&inputs.solver, SOLVER_DEFAULTS, &mut errors);
-        inputs::check_output_interval(inputs.output.interval, &mut errors);
+        let solver = common_inputs::solver(&inputs.solver, SOLVER_DEFAULTS, &mut errors);
+        common_inputs::check_output_interval(inputs.output.interval, &mut errors);
         let mut settings = solver.integration(inputs.output.interval, vec![spec.length]);
         settings.impacts = impact_report::counting(inputs.output.impacts.as_ref(), inputs.output.blocks);
         let stand_in = StandIn::of(&inputs.beam);
@@ -537,7 +537,7 @@ impl Simulation for CantileverImpact {
         if !errors.is_empty() {
             return Err(InvalidInputs(errors));
         }
-        let step = inputs::resolve_step(&tip_model(&inputs, &basis, contact_stiffness), &settings)?;
+        let step = common_inputs::resolve_step(&tip_model(&inputs, &basis, contact_stiffness), &settings)?;
         Ok(Plan {
             inputs,
             basis,
@@ -552,8 +552,8 @@ impl Simulation for CantileverImpact {
     /// One pin of `modes` modes and one contact per step; four histories of three
     /// columns (time, numerical, reference).
     fn estimate(plan: &Plan) -> WorkEstimate {
-        let (stepping, samples) = inputs::stepping(&plan.settings, &plan.step);
-        let stepping = inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "beam");
+        let (stepping, samples) = common_inputs::stepping(&plan.settings, &plan.step);
+        let stepping = common_inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "beam");
         let mut history_drivers = vec![
             "/inputs/solver/duration".to_owned(),
             "/inputs/output/interval".to_owned(),
@@ -762,5 +762,4 @@ fn reference_peaks(
 }
 
 #[cfg(test)]
-#[path = "cantilever_impact_tests.rs"]
 mod tests;

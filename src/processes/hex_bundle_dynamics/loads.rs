@@ -14,13 +14,13 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 use utoipa::ToSchema;
 
-use super::FieldError;
-use super::hex_inputs::HexInputs;
-use super::input_schema::NonNegativeNumber;
-use super::inputs::at;
-use super::model_check::StandIn;
+use super::inputs::HexInputs;
 use crate::physics::hex::{MAX_RINGS, pin_count};
 use crate::physics::loads::{PointForce, Table};
+use crate::processes::FieldError;
+use crate::processes::common_inputs::at;
+use crate::processes::input_schema::NonNegativeNumber;
+use crate::processes::model_check::StandIn;
 
 /// The state at t = 0.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, ToSchema)]
@@ -229,5 +229,4 @@ fn point_forces(inputs: &HexInputs, pins: Option<usize>, errors: &mut Vec<FieldE
 }
 
 #[cfg(test)]
-#[path = "hex_loads_tests.rs"]
 mod tests;
