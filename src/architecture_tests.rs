@@ -50,14 +50,19 @@ fn without_tests(source: &str) -> &str {
 
 /// `crate::a` and `crate::{a, b::c}` paths: the modules named first.
 fn referenced(source: &str) -> BTreeSet<String> {
+    named_after(source, "crate::")
+}
+
+/// The names that follow `prefix` in paths (`<prefix>a`, `<prefix>{a, b::c}`).
+fn named_after(source: &str, prefix: &str) -> BTreeSet<String> {
     let mut modules = BTreeSet::new();
     let ident = |s: &str| -> String {
         s.chars()
             .take_while(|c| c.is_alphanumeric() || *c == '_')
             .collect()
     };
-    for (at, _) in source.match_indices("crate::") {
-        let rest = &source[at + "crate::".len()..];
+    for (at, _) in source.match_indices(prefix) {
+        let rest = &source[at + prefix.len()..];
         if let Some(group) = rest.strip_prefix('{') {
             let inner = &group[..group.find('}').unwrap_or(group.len())];
             modules.extend(
@@ -189,4 +194,67 @@ fn the_scan_sees_grouped_paths_and_skips_test_modules() {
     let source = "use crate::{a, b::c};\nuse crate::d::e;\n#[cfg(test)]\nmod tests {\n use crate::f;\n}\n";
     let found = referenced(without_tests(source));
     assert_eq!(found, ["a", "b", "d"].into_iter().map(String::from).collect());
+}
+
+/// The processes: the folders of `src/processes`.
+fn process_folders() -> BTreeSet<String> {
+    std::fs::read_dir(Path::new(SOURCES).join("processes"))
+        .expect("readable processes folder")
+        .flatten()
+        .filter(|entry| entry.path().is_dir())
+        .map(|entry| entry.file_name().to_string_lossy().into_owned())
+        .collect()
+}
+
+/// A process is a room of its own: the files of a process's folder name no other
+/// process (through `crate::processes::`, `super::` or `super::super::`), and the shared
+/// modules of `src/processes` name none (the registry in `mod.rs` lists them all).
+#[test]
+fn no_process_reaches_into_another_and_shared_modules_into_none() {
+    let processes = process_folders();
+    assert!(processes.len() >= 3, "too few process folders: {processes:?}");
+    let root = Path::new(SOURCES).join("processes");
+    let mut files = Vec::new();
+    rust_files(&root, &mut files);
+    let mut trespasses = Vec::new();
+    for file in files {
+        let relative = file.strip_prefix(&root).expect("under processes");
+        let name = file.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        if name.ends_with("tests.rs") || relative == Path::new("mod.rs") {
+            continue;
+        }
+        let own = relative
+            .components()
+            .next()
+            .filter(|_| relative.components().count() > 1)
+            .map(|c| c.as_os_str().to_string_lossy().into_owned());
+        let source = std::fs::read_to_string(&file).expect("readable source");
+        let source = without_tests(&source);
+        let named: BTreeSet<String> = ["processes::", "super::", "super::super::"]
+            .iter()
+            .flat_map(|prefix| named_after(source, prefix))
+            .collect();
+        for other in named.intersection(&processes) {
+            if own.as_ref() != Some(other) {
+                trespasses.push(format!("{} names the process {other}", relative.display()));
+            }
+        }
+    }
+    assert!(trespasses.is_empty(), "{trespasses:#?}");
+}
+
+#[test]
+fn the_process_scan_sees_every_way_to_name_a_module() {
+    let source = "use super::{a, b::c};\nuse crate::processes::d::e;\nuse super::super::f;\n";
+    let named: BTreeSet<String> = ["processes::", "super::", "super::super::"]
+        .iter()
+        .flat_map(|prefix| named_after(source, prefix))
+        .collect();
+    assert_eq!(
+        named,
+        ["a", "b", "d", "f", "super"]
+            .into_iter()
+            .map(String::from)
+            .collect()
+    );
 }

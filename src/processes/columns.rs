@@ -74,13 +74,13 @@ pub fn metres(height: f64) -> String {
 }
 
 /// The contact index `k` of a `c<k>` column.
-fn contact_index(name: &str) -> Option<usize> {
+pub fn contact_index(name: &str) -> Option<usize> {
     name.strip_prefix('c')?.parse().ok()
 }
 
 /// The pin and where of a `p<pin>` column (`at its tip`), or a `p<pin>@<height>` one,
 /// with the axis letter of a hexagonal bundle's `p<pin>x` columns when `axes`.
-fn deflection(name: &str, axes: bool) -> Option<(usize, Option<char>, String)> {
+pub fn deflection(name: &str, axes: bool) -> Option<(usize, Option<char>, String)> {
     let (line, at) = match name.strip_prefix('p')?.split_once('@') {
         Some((line, height)) => (line, metres(height.parse().ok()?)),
         None => (name.strip_prefix('p')?, "its tip".to_owned()),
@@ -96,7 +96,7 @@ fn deflection(name: &str, axes: bool) -> Option<(usize, Option<char>, String)> {
 }
 
 /// A row's body as the results write it (`"wall"` or a pin number): `wall`, `p3`.
-fn body(value: &serde_json::Value) -> Option<String> {
+pub fn body(value: &serde_json::Value) -> Option<String> {
     match value {
         serde_json::Value::String(wall) => Some(wall.clone()),
         serde_json::Value::Number(pin) => Some(format!("p{pin}")),
@@ -104,115 +104,9 @@ fn body(value: &serde_json::Value) -> Option<String> {
     }
 }
 
-/// A column of `bundle-dynamics`: `c<k>` the force (N) of contact k of the results'
-/// `contacts`, `p<pin>[@<height>]` a pin's deflection (m).
-pub fn row(output: &str, name: &str, document: &serde_json::Value) -> Option<Column> {
-    let description = match output.trim_end_matches("_peaks") {
-        "contact_forces" => {
-            let contact = &document["contacts"][contact_index(name)?];
-            let height = contact["height"].as_f64()?;
-            let (left, right) = (body(&contact["left"])?, body(&contact["right"])?);
-            ("N", format!("contact {left}–{right} at {}", metres(height)))
-        }
-        "displacements" => {
-            let (pin, _, at) = deflection(name, false)?;
-            (
-                "m",
-                format!("deflection of p{pin} at {at}, toward the right wall, relative to the pin feet"),
-            )
-        }
-        _ => return None,
-    };
-    Some(Column::new(name, description.0, of_output(output, description.1)))
-}
-
-/// A column of `hex-bundle-dynamics`: `c<k>` the force (N, along the contact's normal) of
-/// contact k of the results' `contacts`, `p<pin><x|y>[@<height>]` a pin's deflection (m).
-pub fn hex(output: &str, name: &str, document: &serde_json::Value) -> Option<Column> {
-    let description = match output.trim_end_matches("_peaks") {
-        "contact_forces" => {
-            let contact = &document["contacts"][contact_index(name)?];
-            let height = contact["height"].as_f64()?;
-            let wire = contact["wire_pin"].as_u64()?;
-            let touched = match (contact["touched_pin"].as_u64(), contact["touched_flat"].as_u64()) {
-                (Some(pin), _) => format!("the clad of p{pin}"),
-                (None, Some(flat)) => format!("wrapper flat {flat}"),
-                (None, None) => return None,
-            };
-            (
-                "N",
-                format!("contact of p{wire}'s wire on {touched} at {}", metres(height)),
-            )
-        }
-        "displacements" => {
-            let (pin, axis, at) = deflection(name, true)?;
-            (
-                "m",
-                format!(
-                    "deflection of p{pin} along {} at {at}, relative to the pin feet",
-                    axis.unwrap_or('x')
-                ),
-            )
-        }
-        _ => return None,
-    };
-    Some(Column::new(name, description.0, of_output(output, description.1)))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn row_and_hex_columns_name_their_bodies_heights_and_units() {
-        let row_document = serde_json::json!({"contacts": [
-            {"left": "wall", "right": 0, "height": 0.18},
-            {"left": 0, "right": 1, "height": 0.18}]});
-        let force = row("contact_forces", "c0", &row_document).unwrap();
-        assert_eq!(force.long_header(), "c0 [N] contact wall–p0 at 0.18 m");
-        assert_eq!(
-            row("contact_forces", "c1", &row_document)
-                .unwrap()
-                .description
-                .unwrap(),
-            "contact p0–p1 at 0.18 m"
-        );
-        assert!(row("contact_forces", "c2", &row_document).is_none());
-        let tip = row("displacements", "p1", &row_document).unwrap();
-        assert_eq!(tip.unit.as_deref(), Some("m"));
-        assert!(
-            tip.description
-                .unwrap()
-                .starts_with("deflection of p1 at its tip")
-        );
-        let mid = row("displacements_peaks", "p1@0.9", &row_document).unwrap();
-        assert!(mid.description.unwrap().starts_with("deflection of p1 at 0.9 m"));
-
-        let hex_document = serde_json::json!({"contacts": [
-            {"wire_pin": 3, "touched_pin": 10, "touched_flat": null, "height": 0.45},
-            {"wire_pin": 8, "touched_pin": null, "touched_flat": 2, "height": 0.6}]});
-        assert_eq!(
-            hex("contact_forces", "c0", &hex_document)
-                .unwrap()
-                .description
-                .unwrap(),
-            "contact of p3's wire on the clad of p10 at 0.45 m"
-        );
-        assert_eq!(
-            hex("contact_forces", "c1", &hex_document)
-                .unwrap()
-                .description
-                .unwrap(),
-            "contact of p8's wire on wrapper flat 2 at 0.6 m"
-        );
-        assert!(
-            hex("displacements", "p12y@0.3", &hex_document)
-                .unwrap()
-                .description
-                .unwrap()
-                .starts_with("deflection of p12 along y at 0.3 m")
-        );
-    }
 
     #[test]
     fn the_long_header_starts_with_the_short_name() {

@@ -34,6 +34,8 @@ pub mod random_gaps;
 pub mod report;
 /// Every missing member at once, with the other problems of the inputs.
 pub mod required;
+/// What every run of pins with point contacts reports: per contact, per line, the run.
+pub mod run_report;
 /// The `signal` base acceleration: a stored accelerogram by id, or a file for the CLI.
 pub mod signal_input;
 /// A process described by its types, and the one adapter to [`Process`].
@@ -60,6 +62,14 @@ pub use columns::Column;
 pub use cost::{CostLimits, TooCostly, WorkEstimate};
 pub use simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 pub use warnings::Warning;
+
+/// A shipped example of a process: its file in `examples/` and the execution request it
+/// holds (`{"inputs": …}`), embedded in the binary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Example {
+    pub file: &'static str,
+    pub body: &'static str,
+}
 
 /// One problem with the inputs: where (JSON pointer into the request body) and why.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -218,6 +228,10 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     fn id(&self) -> &'static str;
     /// One-line title.
     fn title(&self) -> &'static str;
+    /// Its shipped examples (none by default).
+    fn examples(&self) -> &'static [Example] {
+        &[]
+    }
     /// A paragraph for the process list.
     fn description(&self) -> &'static str;
     /// OGC process description `inputs` object: `{name: {title, description, schema}}`.

@@ -11,36 +11,25 @@
 use proptest::prelude::*;
 use serde_json::Value;
 
-use super::Process;
-use super::bundle_dynamics::BundleDynamics;
-use super::cantilever_impact::CantileverImpact;
+use std::sync::Arc;
 
-/// The shipped execution examples, with their process.
-fn examples() -> Vec<(&'static str, &'static dyn Process, Value)> {
+use super::Process;
+
+/// The shipped execution examples of every process of the registry, with their process.
+fn examples() -> Vec<(&'static str, Arc<dyn Process>, Value)> {
     let parse =
         |text: &str| serde_json::from_str::<Value>(text).expect("examples are JSON")["inputs"].clone();
-    vec![
-        (
-            "cantilever-impact",
-            &CantileverImpact as &dyn Process,
-            parse(include_str!("../../examples/cantilever-impact.json")),
-        ),
-        (
-            "bundle-row17",
-            &BundleDynamics,
-            parse(include_str!("../../examples/bundle-row17.json")),
-        ),
-        (
-            "bundle-random-gaps",
-            &BundleDynamics,
-            parse(include_str!("../../examples/bundle-random-gaps.json")),
-        ),
-        (
-            "bundle-local-closure",
-            &BundleDynamics,
-            parse(include_str!("../../examples/bundle-local-closure.json")),
-        ),
-    ]
+    let registry = super::Registry::builtin();
+    let all: Vec<_> = (registry.all().iter())
+        .flat_map(|process| {
+            process
+                .examples()
+                .iter()
+                .map(move |e| (e.file, process.clone(), parse(e.body)))
+        })
+        .collect();
+    assert!(all.len() >= 3, "too few examples: {}", all.len());
+    all
 }
 
 /// Pointers of every value in `value` (the root is `""`), objects only if `objects_only`.
@@ -304,10 +293,11 @@ proptest! {
 
     #[test]
     fn mutated_examples_are_accepted_or_refused_with_pointers_never_panic(
-        example in 0usize..4,
+        example in any::<prop::sample::Index>(),
         mutations in prop::collection::vec(mutation(), 1..4),
     ) {
-        let (name, process, mut inputs) = examples().swap_remove(example);
+        let mut all = examples();
+        let (name, process, mut inputs) = all.swap_remove(example.index(all.len()));
         for m in &mutations {
             apply(&mut inputs, m);
         }

@@ -83,6 +83,9 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
     /// Whether a run shares its steps between the threads `solver.threads` asks for
     /// (a worker then grants it up to that many cores; otherwise one).
     const SHARES_STEPS: bool = false;
+    /// Its shipped examples (`examples/`): the dashboard's templates, checked by the tests
+    /// that go through every example.
+    const EXAMPLES: &'static [super::Example] = &[];
 
     /// The `inputs` object of an execution request (unknown fields refused).
     type Inputs: DeserializeOwned + ToSchema;
@@ -163,6 +166,10 @@ impl<S: Simulation> Process for S {
         } else {
             1
         }
+    }
+
+    fn examples(&self) -> &'static [super::Example] {
+        S::EXAMPLES
     }
 
     fn title(&self) -> &'static str {

@@ -188,6 +188,27 @@ fn a_bundle_results_document_is_what_its_schema_says_in_both_forms() {
     assert_matches_its_schema(&BundleDynamics, "BundleResults", &output);
 }
 
+/// Every process of the registry, on its first shipped example cut to 2 ms: its results
+/// document is what its schema says and its histories are the ones it declares.
+#[test]
+fn every_process_writes_what_its_schema_and_outputs_declare() {
+    let registry = super::Registry::builtin();
+    for process in registry.all() {
+        let example = process.examples().first().unwrap_or_else(|| panic!("{} has no example", process.id()));
+        let mut inputs = serde_json::from_str::<Value>(example.body).expect("JSON")["inputs"].clone();
+        inputs["solver"]["duration"] = json!(0.002);
+        let output = run(process.as_ref(), &inputs);
+        // The results schema: the one the adapter gives its `warnings` member.
+        let components = components(process.as_ref());
+        let results = components
+            .iter()
+            .find(|(_, schema)| schema["allOf"][1]["properties"].get("warnings").is_some())
+            .map(|(name, _)| name.clone())
+            .unwrap_or_else(|| panic!("{}: no results schema", process.id()));
+        assert_matches_its_schema(process.as_ref(), &results, &output);
+    }
+}
+
 #[test]
 fn the_shape_check_sees_an_unknown_and_a_missing_property() {
     let components = HashMap::new();

@@ -3,27 +3,15 @@
 //! reports utilisations, friction and Archard wear that follow from its own numbers by
 //! their definitions (peak over allowable, K P t and the geometry's depth).
 
-use std::sync::Arc;
-
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use chocmodal::processes::bundle_dynamics::BundleDynamics;
-use chocmodal::processes::cantilever_impact::CantileverImpact;
-use chocmodal::processes::hex_bundle_dynamics::HexBundleDynamics;
+use chocmodal::processes::Registry;
 
 use crate::helpers::{TestApp, assert_problem, spawn_app_with_processes};
 
 async fn spawn() -> TestApp {
-    spawn_app_with_processes(
-        vec![
-            Arc::new(BundleDynamics),
-            Arc::new(HexBundleDynamics),
-            Arc::new(CantileverImpact),
-        ],
-        |_| {},
-    )
-    .await
+    spawn_app_with_processes(Registry::builtin().all().to_vec(), |_| {}).await
 }
 
 fn pin() -> Value {

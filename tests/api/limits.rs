@@ -2,12 +2,9 @@
 //! and the limit; every run of a sweep), the per-tenant limit on queued jobs (429 with
 //! `Retry-After`), the wall-time limit of a job, and the cap on history responses.
 
-use std::sync::Arc;
 use std::time::Duration;
 
-use chocmodal::processes::bundle_dynamics::BundleDynamics;
-use chocmodal::processes::cantilever_impact::CantileverImpact;
-use chocmodal::processes::{CostLimits, Process};
+use chocmodal::processes::{CostLimits, Registry};
 use chocmodal::service::auth::TokenTable;
 use reqwest::StatusCode;
 use serde_json::{Value, json};
@@ -27,8 +24,7 @@ fn example(name: &str) -> Value {
 
 /// The real processes, no workers (nothing accepted here needs to run).
 async fn spawn_validating(limits: CostLimits) -> TestApp {
-    let processes: Vec<Arc<dyn Process>> = vec![Arc::new(CantileverImpact), Arc::new(BundleDynamics)];
-    spawn_app_with_processes(processes, move |config| {
+    spawn_app_with_processes(Registry::builtin().all().to_vec(), move |config| {
         config.workers = 0;
         config.limits = limits;
     })
@@ -117,19 +113,13 @@ async fn histories_above_the_ceiling_point_at_the_output_interval() {
 #[tokio::test]
 async fn the_shipped_examples_pass_the_default_ceilings() {
     let app = spawn_validating(CostLimits::default()).await;
-    for (process, name) in [
-        ("cantilever-impact", "cantilever-impact.json"),
-        ("bundle-dynamics", "bundle-row17.json"),
-        ("bundle-dynamics", "bundle-random-gaps.json"),
-        ("bundle-dynamics", "bundle-local-closure.json"),
-        ("bundle-dynamics", "bundle-sine-auto.json"),
-        ("bundle-dynamics", "bundle-minimal-sine.json"),
-        ("bundle-dynamics", "bundle-minimal-table.json"),
-        ("bundle-dynamics", "bundle-haversine.json"),
-        ("bundle-dynamics", "bundle-earthquake.json"),
-    ] {
-        let response = app.post_execution(process, &example(name)).await;
-        assert_eq!(response.status(), StatusCode::CREATED, "{name}");
+    let registry = Registry::builtin();
+    for process in registry.all() {
+        for example in process.examples() {
+            let body: Value = serde_json::from_str(example.body).unwrap();
+            let response = app.post_execution(process.id(), &body).await;
+            assert_eq!(response.status(), StatusCode::CREATED, "{}", example.file);
+        }
     }
     for name in ["sweep-calibration.json", "sweep-gaps.json"] {
         let response = app.post_sweep(&example(name)).await;

@@ -6,11 +6,7 @@
 //! word is an SI unit expression (`(m)`, `(N·s/m)`, `(m/s², ≥ 0)`, `(kg/m³)`) or
 //! `dimensionless`; `degrees` counts for angles. `assets/schema.js` reads it the same way.
 
-use std::sync::Arc;
-
-use chocmodal::processes::bundle_dynamics::BundleDynamics;
-use chocmodal::processes::cantilever_impact::CantileverImpact;
-use chocmodal::processes::hex_bundle_dynamics::HexBundleDynamics;
+use chocmodal::processes::Registry;
 use serde_json::Value;
 
 use crate::helpers::spawn_app_with_processes;
@@ -116,16 +112,9 @@ fn units_are_read_from_the_first_group_that_names_one() {
 
 #[tokio::test]
 async fn every_number_input_states_its_unit_and_every_history_its_kind() {
-    let app = spawn_app_with_processes(
-        vec![
-            Arc::new(CantileverImpact),
-            Arc::new(BundleDynamics),
-            Arc::new(HexBundleDynamics),
-        ],
-        |_| {},
-    )
-    .await;
-    for process in ["cantilever-impact", "bundle-dynamics", "hex-bundle-dynamics"] {
+    let registry = Registry::builtin();
+    let app = spawn_app_with_processes(registry.all().to_vec(), |_| {}).await;
+    for process in registry.all().iter().map(|p| p.id()) {
         let description = app.get_json(&format!("/processes/{process}")).await;
         let mut missing = Vec::new();
         for (name, input) in description["inputs"].as_object().unwrap() {

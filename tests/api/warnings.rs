@@ -10,21 +10,14 @@ use std::sync::Arc;
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use chocmodal::processes::Process;
-use chocmodal::processes::bundle_dynamics::BundleDynamics;
-use chocmodal::processes::cantilever_impact::CantileverImpact;
-use chocmodal::processes::hex_bundle_dynamics::HexBundleDynamics;
+use chocmodal::processes::{Process, Registry};
 
 use crate::helpers::{
     TestApp, TestStore, assert_problem, spawn_app_in_with_processes, spawn_app_with_processes,
 };
 
 fn shipped() -> Vec<Arc<dyn Process>> {
-    vec![
-        Arc::new(CantileverImpact),
-        Arc::new(BundleDynamics),
-        Arc::new(HexBundleDynamics),
-    ]
+    Registry::builtin().all().to_vec()
 }
 
 /// The shipped processes without workers: submissions are only validated and queued.
@@ -37,15 +30,17 @@ fn example(name: &str) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).expect("example")).expect("JSON")
 }
 
-/// The process an example's inputs are for.
-fn process_of(inputs: &Value) -> &'static str {
-    if inputs.get("beam").is_some() {
-        "cantilever-impact"
-    } else if inputs["bundle"].get("rings").is_some() {
-        "hex-bundle-dynamics"
-    } else {
-        "bundle-dynamics"
-    }
+/// The shipped process whose examples include the file `name`.
+fn process_of(name: &str) -> String {
+    let registry = Registry::builtin();
+    let owner = registry
+        .all()
+        .iter()
+        .find(|p| p.examples().iter().any(|e| e.file == name));
+    owner
+        .unwrap_or_else(|| panic!("{name} is no process's example"))
+        .id()
+        .to_owned()
 }
 
 /// Submits `inputs` to `process`: the 201 body.
@@ -138,7 +133,7 @@ async fn the_shipped_examples_get_no_warning() {
         // A sweep's base inputs are a complete request of its process.
         let (process, inputs) = match body["process"].as_str() {
             Some(process) => (process.to_owned(), body["inputs"].clone()),
-            None => (process_of(&body["inputs"]).to_owned(), body["inputs"].clone()),
+            None => (process_of(&name), body["inputs"].clone()),
         };
         let status = accepted(&app, &process, &inputs).await;
         assert_eq!(warnings(&status), [], "{name}: {status}");

@@ -10,18 +10,19 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
+use super::columns;
 use super::common_inputs::{self, SolverDefaults, at};
-use super::contact_law::{self, LawInput, Utilisation};
+use super::contact_law::LawInput;
 use super::excitation::BaseAccelerationInput;
-use super::impact_report::{self, ContactImpacts, ImpactSummary};
+use super::impact_report;
 use super::model_check::{self, StandIn};
-use super::report::{EnergyReport, QualityReport};
+use super::run_report::{self, ContactStatistics, LineExtremes, RunSize, RunSummary};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
-use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
+use super::{Example, FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::{Body, Contact};
 use crate::physics::discretisation::auto::Choice as BasisChoice;
-use crate::physics::integrate::{self, Model, Settings, StepSize};
+use crate::physics::integrate::{self, Model, Settings, Simulation as Run, StepSize};
 use crate::physics::modal::ModalBasis;
 use inputs::{BodyInput, BundleInputs, ContactInput};
 
@@ -149,31 +150,10 @@ pub struct BundleResults {
     /// Every contact (the expanded list for the generator form) and its statistics,
     /// accumulated at every step.
     pub contacts: Vec<ContactResult>,
-    /// The largest force over all contacts; null without contacts.
-    pub max_contact_force: Option<PeakForce>,
-    /// The contact of largest utilisation (peak force over allowable force); absent
-    /// when no law gives an allowable force.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub max_utilisation: Option<Utilisation>,
-    /// Impacts over all contacts, as `output.impacts` counts them.
-    pub impacts: u64,
-    /// The run's impacts: counting, totals, histogram, contacts ranked.
-    pub impact_summary: ImpactSummary,
     /// Per pin, its largest deflection.
     pub pins: Vec<PinResult>,
-    pub energy: EnergyReport,
-    /// Step used (s).
-    pub time_step: f64,
-    /// Critical step with every contact closed (s).
-    pub critical_time_step: f64,
-    /// Steps taken.
-    pub steps: u64,
-    /// Time between two history samples (s).
-    pub output_interval: f64,
-    pub quality: QualityReport,
-    /// Frequencies of the pin's basis (Hz), eigenmodes then pseudo-modes.
-    pub frequencies_hz: Vec<f64>,
-    pub basis: BasisReport,
+    #[serde(flatten)]
+    pub run: RunSummary,
     /// The generator form's expansion (absent for the explicit form).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub expansion: Option<Expansion>,
@@ -184,81 +164,16 @@ pub struct BundleResults {
 pub struct ContactResult {
     #[serde(flatten)]
     pub contact: ContactInput,
-    /// Largest force (N).
-    pub max_force: f64,
-    /// Its time (s); 0 when the contact never closed.
-    pub max_force_time: f64,
-    /// Closures after a separation (the first counts).
-    pub impacts: u64,
-    /// Total time closed (s).
-    pub contact_time: f64,
-    /// ∫ F dt (N·s).
-    pub impulse: f64,
-    /// Time of the first closure (s), interpolated between steps; null if none.
-    pub first_impact_time: Option<f64>,
-    /// Largest penetration (m); ≤ 0 when the contact never closed (smallest clearance).
-    pub max_penetration: f64,
-    /// Its impacts as `output.impacts` counts them (`impacts` above is their number).
-    pub impact_statistics: ContactImpacts,
-    /// `max_force` over the law's `allowable_force`; absent without one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub utilisation: Option<f64>,
-}
-
-/// The largest contact force of the run.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
-pub struct PeakForce {
-    /// Contact index.
-    pub contact: usize,
-    /// Force (N).
-    pub force: f64,
-    /// Time (s).
-    pub time: f64,
+    #[serde(flatten)]
+    pub statistics: ContactStatistics,
 }
 
 /// One pin's largest deflections.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 pub struct PinResult {
     pub pin: usize,
-    /// max |w| (m) over the mesh nodes at every output time.
-    pub max_abs_deflection: f64,
-    /// Height where it occurred (m).
-    pub height: f64,
-    /// When (s).
-    pub time: f64,
-    /// Per output height, the deflection of largest magnitude over every step (the
-    /// extreme of its `displacements_peaks` column).
-    pub peak_deflections: Vec<PeakDeflectionResult>,
-}
-
-/// The deflection of largest magnitude at one height, over every step.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
-pub struct PeakDeflectionResult {
-    /// Height (m).
-    pub height: f64,
-    /// Signed deflection (m).
-    pub deflection: f64,
-    /// The end of the output interval that holds it (s).
-    pub time: f64,
-}
-
-impl PeakDeflectionResult {
-    /// Line `line`'s peak at each output height of a run.
-    pub fn of_line(
-        heights: &[f64],
-        peaks: &[Vec<crate::physics::integrate::PeakDeflection>],
-        line: usize,
-    ) -> Vec<Self> {
-        heights
-            .iter()
-            .zip(peaks)
-            .map(|(height, per_line)| Self {
-                height: *height,
-                deflection: per_line[line].deflection,
-                time: per_line[line].time,
-            })
-            .collect()
-    }
+    #[serde(flatten)]
+    pub extremes: LineExtremes,
 }
 
 /// The explicit model the generator form expands to.
@@ -294,6 +209,48 @@ impl Simulation for BundleDynamics {
          pins and against the walls, under a base acceleration of the wrapper, initial releases and point \
          forces. Returns per-contact statistics (peak force, impacts, contact time, impulse), per-pin \
          extremes, the energy balance, and contact-force and deflection histories.";
+    const EXAMPLES: &'static [Example] = &[
+        Example {
+            file: "bundle-row17.json",
+            body: include_str!("../../../examples/bundle-row17.json"),
+        },
+        Example {
+            file: "bundle-random-gaps.json",
+            body: include_str!("../../../examples/bundle-random-gaps.json"),
+        },
+        Example {
+            file: "bundle-local-closure.json",
+            body: include_str!("../../../examples/bundle-local-closure.json"),
+        },
+        Example {
+            file: "bundle-sine-auto.json",
+            body: include_str!("../../../examples/bundle-sine-auto.json"),
+        },
+        Example {
+            file: "bundle-minimal-sine.json",
+            body: include_str!("../../../examples/bundle-minimal-sine.json"),
+        },
+        Example {
+            file: "bundle-minimal-table.json",
+            body: include_str!("../../../examples/bundle-minimal-table.json"),
+        },
+        Example {
+            file: "bundle-haversine.json",
+            body: include_str!("../../../examples/bundle-haversine.json"),
+        },
+        Example {
+            file: "bundle-earthquake.json",
+            body: include_str!("../../../examples/bundle-earthquake.json"),
+        },
+        Example {
+            file: "bundle-row12-shock.json",
+            body: include_str!("../../../examples/bundle-row12-shock.json"),
+        },
+        Example {
+            file: "sdnl104c.json",
+            body: include_str!("../../../examples/sdnl104c.json"),
+        },
+    ];
     const HISTORIES: &'static [HistoryOutput] = &[
         HistoryOutput {
             name: "contact_forces",
@@ -329,7 +286,7 @@ impl Simulation for BundleDynamics {
     type Plan = Plan;
 
     fn column(output: &str, name: &str, document: &serde_json::Value) -> Option<super::Column> {
-        super::columns::row(output, name, document)
+        column_of(output, name, document)
     }
 
     fn signals(inputs: &mut BundleInputs) -> Vec<super::signal_input::SignalSlot<'_>> {
@@ -471,46 +428,25 @@ impl Simulation for BundleDynamics {
         })
     }
 
-    /// pins × modes modal DOFs and every contact at each step; histories
-    /// `contact_forces` (time + one column per contact) and `displacements` (time + one
-    /// column per pin and output height), and their peaks.
+    /// One line per pin, every contact recorded ([`RunSize::estimate`]).
     fn estimate(plan: &Plan) -> WorkEstimate {
-        let (stepping, samples) = common_inputs::stepping(&plan.settings, &plan.step);
-        let stepping = common_inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "pin");
-        let columns = 2 * ((1 + plan.contacts.len()) + (1 + plan.pins * plan.settings.output_heights.len()));
-        let generated = plan.inputs.bundle.is_some();
-        let (pins, contacts) = if generated {
-            ("/inputs/bundle/pins", "/inputs/bundle/levels")
-        } else {
-            ("/inputs/pins", "/inputs/contacts")
+        let (pins, contacts) = match plan.inputs.bundle.is_some() {
+            true => ("/inputs/bundle/pins", "/inputs/bundle/levels"),
+            false => ("/inputs/pins", "/inputs/contacts"),
         };
-        let mut history_drivers = vec![
-            "/inputs/solver/duration".to_owned(),
-            "/inputs/output/interval".to_owned(),
-            pins.to_owned(),
-        ];
-        if plan.inputs.output.heights.is_some() {
-            history_drivers.push("/inputs/output/heights".to_owned());
+        RunSize {
+            settings: &plan.settings,
+            step: &plan.step,
+            choice: plan.basis_choice.as_ref(),
+            lines: plan.pins,
+            modes: plan.basis.modes(),
+            contacts: plan.contacts.len(),
+            recorded: plan.contacts.len(),
+            work_drivers: &[pins, contacts],
+            history_drivers: &[pins],
+            heights_given: plan.inputs.output.heights.is_some(),
         }
-        history_drivers.push("/inputs/output/impacts/max_rows".to_owned());
-        let table =
-            impact_report::table_values(&plan.settings.impacts, plan.contacts.len(), stepping.pass_steps);
-        WorkEstimate {
-            modal_dofs: (plan.pins * plan.basis.modes()) as f64,
-            contacts: plan.contacts.len() as f64,
-            history_values: samples * columns as f64 + table,
-            work_drivers: [
-                "/inputs/solver/duration",
-                "/inputs/solver/time_step",
-                "/inputs/pin/modes",
-                pins,
-                contacts,
-            ]
-            .map(str::to_owned)
-            .to_vec(),
-            history_drivers,
-            ..stepping
-        }
+        .estimate()
     }
 
     fn metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
@@ -540,72 +476,36 @@ impl Simulation for BundleDynamics {
             .map(|(k, c)| plan.inputs.law_of(c, k).0)
             .collect();
         let allowables: Vec<Option<f64>> = laws.iter().map(LawInput::allowable).collect();
-        let peaks: Vec<f64> = simulation
-            .contact_statistics
-            .iter()
-            .map(|s| s.max_force)
-            .collect();
-        let contacts: Vec<ContactResult> = plan
-            .contacts
-            .iter()
-            .zip(&simulation.contact_statistics)
-            .zip(impact_report::contact_reports(&simulation))
-            .zip(laws.iter().zip(&allowables))
-            .map(|(((c, s), impact_statistics), (law, allowable))| ContactResult {
+        let contacts: Vec<ContactResult> = (plan.contacts.iter().zip(&laws))
+            .zip(ContactStatistics::of_run(&simulation, &allowables))
+            .map(|((c, law), statistics)| ContactResult {
                 contact: ContactInput::echo(c, *law),
-                utilisation: contact_law::utilisation(s.max_force, *allowable),
-                max_force: s.max_force,
-                max_force_time: s.max_force_time,
-                impacts: s.impacts,
-                contact_time: s.contact_time,
-                impulse: s.impulse,
-                first_impact_time: s.first_impact_time,
-                max_penetration: s.max_penetration,
-                impact_statistics,
+                statistics,
             })
             .collect();
-        let max_contact_force = simulation
-            .contact_statistics
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.max_force.total_cmp(&b.1.max_force))
-            .map(|(k, s)| PeakForce {
-                contact: k,
-                force: s.max_force,
-                time: s.max_force_time,
-            });
         let heights = &plan.settings.output_heights;
-        let pins: Vec<PinResult> = simulation
-            .pin_extremes
-            .iter()
-            .enumerate()
-            .map(|(p, e)| PinResult {
+        let pins: Vec<PinResult> = (0..plan.pins)
+            .map(|p| PinResult {
                 pin: p,
-                max_abs_deflection: e.max_abs_deflection,
-                height: e.height,
-                time: e.time,
-                peak_deflections: PeakDeflectionResult::of_line(heights, &simulation.peak_deflections, p),
+                extremes: LineExtremes::of_line(&simulation, heights, p),
             })
             .collect();
+        let basis = BasisReport::of(
+            &model,
+            plan.settings.scheme,
+            simulation.step.critical_time_step,
+            (&plan.inputs.pin, plan.basis_choice.as_ref()),
+        );
         let results = BundleResults {
             contacts,
-            max_contact_force,
-            max_utilisation: contact_law::worst(&peaks, &allowables),
-            impacts: simulation.contact_statistics.iter().map(|s| s.impacts).sum(),
-            impact_summary: impact_report::summary(&simulation, &plan.settings.impacts),
             pins,
-            energy: simulation.energy.into(),
-            time_step: simulation.step.time_step,
-            critical_time_step: simulation.step.critical_time_step,
-            steps: simulation.steps,
-            output_interval: simulation.output_interval,
-            quality,
-            frequencies_hz: plan.basis.frequencies_hz(),
-            basis: BasisReport::of(
-                &model,
-                plan.settings.scheme,
-                simulation.step.critical_time_step,
-                (&plan.inputs.pin, plan.basis_choice.as_ref()),
+            run: RunSummary::of(
+                &simulation,
+                quality,
+                &plan.settings,
+                &allowables,
+                basis,
+                plan.basis.frequencies_hz(),
             ),
             expansion: plan.inputs.bundle.is_some().then(|| Expansion {
                 pins: plan.pins,
@@ -649,45 +549,46 @@ fn bundle_metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Valu
     metrics
 }
 
-fn histories(prepared: &Plan, simulation: crate::physics::integrate::Simulation) -> Vec<History> {
-    let tips_only = prepared.inputs.output.heights.is_none();
-    let mut displacement_series = Vec::new();
-    for (h, per_pin) in simulation.deflections.into_iter().enumerate() {
-        let height = prepared.settings.output_heights[h];
-        for (p, values) in per_pin.into_iter().enumerate() {
-            let name = if tips_only {
-                format!("p{p}")
-            } else {
-                format!("p{p}@{height}")
-            };
-            displacement_series.push((name, values));
+fn histories(plan: &Plan, simulation: Run) -> Vec<History> {
+    let contacts: Vec<String> = (0..plan.contacts.len()).map(|k| format!("c{k}")).collect();
+    let tips_only = plan.inputs.output.heights.is_none();
+    let deflections =
+        run_report::deflection_names(&plan.settings.output_heights, plan.pins, tips_only, |p| {
+            format!("p{p}")
+        });
+    run_report::histories(simulation, &contacts, &deflections)
+}
+
+/// A column of `bundle-dynamics`: `c<k>` the force (N) of contact k of the results'
+/// `contacts`, `p<pin>[@<height>]` a pin's deflection (m).
+fn column_of(output: &str, name: &str, document: &serde_json::Value) -> Option<super::Column> {
+    let description = match output.trim_end_matches("_peaks") {
+        "contact_forces" => {
+            let contact = &document["contacts"][columns::contact_index(name)?];
+            let height = contact["height"].as_f64()?;
+            let (left, right) = (
+                columns::body(&contact["left"])?,
+                columns::body(&contact["right"])?,
+            );
+            (
+                "N",
+                format!("contact {left}–{right} at {}", columns::metres(height)),
+            )
         }
-    }
-    let named = |prefix: &str, columns: Vec<Vec<f64>>| -> Vec<(String, Vec<f64>)> {
-        columns
-            .into_iter()
-            .enumerate()
-            .map(|(c, v)| (format!("{prefix}{c}"), v))
-            .collect()
+        "displacements" => {
+            let (pin, _, at) = columns::deflection(name, false)?;
+            (
+                "m",
+                format!("deflection of p{pin} at {at}, toward the right wall, relative to the pin feet"),
+            )
+        }
+        _ => return None,
     };
-    let peak_series = displacement_series
-        .iter()
-        .map(|(name, _)| name.clone())
-        .zip(simulation.deflection_peaks.into_iter().flatten())
-        .collect();
-    let history = |name: &str, series| History {
-        name: name.into(),
-        time: simulation.time.clone(),
-        series,
-    };
-    let table = impact_report::table_history(&simulation.impact_table);
-    vec![
-        history("contact_forces", named("c", simulation.contact_forces)),
-        history("displacements", displacement_series),
-        history("contact_forces_peaks", named("c", simulation.contact_force_peaks)),
-        history("displacements_peaks", peak_series),
-        table,
-    ]
+    Some(super::Column::new(
+        name,
+        description.0,
+        columns::of_output(output, description.1),
+    ))
 }
 
 #[cfg(test)]

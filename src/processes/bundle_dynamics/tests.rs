@@ -411,3 +411,29 @@ fn wall_motions_are_exclusive_and_checked() {
     held["pin"]["supports"] = json!({"foot": "clamped", "top": "pinned"});
     assert_eq!(pointers(&held), ["/inputs/excitation/left_wall_acceleration"]);
 }
+
+#[test]
+fn its_columns_name_their_bodies_heights_and_units() {
+    let row_document = serde_json::json!({"contacts": [
+        {"left": "wall", "right": 0, "height": 0.18},
+        {"left": 0, "right": 1, "height": 0.18}]});
+    let force = column_of("contact_forces", "c0", &row_document).unwrap();
+    assert_eq!(force.long_header(), "c0 [N] contact wall–p0 at 0.18 m");
+    assert_eq!(
+        column_of("contact_forces", "c1", &row_document)
+            .unwrap()
+            .description
+            .unwrap(),
+        "contact p0–p1 at 0.18 m"
+    );
+    assert!(column_of("contact_forces", "c2", &row_document).is_none());
+    let tip = column_of("displacements", "p1", &row_document).unwrap();
+    assert_eq!(tip.unit.as_deref(), Some("m"));
+    assert!(
+        tip.description
+            .unwrap()
+            .starts_with("deflection of p1 at its tip")
+    );
+    let mid = column_of("displacements_peaks", "p1@0.9", &row_document).unwrap();
+    assert!(mid.description.unwrap().starts_with("deflection of p1 at 0.9 m"));
+}

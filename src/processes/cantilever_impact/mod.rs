@@ -15,7 +15,7 @@ use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::{Subject, WarningsInput};
-use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
+use super::{Example, FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::InputIssue;
 use crate::physics::contact::{Body, Contact};
 use crate::physics::discretisation::auto::Choice as BasisChoice;
@@ -425,6 +425,10 @@ impl Simulation for CantileverImpact {
          truncated modal basis with a penalty contact (central difference or Tchamwa-Wielgosz), solves the \
          same problem semi-analytically (exact up to modal truncation), and compares the tip-deflection \
          spectra with f_err (validity threshold 0.2).";
+    const EXAMPLES: &'static [Example] = &[Example {
+        file: "cantilever-impact.json",
+        body: include_str!("../../../examples/cantilever-impact.json"),
+    }];
     const HISTORIES: &'static [HistoryOutput] = &[
         HistoryOutput {
             name: "tip_displacement",

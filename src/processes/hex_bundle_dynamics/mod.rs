@@ -15,14 +15,15 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
+use super::columns;
 use super::common_inputs::{self, SolverDefaults, at};
-use super::contact_law::{self, FrictionReport, LawInput, Utilisation, WearDepth, WearReport};
+use super::contact_law::{FrictionReport, LawInput, WearDepth, WearReport};
 use super::excitation::{PlaneSignal, plane_signal};
-use super::impact_report::{self, ContactImpacts, ImpactSummary};
-use super::report::{EnergyReport, QualityReport};
+use super::impact_report;
+use super::run_report::{self, ContactStatistics, LineExtremes, RunSize, RunSummary};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
-use super::{FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
+use super::{Example, FieldError, History, InvalidInputs, ProgressFn, RunError, WorkEstimate};
 use crate::physics::contact::{Body as RowBody, Contact};
 use crate::physics::discretisation::auto::{self, Choice as BasisChoice};
 use crate::physics::hex::{Aim, Body, HexBundle, HexContact, pair_count};
@@ -30,7 +31,6 @@ use crate::physics::integrate::{self, Model, Plane, Settings, StepSize, WallMoti
 use crate::physics::loads::BaseAcceleration;
 use crate::physics::modal::ModalBasis;
 use crate::physics::{InputIssue, require_non_negative};
-use crate::processes::bundle_dynamics::{PeakDeflectionResult, PeakForce};
 use inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
 use loads::PlaneLoads;
 
@@ -106,37 +106,15 @@ pub struct HexResults {
     /// Every contact (bodies, level, normal, gap) and its statistics, accumulated at
     /// every step.
     pub contacts: Vec<HexContactResult>,
-    /// The largest force over all contacts; null without contacts.
-    pub max_contact_force: Option<PeakForce>,
-    /// The contact of largest utilisation (peak force over allowable force); absent
-    /// when no law gives an allowable force.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub max_utilisation: Option<Utilisation>,
     /// The contact worn deepest after `output.service_time`; absent without wear laws.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_wear_depth: Option<WearDepth>,
-    /// Impacts over all contacts, as `output.impacts` counts them.
-    pub impacts: u64,
-    /// The run's impacts: counting, totals, histogram, contacts ranked.
-    pub impact_summary: ImpactSummary,
     /// Contacts whose force histories were recorded (`c<k>` columns), in column order.
     pub recorded_contacts: Vec<usize>,
     /// Per pin: position and largest deflections along x and y.
     pub pins: Vec<HexPinResult>,
-    pub energy: EnergyReport,
-    /// Step used (s).
-    pub time_step: f64,
-    /// Critical step with every contact closed (s).
-    pub critical_time_step: f64,
-    /// Steps taken.
-    pub steps: u64,
-    /// Time between two history samples (s).
-    pub output_interval: f64,
-    pub quality: QualityReport,
-    /// Frequencies of the pin's basis (Hz), eigenmodes then pseudo-modes (the same in x
-    /// and y).
-    pub frequencies_hz: Vec<f64>,
-    pub basis: BasisReport,
+    #[serde(flatten)]
+    pub run: RunSummary,
 }
 
 /// The generated bundle.
@@ -197,29 +175,12 @@ pub struct HexContactResult {
     pub normal: [f64; 2],
     /// Gap at rest (m).
     pub gap: f64,
-    /// Largest force (N).
-    pub max_force: f64,
-    /// Its time (s); 0 when the contact never closed.
-    pub max_force_time: f64,
-    /// Impacts, as `output.impacts` counts them (default: closures after a separation).
-    pub impacts: u64,
-    /// Total time closed (s).
-    pub contact_time: f64,
-    /// ∫ F dt (N·s), along the normal.
-    pub impulse: f64,
-    /// Time of the first closure (s), interpolated between steps; null if none.
-    pub first_impact_time: Option<f64>,
-    /// Largest penetration (m); ≤ 0 when the contact never closed (smallest clearance).
-    pub max_penetration: f64,
+    #[serde(flatten)]
+    pub statistics: ContactStatistics,
     /// Wear work rate (1/T) ∫ F·|v_t| dt (W), v_t the sliding velocity across the normal,
     /// over the steps the contact slips when its law has friction (code_aster's
     /// PUIS_USURE), over every closed step without: the P of Archard's wear.
     pub wear_work_rate: f64,
-    /// Its impacts as `output.impacts` counts them (`impacts` above is their number).
-    pub impact_statistics: ContactImpacts,
-    /// `max_force` over its law's `allowable_force`; absent without one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub utilisation: Option<f64>,
     /// Its friction (absent when its law has none).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<FrictionReport>,
@@ -237,22 +198,9 @@ pub struct HexPinResult {
     /// Centre (x, y) in the wrapper (m).
     pub position: [f64; 2],
     /// Bending along x.
-    pub x: DirectionResult,
+    pub x: LineExtremes,
     /// Bending along y.
-    pub y: DirectionResult,
-}
-
-/// A pin's largest deflections along one direction.
-#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
-pub struct DirectionResult {
-    /// max |w| (m) over the mesh nodes at every output time.
-    pub max_abs_deflection: f64,
-    /// Height where it occurred (m).
-    pub height: f64,
-    /// When (s).
-    pub time: f64,
-    /// Per output height, the deflection of largest magnitude over every step.
-    pub peak_deflections: Vec<PeakDeflectionResult>,
+    pub y: LineExtremes,
 }
 
 /// The `hex-bundle-dynamics` process.
@@ -270,6 +218,20 @@ impl Simulation for HexBundleDynamics {
          Returns every contact with its statistics (peak force, impacts, contact time, impulse, wear \
          work rate), per-pin extremes, the energy balance, force histories of a selection of \
          contacts and the pins' deflection histories.";
+    const EXAMPLES: &'static [Example] = &[
+        Example {
+            file: "hex217.json",
+            body: include_str!("../../../examples/hex217.json"),
+        },
+        Example {
+            file: "hex7-loads.json",
+            body: include_str!("../../../examples/hex7-loads.json"),
+        },
+        Example {
+            file: "hex7-fretting.json",
+            body: include_str!("../../../examples/hex7-fretting.json"),
+        },
+    ];
     const HISTORIES: &'static [HistoryOutput] = &[
         HistoryOutput {
             name: "contact_forces",
@@ -305,7 +267,7 @@ impl Simulation for HexBundleDynamics {
     type Plan = Plan;
 
     fn column(output: &str, name: &str, document: &serde_json::Value) -> Option<super::Column> {
-        super::columns::hex(output, name, document)
+        column_of(output, name, document)
     }
 
     fn signals(inputs: &mut HexInputs) -> Vec<super::signal_input::SignalSlot<'_>> {
@@ -446,43 +408,22 @@ impl Simulation for HexBundleDynamics {
         })
     }
 
-    /// 2 × pins lines of modes and every contact at each step; histories
-    /// `contact_forces` (time + one column per recorded contact) and `displacements`
-    /// (time + two columns per pin and output height), and their peaks.
+    /// Two lines (x and y) per pin, the recorded contacts' histories
+    /// ([`RunSize::estimate`]).
     fn estimate(plan: &Plan) -> WorkEstimate {
-        let (stepping, samples) = common_inputs::stepping(&plan.settings, &plan.step);
-        let stepping = common_inputs::with_auto_note(stepping, plan.basis_choice.as_ref(), "pin");
-        let lines = 2 * plan.bundle.pin_count();
-        let recorded = plan.settings.recorded_contacts.as_ref().map_or(0, Vec::len);
-        let columns = 2 * ((1 + recorded) + (1 + lines * plan.settings.output_heights.len()));
-        let mut history_drivers = vec![
-            "/inputs/solver/duration".to_owned(),
-            "/inputs/output/interval".to_owned(),
-            "/inputs/output/contacts".to_owned(),
-            "/inputs/bundle/rings".to_owned(),
-        ];
-        if plan.inputs.output.heights.is_some() {
-            history_drivers.push("/inputs/output/heights".to_owned());
+        RunSize {
+            settings: &plan.settings,
+            step: &plan.step,
+            choice: plan.basis_choice.as_ref(),
+            lines: 2 * plan.bundle.pin_count(),
+            modes: plan.basis.modes(),
+            contacts: plan.contacts.len(),
+            recorded: plan.settings.recorded_contacts.as_ref().map_or(0, Vec::len),
+            work_drivers: &["/inputs/bundle/rings", "/inputs/bundle/wire_lead"],
+            history_drivers: &["/inputs/output/contacts", "/inputs/bundle/rings"],
+            heights_given: plan.inputs.output.heights.is_some(),
         }
-        history_drivers.push("/inputs/output/impacts/max_rows".to_owned());
-        let table =
-            impact_report::table_values(&plan.settings.impacts, plan.contacts.len(), stepping.pass_steps);
-        WorkEstimate {
-            modal_dofs: (lines * plan.basis.modes()) as f64,
-            contacts: plan.contacts.len() as f64,
-            history_values: samples * columns as f64 + table,
-            work_drivers: [
-                "/inputs/solver/duration",
-                "/inputs/solver/time_step",
-                "/inputs/pin/modes",
-                "/inputs/bundle/rings",
-                "/inputs/bundle/wire_lead",
-            ]
-            .map(str::to_owned)
-            .to_vec(),
-            history_drivers,
-            ..stepping
-        }
+        .estimate()
     }
 
     /// The pin of the bundle (D may be given apart from its section), its contacts'
@@ -515,46 +456,34 @@ impl Simulation for HexBundleDynamics {
             .collect();
         let allowables: Vec<Option<f64>> = laws.iter().map(|law| law.allowable()).collect();
         let service_time = plan.inputs.output.service_time.unwrap_or(0.0);
-        let peaks: Vec<f64> = simulation
-            .contact_statistics
-            .iter()
-            .map(|s| s.max_force)
-            .collect();
-        let contacts: Vec<HexContactResult> = plan
-            .geometry
-            .iter()
-            .zip(&plan.contacts)
-            .zip(&simulation.contact_statistics)
-            .zip(impact_report::contact_reports(&simulation))
+        let contacts: Vec<HexContactResult> = (plan.geometry.iter().zip(&plan.contacts))
+            .zip(ContactStatistics::of_run(&simulation, &allowables))
             .enumerate()
-            .map(|(k, (((g, c), s), impact_statistics))| HexContactResult {
-                level: g.level,
-                height: g.height,
-                wire_pin: g.wire_pin,
-                touched_pin: g.touched_pin(),
-                touched_flat: match g.touched {
-                    Body::Flat(flat) => Some(flat.index()),
-                    Body::Pin(_) => None,
-                },
-                normal: [g.normal.x, g.normal.y],
-                gap: c.gap,
-                max_force: s.max_force,
-                max_force_time: s.max_force_time,
-                impacts: s.impacts,
-                contact_time: s.contact_time,
-                impulse: s.impulse,
-                first_impact_time: s.first_impact_time,
-                max_penetration: s.max_penetration,
-                wear_work_rate: simulation.wear_work.get(k).copied().unwrap_or(0.0) / duration,
-                utilisation: contact_law::utilisation(s.max_force, allowables[k]),
-                friction: c.law.friction.is_on().then(|| {
-                    FrictionReport::of(&simulation.friction_statistics[k], s.contact_time, duration)
-                }),
-                wear: laws[k].wear.as_ref().map(|wear| {
-                    let power = simulation.wear_work.get(k).copied().unwrap_or(0.0) / duration;
-                    WearReport::of(wear, power, service_time)
-                }),
-                impact_statistics,
+            .map(|(k, ((g, c), statistics))| {
+                let wear_work_rate = simulation.wear_work.get(k).copied().unwrap_or(0.0) / duration;
+                HexContactResult {
+                    level: g.level,
+                    height: g.height,
+                    wire_pin: g.wire_pin,
+                    touched_pin: g.touched_pin(),
+                    touched_flat: match g.touched {
+                        Body::Flat(flat) => Some(flat.index()),
+                        Body::Pin(_) => None,
+                    },
+                    normal: [g.normal.x, g.normal.y],
+                    gap: c.gap,
+                    wear_work_rate,
+                    friction: c.law.friction.is_on().then(|| {
+                        FrictionReport::of(
+                            &simulation.friction_statistics[k],
+                            statistics.contact_time,
+                            duration,
+                        )
+                    }),
+                    wear: (laws[k].wear.as_ref())
+                        .map(|wear| WearReport::of(wear, wear_work_rate, service_time)),
+                    statistics,
+                }
             })
             .collect();
         let max_wear_depth = contacts
@@ -567,27 +496,8 @@ impl Simulation for HexBundleDynamics {
                 })
             })
             .max_by(|a, b| a.depth.total_cmp(&b.depth));
-        let max_contact_force = simulation
-            .contact_statistics
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.max_force.total_cmp(&b.1.max_force))
-            .map(|(k, s)| PeakForce {
-                contact: k,
-                force: s.max_force,
-                time: s.max_force_time,
-            });
         let pin_count = plan.bundle.pin_count();
         let heights = &plan.settings.output_heights;
-        let direction = |line: usize| {
-            let extreme = &simulation.pin_extremes[line];
-            DirectionResult {
-                max_abs_deflection: extreme.max_abs_deflection,
-                height: extreme.height,
-                time: extreme.time,
-                peak_deflections: PeakDeflectionResult::of_line(heights, &simulation.peak_deflections, line),
-            }
-        };
         let pins: Vec<HexPinResult> = (0..pin_count)
             .map(|p| {
                 let position = plan.bundle.position(p);
@@ -595,34 +505,30 @@ impl Simulation for HexBundleDynamics {
                     pin: p,
                     ring: plan.bundle.lattice().ring(p),
                     position: [position.x, position.y],
-                    x: direction(p),
-                    y: direction(pin_count + p),
+                    x: LineExtremes::of_line(&simulation, heights, p),
+                    y: LineExtremes::of_line(&simulation, heights, pin_count + p),
                 }
             })
             .collect();
-        let recorded_contacts = plan.settings.recorded_contacts.clone().unwrap_or_default();
+        let basis = BasisReport::of(
+            &model,
+            plan.settings.scheme,
+            simulation.step.critical_time_step,
+            (&plan.inputs.pin, plan.basis_choice.as_ref()),
+        );
         let results = HexResults {
             geometry: geometry_report(&plan.bundle, plan.geometry.len()),
             contacts,
-            max_contact_force,
-            max_utilisation: contact_law::worst(&peaks, &allowables),
             max_wear_depth,
-            impacts: simulation.contact_statistics.iter().map(|s| s.impacts).sum(),
-            impact_summary: impact_report::summary(&simulation, &plan.settings.impacts),
-            recorded_contacts,
+            recorded_contacts: plan.settings.recorded_contacts.clone().unwrap_or_default(),
             pins,
-            energy: simulation.energy.into(),
-            time_step: simulation.step.time_step,
-            critical_time_step: simulation.step.critical_time_step,
-            steps: simulation.steps,
-            output_interval: simulation.output_interval,
-            quality,
-            frequencies_hz: plan.basis.frequencies_hz(),
-            basis: BasisReport::of(
-                &model,
-                plan.settings.scheme,
-                simulation.step.critical_time_step,
-                (&plan.inputs.pin, plan.basis_choice.as_ref()),
+            run: RunSummary::of(
+                &simulation,
+                quality,
+                &plan.settings,
+                &allowables,
+                basis,
+                plan.basis.frequencies_hz(),
             ),
         };
         let histories = histories(&plan, simulation);
@@ -863,59 +769,59 @@ fn geometry_report(bundle: &HexBundle, contacts: usize) -> GeometryReport {
 fn histories(plan: &Plan, simulation: integrate::Simulation) -> Vec<History> {
     let tips_only = plan.inputs.output.heights.is_none();
     let pins = plan.bundle.pin_count();
-    let mut displacement_names = Vec::new();
-    for height in &plan.settings.output_heights {
-        for line in 0..2 * pins {
-            let (pin, axis) = if line < pins {
-                (line, 'x')
-            } else {
-                (line - pins, 'y')
-            };
-            displacement_names.push(if tips_only {
-                format!("p{pin}{axis}")
-            } else {
-                format!("p{pin}{axis}@{height}")
-            });
-        }
-    }
-    let contact_names: Vec<String> = plan
-        .settings
-        .recorded_contacts
-        .iter()
-        .flatten()
+    let deflections = run_report::deflection_names(
+        &plan.settings.output_heights,
+        2 * pins,
+        tips_only,
+        |line| match line < pins {
+            true => format!("p{line}x"),
+            false => format!("p{}y", line - pins),
+        },
+    );
+    let contacts: Vec<String> = (plan.settings.recorded_contacts.iter().flatten())
         .map(|k| format!("c{k}"))
         .collect();
-    let named = |names: &[String], columns: Vec<Vec<f64>>| -> Vec<(String, Vec<f64>)> {
-        names.iter().cloned().zip(columns).collect()
+    run_report::histories(simulation, &contacts, &deflections)
+}
+
+/// A column of `hex-bundle-dynamics`: `c<k>` the force (N, along the contact's normal) of
+/// contact k of the results' `contacts`, `p<pin><x|y>[@<height>]` a pin's deflection (m).
+fn column_of(output: &str, name: &str, document: &serde_json::Value) -> Option<super::Column> {
+    let description = match output.trim_end_matches("_peaks") {
+        "contact_forces" => {
+            let contact = &document["contacts"][columns::contact_index(name)?];
+            let height = contact["height"].as_f64()?;
+            let wire = contact["wire_pin"].as_u64()?;
+            let touched = match (contact["touched_pin"].as_u64(), contact["touched_flat"].as_u64()) {
+                (Some(pin), _) => format!("the clad of p{pin}"),
+                (None, Some(flat)) => format!("wrapper flat {flat}"),
+                (None, None) => return None,
+            };
+            (
+                "N",
+                format!(
+                    "contact of p{wire}'s wire on {touched} at {}",
+                    columns::metres(height)
+                ),
+            )
+        }
+        "displacements" => {
+            let (pin, axis, at) = columns::deflection(name, true)?;
+            (
+                "m",
+                format!(
+                    "deflection of p{pin} along {} at {at}, relative to the pin feet",
+                    axis.unwrap_or('x')
+                ),
+            )
+        }
+        _ => return None,
     };
-    let history = |name: &str, series| History {
-        name: name.into(),
-        time: simulation.time.clone(),
-        series,
-    };
-    let table = impact_report::table_history(&simulation.impact_table);
-    vec![
-        history("contact_forces", named(&contact_names, simulation.contact_forces)),
-        history(
-            "displacements",
-            named(
-                &displacement_names,
-                simulation.deflections.into_iter().flatten().collect(),
-            ),
-        ),
-        history(
-            "contact_forces_peaks",
-            named(&contact_names, simulation.contact_force_peaks),
-        ),
-        history(
-            "displacements_peaks",
-            named(
-                &displacement_names,
-                simulation.deflection_peaks.into_iter().flatten().collect(),
-            ),
-        ),
-        table,
-    ]
+    Some(super::Column::new(
+        name,
+        description.0,
+        columns::of_output(output, description.1),
+    ))
 }
 
 #[cfg(test)]

@@ -425,3 +425,31 @@ fn wrapper_motion_forms_are_exclusive_and_checked() {
     let pointers: Vec<String> = errors(&bad).into_iter().map(|(p, _)| p).collect();
     assert_eq!(pointers, ["/inputs/excitation/wrapper_acceleration/duration"]);
 }
+
+#[test]
+fn its_columns_name_their_bodies_heights_and_units() {
+    let hex_document = serde_json::json!({"contacts": [
+        {"wire_pin": 3, "touched_pin": 10, "touched_flat": null, "height": 0.45},
+        {"wire_pin": 8, "touched_pin": null, "touched_flat": 2, "height": 0.6}]});
+    assert_eq!(
+        column_of("contact_forces", "c0", &hex_document)
+            .unwrap()
+            .description
+            .unwrap(),
+        "contact of p3's wire on the clad of p10 at 0.45 m"
+    );
+    assert_eq!(
+        column_of("contact_forces", "c1", &hex_document)
+            .unwrap()
+            .description
+            .unwrap(),
+        "contact of p8's wire on wrapper flat 2 at 0.6 m"
+    );
+    assert!(
+        column_of("displacements", "p12y@0.3", &hex_document)
+            .unwrap()
+            .description
+            .unwrap()
+            .starts_with("deflection of p12 along y at 0.3 m")
+    );
+}

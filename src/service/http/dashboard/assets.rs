@@ -3,7 +3,7 @@
 //! `assets/vendor/README.md`), and the shipped examples (`examples/*.json`) offered as
 //! templates by the submit page.
 
-use std::sync::OnceLock;
+use crate::processes::{Example, Registry};
 
 /// One embedded file.
 #[derive(Debug, Clone, Copy)]
@@ -60,65 +60,45 @@ pub fn find(name: &str) -> Option<&'static Asset> {
     ASSETS.iter().find(|a| a.name == name)
 }
 
-/// A shipped example: its file name, the process it runs (`None` for a sweep request,
-/// which names its process itself), and the request body.
-#[derive(Debug, Clone, Copy)]
-pub struct Example {
-    pub file: &'static str,
-    pub process: Option<&'static str>,
-    pub body: &'static str,
-}
-
-macro_rules! example {
-    ($file:literal, $process:expr) => {
-        Example {
-            file: $file,
-            process: $process,
-            body: include_str!(concat!("../../../../examples/", $file)),
-        }
-    };
-}
-
-/// Every file of `examples/` (a test checks none is missing).
-pub const EXAMPLES: &[Example] = &[
-    example!("cantilever-impact.json", Some("cantilever-impact")),
-    example!("bundle-row17.json", Some("bundle-dynamics")),
-    example!("bundle-random-gaps.json", Some("bundle-dynamics")),
-    example!("bundle-local-closure.json", Some("bundle-dynamics")),
-    example!("bundle-sine-auto.json", Some("bundle-dynamics")),
-    example!("bundle-minimal-sine.json", Some("bundle-dynamics")),
-    example!("bundle-minimal-table.json", Some("bundle-dynamics")),
-    example!("bundle-haversine.json", Some("bundle-dynamics")),
-    example!("bundle-earthquake.json", Some("bundle-dynamics")),
-    example!("bundle-row12-shock.json", Some("bundle-dynamics")),
-    example!("sdnl104c.json", Some("bundle-dynamics")),
-    example!("hex217.json", Some("hex-bundle-dynamics")),
-    example!("hex7-loads.json", Some("hex-bundle-dynamics")),
-    example!("hex7-fretting.json", Some("hex-bundle-dynamics")),
-    example!("sweep-calibration.json", None),
-    example!("sweep-gaps.json", None),
-    example!("sweep-static-correction.json", None),
+/// The shipped sweep requests (`examples/sweep-*.json`; each names its process itself).
+/// A process's own examples come with it ([`crate::processes::Process::examples`]).
+pub const SWEEP_EXAMPLES: &[Example] = &[
+    Example {
+        file: "sweep-calibration.json",
+        body: include_str!("../../../../examples/sweep-calibration.json"),
+    },
+    Example {
+        file: "sweep-gaps.json",
+        body: include_str!("../../../../examples/sweep-gaps.json"),
+    },
+    Example {
+        file: "sweep-static-correction.json",
+        body: include_str!("../../../../examples/sweep-static-correction.json"),
+    },
 ];
 
-/// `[{"file", "process", "kind": "job" | "sweep", "body"}]`, the bodies verbatim (their
-/// members keep the order of the files).
-pub fn examples_json() -> &'static str {
-    static JSON: OnceLock<String> = OnceLock::new();
-    JSON.get_or_init(|| {
-        let items: Vec<String> = EXAMPLES
-            .iter()
-            .map(|e| {
-                format!(
-                    r#"{{"file":{},"process":{},"kind":"{}","body":{}}}"#,
-                    serde_json::Value::from(e.file),
-                    e.process.map_or(serde_json::Value::Null, serde_json::Value::from),
-                    if e.process.is_some() { "job" } else { "sweep" },
-                    e.body.trim()
-                )
-            })
-            .collect();
-        format!("[{}]", items.join(","))
-    })
+/// `[{"file", "process", "kind": "job" | "sweep", "body"}]`: every example of the
+/// `registry`'s processes, then the sweeps, the bodies verbatim (their members keep the
+/// order of the files).
+pub fn examples_json(registry: &Registry) -> String {
+    let jobs = registry
+        .all()
+        .iter()
+        .flat_map(|process| process.examples().iter().map(move |e| (e, Some(process.id()))));
+    let sweeps = SWEEP_EXAMPLES.iter().map(|e| (e, None));
+    let items: Vec<String> = jobs
+        .chain(sweeps)
+        .map(|(e, process)| {
+            format!(
+                r#"{{"file":{},"process":{},"kind":"{}","body":{}}}"#,
+                serde_json::Value::from(e.file),
+                process.map_or(serde_json::Value::Null, serde_json::Value::from),
+                if process.is_some() { "job" } else { "sweep" },
+                e.body.trim()
+            )
+        })
+        .collect();
+    format!("[{}]", items.join(","))
 }
 
 #[cfg(test)]
@@ -134,11 +114,16 @@ mod tests {
             .filter(|name| name.ends_with(".json"))
             .collect();
         files.sort();
-        let mut embedded: Vec<String> = EXAMPLES.iter().map(|e| e.file.to_owned()).collect();
+        let registry = Registry::builtin();
+        let parsed: serde_json::Value = serde_json::from_str(&examples_json(&registry)).unwrap();
+        let mut embedded: Vec<String> = (parsed.as_array().unwrap().iter())
+            .map(|e| e["file"].as_str().unwrap().to_owned())
+            .collect();
         embedded.sort();
-        assert_eq!(embedded, files, "examples/ and the dashboard's templates differ");
-        let parsed: serde_json::Value = serde_json::from_str(examples_json()).unwrap();
-        assert_eq!(parsed.as_array().map(Vec::len), Some(EXAMPLES.len()));
+        assert_eq!(
+            embedded, files,
+            "examples/ and the processes' and sweeps' examples differ"
+        );
         for example in parsed.as_array().unwrap() {
             let body = &example["body"];
             match example["kind"].as_str() {

@@ -12,7 +12,7 @@ pub mod assets;
 pub mod negotiation;
 
 use axum::Router;
-use axum::extract::{MatchedPath, Path, Request};
+use axum::extract::{MatchedPath, Path, Request, State};
 use axum::http::{HeaderMap, HeaderValue, Method, StatusCode, header};
 use axum::middleware::Next;
 use axum::response::{Html, IntoResponse, Response};
@@ -169,11 +169,11 @@ async fn submit_page() -> Response {
     html_page(Page::Submit, StatusCode::OK)
 }
 
-async fn examples(headers: HeaderMap) -> Response {
+async fn examples(State(state): State<AppState>, headers: HeaderMap) -> Response {
     super::conditional::tagged(
         &headers,
         "application/json",
-        assets::examples_json().as_bytes().to_vec(),
+        assets::examples_json(&state.registry).into_bytes(),
         HeaderMap::new(),
     )
 }
