@@ -6,7 +6,9 @@
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use crate::helpers::{TestApp, spawn_app};
+use chocmodal::processes::Registry;
+
+use crate::helpers::{TestApp, spawn_app, spawn_app_with_processes};
 
 const BROWSER: &str = "text/html,application/xhtml+xml,application/xml;q=0.9,image/avif,image/webp,*/*;q=0.8";
 
@@ -123,7 +125,7 @@ async fn the_page_of_a_missing_job_or_a_bad_query_has_the_status_of_the_json_ans
 
 #[tokio::test]
 async fn the_dashboard_assets_and_examples_are_served_from_the_binary() {
-    let app = spawn_app().await;
+    let app = spawn_app_with_processes(Registry::builtin().all().to_vec(), |_| {}).await;
     for (path, content_type) in [
         ("/ui/assets/app.js", "text/javascript; charset=utf-8"),
         ("/ui/assets/plot.js", "text/javascript; charset=utf-8"),
@@ -143,6 +145,9 @@ async fn the_dashboard_assets_and_examples_are_served_from_the_binary() {
         .map(|e| e["file"].as_str().unwrap())
         .collect();
     assert!(files.contains(&"cantilever-impact.json") && files.contains(&"sweep-calibration.json"));
+    // A server offers the examples of its own processes only.
+    let without = spawn_app().await.get_json("/ui/examples.json").await;
+    assert_eq!(without, json!([]), "the test processes have no example");
     let (status, content_type, _, _) = fetch(&app, "/ui/assets/missing.js", None).await;
     assert_eq!(status, StatusCode::NOT_FOUND);
     assert_eq!(content_type, "application/problem+json");

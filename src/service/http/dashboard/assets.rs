@@ -78,14 +78,19 @@ pub const SWEEP_EXAMPLES: &[Example] = &[
 ];
 
 /// `[{"file", "process", "kind": "job" | "sweep", "body"}]`: every example of the
-/// `registry`'s processes, then the sweeps, the bodies verbatim (their members keep the
+/// `registry`'s processes, then the sweeps of those processes, the bodies verbatim (their members keep the
 /// order of the files).
 pub fn examples_json(registry: &Registry) -> String {
     let jobs = registry
         .all()
         .iter()
         .flat_map(|process| process.examples().iter().map(move |e| (e, Some(process.id()))));
-    let sweeps = SWEEP_EXAMPLES.iter().map(|e| (e, None));
+    // A sweep names its process: offered only where that process is.
+    let offered = |e: &&Example| {
+        let body: serde_json::Value = serde_json::from_str(e.body).unwrap_or_default();
+        body["process"].as_str().is_some_and(|id| registry.get(id).is_some())
+    };
+    let sweeps = SWEEP_EXAMPLES.iter().filter(offered).map(|e| (e, None));
     let items: Vec<String> = jobs
         .chain(sweeps)
         .map(|(e, process)| {
