@@ -326,11 +326,51 @@ impl BeamModel {
         (element, position - element as f64)
     }
 
+    /// The curvature w''(x) (1/m) of the displacement field `u` (over all DOFs) at height
+    /// `x`: within an element, its linear FE curvature; at a node (to 1e-9 of an element),
+    /// the mean of the curvatures the elements on either side give there (they differ
+    /// where a point force acts; both are exact for the cubic of a tip load).
+    pub fn curvature_at(&self, x: f64, u: &[f64]) -> f64 {
+        let h = self.element_length;
+        let position = (x / h).clamp(0.0, self.elements as f64);
+        let node = position.round();
+        let of = |element: usize, xi: f64| {
+            let weights = hermite_curvatures(xi, h);
+            (0..4).map(|k| weights[k] * u[2 * element + k]).sum::<f64>()
+        };
+        if (position - node).abs() <= 1e-9 {
+            let node = node as usize;
+            let below = (node > 0).then(|| of(node - 1, 1.0));
+            let above = (node < self.elements).then(|| of(node, 0.0));
+            return match (below, above) {
+                (Some(b), Some(a)) => 0.5 * (b + a),
+                (Some(one), None) | (None, Some(one)) => one,
+                (None, None) => 0.0,
+            };
+        }
+        let (element, xi) = self.locate(x);
+        of(element, xi)
+    }
+
     /// Hermite interpolation weights of height `x`: w(x) = Σ weights[k] · u[first_dof + k].
     pub fn interpolation(&self, x: f64) -> (usize, [f64; 4]) {
         let (element, xi) = self.locate(x);
         (2 * element, hermite_shape_functions(xi, self.element_length))
     }
+}
+
+/// Second derivatives along the beam (1/m², 1/m) of the Hermite shape functions on an
+/// element of length `h` at local coordinate ξ: the curvature w''(x) = Σ N''ₖ uₖ, linear
+/// over the element: N1'' = (12ξ − 6)/h², N2'' = (6ξ − 4)/h, N3'' = (6 − 12ξ)/h²,
+/// N4'' = (6ξ − 2)/h.
+pub fn hermite_curvatures(xi: f64, h: f64) -> [f64; 4] {
+    let h2 = h * h;
+    [
+        (12.0 * xi - 6.0) / h2,
+        (6.0 * xi - 4.0) / h,
+        (6.0 - 12.0 * xi) / h2,
+        (6.0 * xi - 2.0) / h,
+    ]
 }
 
 /// Hermite cubic shape functions on an element of length `h` at local coordinate ξ:

@@ -346,6 +346,22 @@ impl ModalBasis {
             .collect()
     }
 
+    /// κᵢ(x) for every mode: the bending curvature φᵢ''(x) of each mode at height `x`
+    /// (1/m per unit modal coordinate; [`crate::beam::BeamModel::curvature_at`]).
+    pub fn curvature_at(&self, x: f64) -> Vec<f64> {
+        (0..self.modes())
+            .map(|i| self.model.curvature_at(x, self.shape(i)))
+            .collect()
+    }
+
+    /// Ψ''(x): the transport's curvature at height `x` (1/m per metre the top support
+    /// moves), 0 without one.
+    pub fn transport_curvature_at(&self, x: f64) -> f64 {
+        self.transport
+            .as_ref()
+            .map_or(0.0, |t| self.model.curvature_at(x, &t.shape))
+    }
+
     /// Modal coordinates q = Φᵀ M u of a displacement field u given over all DOFs.
     pub fn project(&self, displacement: &[f64]) -> Vec<f64> {
         let dofs = self.model.dof_count();
@@ -427,6 +443,47 @@ mod tests {
     use super::*;
     use crate::beam::tests::default_tube;
     use crate::beam::{Section, Support};
+
+    /// The curvature of an M-normalised mode is the FE one: its bending energy
+    /// ∫ EI φᵢ''² dx (two Gauss points per element, exact for the linear curvature of a
+    /// Hermite element) is φᵢᵀ K φᵢ = ωᵢ²; and at a node the curvature is the mean of the
+    /// two elements' (here, away from any load, they nearly agree).
+    #[test]
+    fn a_modes_curvature_carries_its_bending_energy() {
+        let spec = default_tube(12);
+        let basis = ModalBasis::compute(&spec, 5).unwrap();
+        let (h, ei) = (basis.model().element_length, spec.bending_stiffness());
+        let gauss = [0.5 - 0.5 / 3f64.sqrt(), 0.5 + 0.5 / 3f64.sqrt()];
+        for (i, omega) in basis.angular_frequencies().iter().enumerate() {
+            let energy: f64 = (0..spec.elements)
+                .flat_map(|e| gauss.map(|g| (e as f64 + g) * h))
+                .map(|x| 0.5 * h * ei * basis.curvature_at(x)[i].powi(2))
+                .sum();
+            assert!(
+                (energy / omega.powi(2) - 1.0).abs() < 1e-9,
+                "mode {i}: ∫EIφ''² = {energy:e}, ω² = {:e}",
+                omega.powi(2)
+            );
+        }
+    }
+
+    /// The free top carries no moment: its FE curvature (the natural condition, held
+    /// weakly) vanishes as h² when the mesh is refined.
+    #[test]
+    fn the_curvature_at_a_free_top_vanishes_as_the_mesh_is_refined() {
+        let ratio = |elements: usize, mode: usize| {
+            let spec = default_tube(elements);
+            let basis = ModalBasis::compute(&spec, 3).unwrap();
+            (basis.curvature_at(spec.length)[mode] / basis.curvature_at(0.0)[mode]).abs()
+        };
+        for mode in 0..3 {
+            let (coarse, fine) = (ratio(12, mode), ratio(24, mode));
+            assert!(
+                coarse < 0.05 && fine < coarse / 3.0,
+                "mode {mode}: {coarse:e} → {fine:e}"
+            );
+        }
+    }
 
     /// Roots λᵢ of 1 + cos λ cosh λ = 0 (clamped-free Euler-Bernoulli beam).
     const CLAMPED_FREE_ROOTS: [f64; 5] = [

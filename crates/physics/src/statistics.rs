@@ -67,6 +67,22 @@ pub struct PinExtreme {
     pub time: f64,
 }
 
+/// The largest bending curvature |w''| (1/m) at one place, over the output samples: of
+/// one pin along its height, or at one mesh node over every pin. In the plane, the
+/// resultant √(κx² + κy²) of the pin's two bending directions (a circular section's
+/// outer-fibre strain is c × it, its moment EI × it).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct CurvaturePeak {
+    /// max |κ| (1/m), ≥ 0; 0 when the pin never bends.
+    pub curvature: f64,
+    /// Height (m).
+    pub height: f64,
+    /// The pin.
+    pub pin: usize,
+    /// When (s): an output sample's time.
+    pub time: f64,
+}
+
 /// The deflection of largest magnitude at one height of one pin, over every step.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct PeakDeflection {

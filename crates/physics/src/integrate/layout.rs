@@ -73,6 +73,11 @@ pub(super) struct Layout<'m> {
     pub output_offsets: Vec<usize>,
     /// Nodal deflection of each mode, for the pin extremes.
     pub node_shapes: LevelShapes,
+    /// Bending curvature of each mode at every node and at every output height
+    /// ([`crate::modal::ModalBasis::curvature_at`]), for the bending envelope and the
+    /// moment histories.
+    pub node_curvature_shapes: LevelShapes,
+    pub output_curvature_shapes: LevelShapes,
     /// Created energy allowed per joule involved before declaring divergence
     /// (see [`super::stepper`]'s divergence check).
     pub divergence_allowance: f64,
@@ -304,6 +309,15 @@ impl<'m> Layout<'m> {
             row,
             lanes,
         );
+        let curvatures = |heights: &mut dyn Iterator<Item = f64>| {
+            let values: Vec<f64> = heights
+                .flat_map(|h| padded(&basis.curvature_at(h), row, 0.0))
+                .collect();
+            LevelShapes::new(&values, row, lanes)
+        };
+        let element_length = basis.model().element_length;
+        let node_curvature_shapes = curvatures(&mut (0..nodes).map(|n| n as f64 * element_length));
+        let output_curvature_shapes = curvatures(&mut settings.output_heights.iter().copied());
         let r2 = (dt / critical).powi(2);
         let gaps = contact_lanes.by_lane(&contacts.iter().map(|c| c.gap).collect::<Vec<_>>(), f64::INFINITY);
         let walls = model.walls.as_ref().map(|_| {
@@ -386,6 +400,8 @@ impl<'m> Layout<'m> {
                 .map(|level| Self::level_offset(lanes, stride, *level))
                 .collect(),
             node_shapes,
+            node_curvature_shapes,
+            output_curvature_shapes,
             divergence_allowance: if r2 < 1.0 { 2.0 / (1.0 - r2) } else { 1.0 },
             walls,
         }
@@ -410,5 +426,14 @@ impl<'m> Layout<'m> {
     /// Length of a block-major array of the lines' deflections at every node.
     pub fn node_deflections_len(&self) -> usize {
         self.node_shapes.blocks * self.stride * self.lanes
+    }
+
+    /// Length of a block-major array of the lines' curvatures at every node, and at every
+    /// output height.
+    pub fn node_curvatures_len(&self) -> usize {
+        self.node_curvature_shapes.blocks * self.stride * self.lanes
+    }
+    pub fn output_curvatures_len(&self) -> usize {
+        self.output_curvature_shapes.blocks * self.stride * self.lanes
     }
 }

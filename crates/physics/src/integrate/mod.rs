@@ -42,7 +42,7 @@
 //! the step advances) and the recorder (histories, statistics, energy).
 
 pub use super::statistics::{
-    ContactStatistics, EnergyBalance, FrictionStatistics, PeakDeflection, PinExtreme,
+    ContactStatistics, CurvaturePeak, EnergyBalance, FrictionStatistics, PeakDeflection, PinExtreme,
 };
 use crate::InputIssue;
 pub use crate::impacts::{ImpactCounting, ImpactHistogram, ImpactStatistics, ImpactTable};
@@ -127,6 +127,16 @@ pub struct Simulation {
     pub impact_histogram: ImpactHistogram,
     /// Per line (r as in `deflections`).
     pub pin_extremes: Vec<PinExtreme>,
+    /// `curvatures[h][r]`: bending curvature w'' (1/m) of line r at output height h, per
+    /// sample (signed: w'' > 0 bends the line concave toward +x, or +y; the moment is
+    /// EI w''), the transport by a moving top support included.
+    pub curvatures: Vec<Vec<Vec<f64>>>,
+    /// Per mesh node from the foot, the largest curvature there over every pin and
+    /// sample (in the plane, the resultant of x and y), which pin and when.
+    pub curvature_envelope: Vec<CurvaturePeak>,
+    /// Per pin, its largest curvature over its nodes and the samples (in the plane, the
+    /// resultant), where and when.
+    pub pin_curvatures: Vec<CurvaturePeak>,
     /// Energy balance at the end of the run.
     pub energy: EnergyBalance,
     /// Mechanical energy (kinetic + strain + contact) per sample (J).
@@ -190,5 +200,7 @@ mod wall_tests;
 #[cfg(test)]
 mod thread_tests;
 
+#[cfg(test)]
+mod bending_tests;
 #[cfg(test)]
 mod law_tests;

@@ -10,7 +10,8 @@ use super::kernels::level_deflections;
 use super::layout::{ContactModel, Layout};
 use super::state::State;
 use super::{
-    ContactStatistics, EnergyBalance, FrictionStatistics, PeakDeflection, PinExtreme, Settings, Simulation,
+    ContactStatistics, CurvaturePeak, EnergyBalance, FrictionStatistics, PeakDeflection, PinExtreme,
+    Settings, Simulation,
 };
 use crate::impacts::{ContactImpacts, ImpactClock, ImpactLog, ImpactSink, ImpactStatistics};
 
@@ -66,6 +67,13 @@ pub(super) struct Recorder {
     contact_force_peaks: Vec<Vec<f64>>,
     mechanical_energy: Vec<f64>,
     pin_extremes: Vec<PinExtreme>,
+    /// Scratch: every line's curvature at every node and output height at the last
+    /// sample (laid out as the level deflections).
+    node_curvatures: Vec<f64>,
+    output_curvatures: Vec<f64>,
+    curvatures: Vec<Vec<Vec<f64>>>,
+    curvature_envelope: Vec<CurvaturePeak>,
+    pin_curvatures: Vec<CurvaturePeak>,
 }
 
 impl Recorder {
@@ -114,6 +122,21 @@ impl Recorder {
             contact_force_peaks: vec![Vec::new(); contacts],
             mechanical_energy: Vec::new(),
             pin_extremes: vec![PinExtreme::default(); lines],
+            node_curvatures: vec![0.0; layout.node_curvatures_len()],
+            output_curvatures: vec![0.0; layout.output_curvatures_len()],
+            curvatures: vec![vec![Vec::new(); lines]; settings.output_heights.len()],
+            curvature_envelope: (0..=layout.model.basis.model().elements)
+                .map(|node| CurvaturePeak {
+                    height: crate::decimal(node as f64 * layout.model.basis.model().element_length),
+                    ..CurvaturePeak::default()
+                })
+                .collect(),
+            pin_curvatures: (0..layout.model.pins)
+                .map(|pin| CurvaturePeak {
+                    pin,
+                    ..CurvaturePeak::default()
+                })
+                .collect(),
         }
     }
 
@@ -217,6 +240,75 @@ impl Recorder {
         self.force_peak.fill(0.0);
         self.mechanical_energy.push(state.mechanical_energy(arch, layout));
         self.record_pin_extremes(arch, layout, state, t);
+        self.record_bending(arch, layout, state, t);
+    }
+
+    /// The curvature of every line at the output heights (the moment histories), and
+    /// the largest at every node and of every pin so far (the bending envelope).
+    fn record_bending(&mut self, arch: pulp::Arch, layout: &Layout<'_>, state: &State, t: f64) {
+        for (shapes, out) in [
+            (&layout.node_curvature_shapes, &mut self.node_curvatures),
+            (&layout.output_curvature_shapes, &mut self.output_curvatures),
+        ] {
+            arch.dispatch(LevelsOp {
+                layout,
+                shapes,
+                q: &state.q,
+                out,
+            });
+        }
+        let (lanes, stride, pins, lines) = (layout.lanes, layout.stride, layout.model.pins, layout.lines);
+        // The transport's curvature by a moving top support, per channel of the line.
+        let transport = |curvature: &[f64], at: usize, line: usize| match &state.wall {
+            Some(wall) if !curvature.is_empty() => {
+                curvature[at] * wall.transport()[usize::from(line >= pins)]
+            }
+            _ => 0.0,
+        };
+        let no_transport: &[f64] = &[];
+        let (output_transport, node_transport) = match &layout.walls {
+            Some(walls) => (
+                walls.output_transport_curvature.as_slice(),
+                walls.node_transport_curvature.as_slice(),
+            ),
+            None => (no_transport, no_transport),
+        };
+        let value = |values: &[f64], level: usize, line: usize| {
+            let (block, lane) = (level / lanes, level % lanes);
+            values[(block * stride + 1 + line) * lanes + lane]
+        };
+        for (h, per_line) in self.curvatures.iter_mut().enumerate() {
+            for (line, history) in per_line.iter_mut().enumerate() {
+                history.push(value(&self.output_curvatures, h, line) + transport(output_transport, h, line));
+            }
+        }
+        for (node, envelope) in self.curvature_envelope.iter_mut().enumerate() {
+            for (pin, extreme) in self.pin_curvatures.iter_mut().enumerate() {
+                let along = |line: usize| {
+                    value(&self.node_curvatures, node, line) + transport(node_transport, node, line)
+                };
+                let curvature = match lines > pins {
+                    true => along(pin).hypot(along(pins + pin)),
+                    false => along(pin).abs(),
+                };
+                if curvature > envelope.curvature {
+                    *envelope = CurvaturePeak {
+                        curvature,
+                        pin,
+                        time: t,
+                        ..*envelope
+                    };
+                }
+                if curvature > extreme.curvature {
+                    *extreme = CurvaturePeak {
+                        curvature,
+                        height: envelope.height,
+                        pin,
+                        time: t,
+                    };
+                }
+            }
+        }
     }
 
     /// The largest |w| of each line over the mesh nodes, if above the one so far.
@@ -316,6 +408,9 @@ impl Recorder {
             impact_table,
             impact_histogram,
             pin_extremes: self.pin_extremes,
+            curvatures: self.curvatures,
+            curvature_envelope: self.curvature_envelope,
+            pin_curvatures: self.pin_curvatures,
             energy: self.energy,
             mechanical_energy: self.mechanical_energy,
         }
@@ -394,6 +489,32 @@ impl pulp::WithSimd for NodeDeflectionsOp<'_> {
         level_deflections(
             simd,
             &layout.node_shapes,
+            layout.row,
+            self.q,
+            S::as_mut_simd_f64s(self.out).0,
+            layout.stride,
+        );
+    }
+}
+
+/// Every line's value at every level of `shapes` (curvatures at the nodes or at the
+/// output heights), as a [`pulp::WithSimd`] operation.
+struct LevelsOp<'a> {
+    layout: &'a Layout<'a>,
+    shapes: &'a super::kernels::LevelShapes,
+    q: &'a [f64],
+    out: &'a mut [f64],
+}
+
+impl pulp::WithSimd for LevelsOp<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let layout = self.layout;
+        level_deflections(
+            simd,
+            self.shapes,
             layout.row,
             self.q,
             S::as_mut_simd_f64s(self.out).0,

@@ -26,9 +26,12 @@ pub(super) struct WallLayout {
     pub gaps: Vec<f64>,
     /// Γᴾ padded to the row (`None` without a transport: a free top).
     pub transport_participation: Option<Vec<f64>>,
-    /// Ψ at each output height and at each mesh node (empty without a transport).
+    /// Ψ at each output height and at each mesh node, and Ψ'' there (empty without a
+    /// transport).
     pub output_transport: Vec<f64>,
     pub node_transport: Vec<f64>,
+    pub output_transport_curvature: Vec<f64>,
+    pub node_transport_curvature: Vec<f64>,
 }
 
 impl WallLayout {
@@ -80,6 +83,18 @@ impl WallLayout {
             node_transport: match transport {
                 Some(_) => (0..nodes)
                     .map(|n| basis.transport_at(n as f64 * element_length))
+                    .collect(),
+                None => Vec::new(),
+            },
+            output_transport_curvature: match transport {
+                Some(_) => (output_heights.iter())
+                    .map(|h| basis.transport_curvature_at(*h))
+                    .collect(),
+                None => Vec::new(),
+            },
+            node_transport_curvature: match transport {
+                Some(_) => (0..nodes)
+                    .map(|n| basis.transport_curvature_at(n as f64 * element_length))
                     .collect(),
                 None => Vec::new(),
             },
