@@ -14,6 +14,8 @@ pub mod hex_bundle_dynamics;
 
 // What the processes share.
 pub mod basis_report;
+/// Bending moments, stresses and strains from the run's curvatures.
+pub mod bending;
 /// What each column of a history is: name, unit, what it measures.
 pub mod columns;
 /// The inputs every process shares: the beam, the solver, the step, parsing helpers.

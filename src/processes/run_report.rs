@@ -8,9 +8,11 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
+use super::bending::{self, BendingReport, Flexure};
 use super::contact_law::{self, Utilisation};
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::report::{EnergyReport, QualityReport};
+use super::simulation::{HistoryKind, HistoryOutput};
 use super::{History, WorkEstimate, common_inputs};
 use crate::physics::discretisation::auto::Choice as BasisChoice;
 use crate::physics::integrate::{PeakDeflection, Settings, Simulation, StepSize};
@@ -153,18 +155,21 @@ pub struct RunSummary {
     /// every bending direction).
     pub frequencies_hz: Vec<f64>,
     pub basis: BasisReport,
+    #[serde(flatten)]
+    pub bending: BendingReport,
 }
 
 impl RunSummary {
     /// The summary of `run`, judged `quality`, counted as `settings` asks, with the
-    /// allowable force of each contact's law and the report of its basis.
+    /// allowable force of each contact's law, the report of its basis, and its pins'
+    /// flexure.
     pub fn of(
         run: &Simulation,
         quality: QualityReport,
         settings: &Settings,
         allowables: &[Option<f64>],
-        basis: BasisReport,
-        frequencies_hz: Vec<f64>,
+        (basis, frequencies_hz): (BasisReport, Vec<f64>),
+        flexure: &Flexure,
     ) -> Self {
         let peaks: Vec<f64> = run.contact_statistics.iter().map(|s| s.max_force).collect();
         Self {
@@ -189,6 +194,7 @@ impl RunSummary {
             quality,
             frequencies_hz,
             basis,
+            bending: BendingReport::of(run, flexure),
         }
     }
 }
@@ -213,10 +219,27 @@ pub fn deflection_names(
     names
 }
 
+/// The bending moments at the output heights, a history every run of pins gives.
+pub const MOMENTS_OUTPUT: HistoryOutput = HistoryOutput {
+    name: "bending_moments",
+    kind: HistoryKind::Moment,
+    title: "Bending moments (N·m)",
+    description: "CSV columns time (s), then the columns of displacements: the bending moment EI w'' of each \
+                  pin (and direction) at each output height, signed as the curvature (positive bends the pin \
+                  concave toward +x, or +y)",
+};
+
 /// The histories every run of pins gives: `contact_forces`, `displacements`, their
-/// `_peaks` and the impact table, with the columns named `contacts` (one per recorded
-/// contact) and `deflections` ([`deflection_names`]).
-pub fn histories(run: Simulation, contacts: &[String], deflections: &[String]) -> Vec<History> {
+/// `_peaks`, `bending_moments` and the impact table, with the columns named `contacts`
+/// (one per recorded contact) and `deflections` ([`deflection_names`]; the moments' as
+/// the deflections'), the moments of pins of `flexure`.
+pub fn histories(
+    run: Simulation,
+    contacts: &[String],
+    deflections: &[String],
+    flexure: &Flexure,
+) -> Vec<History> {
+    let moments = bending::moment_columns(&run, flexure);
     let named = |names: &[String], columns: Vec<Vec<f64>>| -> Vec<(String, Vec<f64>)> {
         names.iter().cloned().zip(columns).collect()
     };
@@ -237,6 +260,7 @@ pub fn histories(run: Simulation, contacts: &[String], deflections: &[String]) -
             "displacements_peaks",
             named(deflections, run.deflection_peaks.into_iter().flatten().collect()),
         ),
+        history("bending_moments", named(deflections, moments)),
         table,
     ]
 }
@@ -268,11 +292,13 @@ pub struct RunSize<'a> {
 impl RunSize<'_> {
     /// Lines × modes modal DOFs and every contact at each step; histories
     /// `contact_forces` (time + one column per recorded contact) and `displacements`
-    /// (time + one column per line and output height), their peaks, and the impact table.
+    /// (time + one column per line and output height), their peaks, the moments (as the
+    /// displacements), and the impact table.
     pub fn estimate(&self) -> WorkEstimate {
         let (stepping, samples) = common_inputs::stepping(self.settings, self.step);
         let stepping = common_inputs::with_auto_note(stepping, self.choice, "pin");
-        let columns = 2 * ((1 + self.recorded) + (1 + self.lines * self.settings.output_heights.len()));
+        // Forces and their peaks; deflections, their peaks and the moments.
+        let columns = 2 * (1 + self.recorded) + 3 * (1 + self.lines * self.settings.output_heights.len());
         let mut history_drivers = vec![
             "/inputs/solver/duration".to_owned(),
             "/inputs/output/interval".to_owned(),

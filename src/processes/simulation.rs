@@ -43,6 +43,8 @@ pub enum HistoryKind {
     Displacement,
     /// Forces (N), sampled at each output time.
     Force,
+    /// Bending moments (N·m), sampled at each output time.
+    Moment,
     /// The extreme of each output interval over all steps (a `_peaks` companion).
     Peaks,
     /// Not a time series: one row per event.
@@ -55,6 +57,7 @@ impl HistoryKind {
         match self {
             Self::Displacement => "displacement",
             Self::Force => "force",
+            Self::Moment => "moment",
             Self::Peaks => "peaks",
             Self::Table => "table",
         }

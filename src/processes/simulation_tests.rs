@@ -194,7 +194,10 @@ fn a_bundle_results_document_is_what_its_schema_says_in_both_forms() {
 fn every_process_writes_what_its_schema_and_outputs_declare() {
     let registry = super::Registry::builtin();
     for process in registry.all() {
-        let example = process.examples().first().unwrap_or_else(|| panic!("{} has no example", process.id()));
+        let example = process
+            .examples()
+            .first()
+            .unwrap_or_else(|| panic!("{} has no example", process.id()));
         let mut inputs = serde_json::from_str::<Value>(example.body).expect("JSON")["inputs"].clone();
         inputs["solver"]["duration"] = json!(0.002);
         let output = run(process.as_ref(), &inputs);

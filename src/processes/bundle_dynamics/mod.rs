@@ -10,6 +10,7 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
+use super::bending::{Bending, Flexure};
 use super::columns;
 use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::LawInput;
@@ -45,6 +46,10 @@ pub struct Plan {
 }
 
 impl Plan {
+    fn flexure(&self) -> Flexure {
+        Flexure::of(&self.inputs.pin, None)
+    }
+
     fn model(&self) -> Model<'_> {
         row_model(&self.inputs, self.pins, &self.contacts, &self.basis)
     }
@@ -168,12 +173,14 @@ pub struct ContactResult {
     pub statistics: ContactStatistics,
 }
 
-/// One pin's largest deflections.
+/// One pin's largest deflections and bending.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 pub struct PinResult {
     pub pin: usize,
     #[serde(flatten)]
     pub extremes: LineExtremes,
+    /// Its largest bending over its height and the output samples.
+    pub bending: Bending,
 }
 
 /// The explicit model the generator form expands to.
@@ -278,6 +285,7 @@ impl Simulation for BundleDynamics {
             description: "As displacements, each value the deflection of largest magnitude (signed) reached at \
                           any step of its output interval",
         },
+        run_report::MOMENTS_OUTPUT,
         impact_report::TABLE_OUTPUT,
     ];
 
@@ -484,10 +492,12 @@ impl Simulation for BundleDynamics {
             })
             .collect();
         let heights = &plan.settings.output_heights;
+        let flexure = plan.flexure();
         let pins: Vec<PinResult> = (0..plan.pins)
             .map(|p| PinResult {
                 pin: p,
                 extremes: LineExtremes::of_line(&simulation, heights, p),
+                bending: flexure.bending(&simulation.pin_curvatures[p]),
             })
             .collect();
         let basis = BasisReport::of(
@@ -504,8 +514,8 @@ impl Simulation for BundleDynamics {
                 quality,
                 &plan.settings,
                 &allowables,
-                basis,
-                plan.basis.frequencies_hz(),
+                (basis, plan.basis.frequencies_hz()),
+                &flexure,
             ),
             expansion: plan.inputs.bundle.is_some().then(|| Expansion {
                 pins: plan.pins,
@@ -556,7 +566,7 @@ fn histories(plan: &Plan, simulation: Run) -> Vec<History> {
         run_report::deflection_names(&plan.settings.output_heights, plan.pins, tips_only, |p| {
             format!("p{p}")
         });
-    run_report::histories(simulation, &contacts, &deflections)
+    run_report::histories(simulation, &contacts, &deflections, &plan.flexure())
 }
 
 /// A column of `bundle-dynamics`: `c<k>` the force (N) of contact k of the results'
@@ -581,6 +591,10 @@ fn column_of(output: &str, name: &str, document: &serde_json::Value) -> Option<s
                 "m",
                 format!("deflection of p{pin} at {at}, toward the right wall, relative to the pin feet"),
             )
+        }
+        "bending_moments" => {
+            let (pin, _, at) = columns::deflection(name, false)?;
+            ("N·m", format!("bending moment EI w'' of p{pin} at {at}"))
         }
         _ => return None,
     };

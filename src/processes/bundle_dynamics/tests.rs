@@ -437,3 +437,84 @@ fn its_columns_name_their_bodies_heights_and_units() {
     let mid = column_of("displacements_peaks", "p1@0.9", &row_document).unwrap();
     assert!(mid.description.unwrap().starts_with("deflection of p1 at 0.9 m"));
 }
+
+/// A tip force brought on slowly to a pin damped at 0.9 of critical bends it as statics says:
+/// M = F (L − z) along the height (the wall contact, 1 m away, never closes: its static
+/// correction puts the tip's static shape in the basis, which the Hermite elements hold
+/// exactly), σ = M c / I and ε = σ / E at the outer fibre, the worst at the clamped foot;
+/// the moment history at the foot settles on F L.
+#[test]
+fn a_slow_tip_force_bends_the_pin_as_statics_says() {
+    let (force, length) = (0.05, 1.0);
+    let mut pin = pin();
+    pin["damping_ratio"] = json!(0.9);
+    pin["modes"] = json!(4);
+    let output = run(&json!({"pin": pin, "pins": 1,
+        "contacts": [{"left": 0, "right": "wall", "height": length, "gap": 1.0, "stiffness": 1e3}],
+        "excitation": {"point_forces": [{"pin": 0, "height": length, "time": [0.0, 1.0, 10.0],
+                                         "force": [0.0, force, force]}]},
+        "output": {"heights": [0.0, 0.5], "interval": 1e-3},
+        "solver": {"duration": 1.6, "check": "none"}}));
+    let document = &output.document;
+    let (outer, inner) = (0.010f64, 0.009f64);
+    let inertia = std::f64::consts::PI / 64.0 * (outer.powi(4) - inner.powi(4));
+    let envelope = document["bending_envelope"].as_array().unwrap();
+    assert_eq!(envelope.len(), 21, "one entry per node");
+    for entry in envelope {
+        let z = entry["height"].as_f64().unwrap();
+        let moment = entry["moment"].as_f64().unwrap();
+        let exact = force * (length - z);
+        assert!(
+            (moment - exact).abs() <= 1e-4 * force * length,
+            "M at {z} m: {moment:e} vs {exact:e}"
+        );
+        let stress = entry["stress"].as_f64().unwrap();
+        assert!((stress - moment * outer / 2.0 / inertia).abs() <= 1e-9 * stress.abs().max(1.0));
+        let strain = entry["strain"].as_f64().unwrap();
+        assert!((strain - stress / 2.1e11).abs() <= 1e-12 * strain.abs().max(1e-12));
+    }
+    let worst = &document["max_bending"];
+    assert_eq!(worst["height"], 0.0);
+    assert_eq!(worst["pin"], 0);
+    assert_eq!(document["pins"][0]["bending"], *worst);
+    let moments = output
+        .histories
+        .iter()
+        .find(|h| h.name == "bending_moments")
+        .unwrap();
+    let foot = series(moments, "p0@0").last().unwrap();
+    assert!((foot - force * length).abs() <= 1e-6 * force * length, "{foot}");
+    let middle = series(moments, "p0@0.5").last().unwrap();
+    assert!(
+        (middle - 0.5 * force * length).abs() <= 1e-6 * force * length,
+        "{middle}"
+    );
+}
+
+/// With an output height at every node, the largest |moment| of the histories is the
+/// envelope's largest (the same samples, the same places).
+#[test]
+fn the_envelope_holds_the_largest_moment_of_the_histories() {
+    let heights: Vec<f64> = (0..=10).map(|n| n as f64 * 0.1).collect();
+    let mut pin = pin();
+    pin["elements"] = json!(10);
+    let output = run(&json!({"pin": pin, "pins": 2,
+        "contacts": [{"left": "wall", "right": 0, "height": 1.0, "gap": 1e-3, "stiffness": 1e5},
+                     {"left": 0, "right": 1, "height": 0.6, "gap": 5e-4, "stiffness": 1e5},
+                     {"left": 1, "right": "wall", "height": 1.0, "gap": 1e-3, "stiffness": 1e5}],
+        "excitation": {"base_acceleration": {"type": "half_sine", "amplitude": 30.0, "duration": 0.01}},
+        "output": {"heights": heights, "interval": 2e-4},
+        "solver": {"duration": 0.05, "check": "none"}}));
+    let moments = output
+        .histories
+        .iter()
+        .find(|h| h.name == "bending_moments")
+        .unwrap();
+    let largest = (moments.series.iter().flat_map(|(_, values)| values)).fold(0.0f64, |m, v| m.max(v.abs()));
+    let envelope = output.document["max_bending"]["moment"].as_f64().unwrap();
+    assert!(largest > 0.0);
+    assert!(
+        (envelope - largest).abs() <= 1e-12 * largest,
+        "envelope {envelope:e}, histories {largest:e}"
+    );
+}

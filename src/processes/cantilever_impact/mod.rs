@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
+use super::bending::{BendingReport, Flexure};
 use super::columns::{self, Column};
 use super::common_inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::contact_law::{self, LawInput};
@@ -260,6 +261,8 @@ pub struct NumericalResults {
     /// Frequencies of the basis (Hz), eigenmodes then pseudo-modes.
     pub frequencies_hz: Vec<f64>,
     pub energy: EnergyReport,
+    #[serde(flatten)]
+    pub bending: BendingReport,
 }
 
 /// The semi-analytic reference (exact up to modal truncation, no contact dashpot).
@@ -669,6 +672,7 @@ impl Simulation for CantileverImpact {
                 output_interval: simulation.output_interval,
                 frequencies_hz: plan.basis.frequencies_hz(),
                 energy: simulation.energy.into(),
+                bending: BendingReport::of(&simulation, &Flexure::of(&plan.inputs.beam, None)),
             },
             basis: BasisReport::of(
                 &model,

@@ -15,6 +15,7 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
+use super::bending::{Bending, Flexure};
 use super::columns;
 use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::{FrictionReport, LawInput, WearDepth, WearReport};
@@ -56,6 +57,11 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// The pins' flexure: D may be given apart from an explicit section.
+    fn flexure(&self) -> Flexure {
+        Flexure::of(&self.inputs.pin, self.inputs.pin_diameter())
+    }
+
     fn model(&self) -> Model<'_> {
         plane_model(
             &self.inputs,
@@ -201,6 +207,9 @@ pub struct HexPinResult {
     pub x: LineExtremes,
     /// Bending along y.
     pub y: LineExtremes,
+    /// Its largest bending (the resultant of x and y) over its height and the output
+    /// samples.
+    pub bending: Bending,
 }
 
 /// The `hex-bundle-dynamics` process.
@@ -258,6 +267,7 @@ impl Simulation for HexBundleDynamics {
             description: "As displacements, each value the deflection of largest magnitude (signed) reached at \
                           any step of its output interval",
         },
+        run_report::MOMENTS_OUTPUT,
         impact_report::TABLE_OUTPUT,
     ];
     const SHARES_STEPS: bool = true;
@@ -498,6 +508,7 @@ impl Simulation for HexBundleDynamics {
             .max_by(|a, b| a.depth.total_cmp(&b.depth));
         let pin_count = plan.bundle.pin_count();
         let heights = &plan.settings.output_heights;
+        let flexure = plan.flexure();
         let pins: Vec<HexPinResult> = (0..pin_count)
             .map(|p| {
                 let position = plan.bundle.position(p);
@@ -507,6 +518,7 @@ impl Simulation for HexBundleDynamics {
                     position: [position.x, position.y],
                     x: LineExtremes::of_line(&simulation, heights, p),
                     y: LineExtremes::of_line(&simulation, heights, pin_count + p),
+                    bending: flexure.bending(&simulation.pin_curvatures[p]),
                 }
             })
             .collect();
@@ -527,8 +539,8 @@ impl Simulation for HexBundleDynamics {
                 quality,
                 &plan.settings,
                 &allowables,
-                basis,
-                plan.basis.frequencies_hz(),
+                (basis, plan.basis.frequencies_hz()),
+                &flexure,
             ),
         };
         let histories = histories(&plan, simulation);
@@ -781,7 +793,7 @@ fn histories(plan: &Plan, simulation: integrate::Simulation) -> Vec<History> {
     let contacts: Vec<String> = (plan.settings.recorded_contacts.iter().flatten())
         .map(|k| format!("c{k}"))
         .collect();
-    run_report::histories(simulation, &contacts, &deflections)
+    run_report::histories(simulation, &contacts, &deflections, &plan.flexure())
 }
 
 /// A column of `hex-bundle-dynamics`: `c<k>` the force (N, along the contact's normal) of
@@ -811,6 +823,16 @@ fn column_of(output: &str, name: &str, document: &serde_json::Value) -> Option<s
                 "m",
                 format!(
                     "deflection of p{pin} along {} at {at}, relative to the pin feet",
+                    axis.unwrap_or('x')
+                ),
+            )
+        }
+        "bending_moments" => {
+            let (pin, axis, at) = columns::deflection(name, true)?;
+            (
+                "N·m",
+                format!(
+                    "bending moment EI w'' of p{pin} bending along {} at {at}",
                     axis.unwrap_or('x')
                 ),
             )

@@ -453,3 +453,92 @@ fn its_columns_name_their_bodies_heights_and_units() {
             .starts_with("deflection of p12 along y at 0.3 m")
     );
 }
+
+/// A slow force along 30° on one pin at its top, no contact closing (gaps of 5 mm): the
+/// pin bends in x and y, and its bending is the resultant, F (L − z) at every node; the
+/// histories are its cos and sin parts.
+#[test]
+fn a_pin_bent_in_x_and_y_reports_the_resultant() {
+    let (force, length, angle) = (0.05, 0.6, 30f64);
+    let mut inputs = inputs();
+    inputs["pin"]["damping_ratio"] = json!(0.9);
+    inputs["pin"]["static_correction"] = json!("contacts");
+    inputs["gaps"] = json!({"type": "uniform", "pin_pin": 5e-3, "pin_wall": 5e-3});
+    inputs["bundle"]["pitch"] = json!(0.0157);
+    inputs["bundle"]["wrapper_flat_to_flat"] = json!(0.06);
+    inputs["excitation"] = json!({"point_forces": [{"pin": 3, "height": length, "direction": angle,
+        "time": [0.0, 1.0, 10.0], "force": [0.0, force, force]}]});
+    inputs["solver"] = json!({"duration": 1.6, "check": "none"});
+    inputs["output"] = json!({"interval": 1e-3, "heights": [0.0]});
+    let output = run(&inputs);
+    let document = &output.document;
+    assert!(
+        contacts(document).iter().all(|c| c["impacts"] == 0),
+        "no contact closes"
+    );
+    let worst = &document["max_bending"];
+    assert_eq!(worst["pin"], 3);
+    let moment = worst["moment"].as_f64().unwrap();
+    assert!(
+        (moment - force * length).abs() <= 1e-4 * force * length,
+        "{moment:e}"
+    );
+    assert_eq!(document["pins"][3]["bending"], *worst);
+    let moments = output
+        .histories
+        .iter()
+        .find(|h| h.name == "bending_moments")
+        .unwrap();
+    let last = |name: &str| {
+        *moments
+            .series
+            .iter()
+            .find(|(n, _)| n == name)
+            .unwrap()
+            .1
+            .last()
+            .unwrap()
+    };
+    let (x, y) = (last("p3x@0"), last("p3y@0"));
+    let expected = force * length;
+    assert!(
+        (x - expected * angle.to_radians().cos()).abs() <= 1e-5 * expected,
+        "{x:e}"
+    );
+    assert!(
+        (y - expected * angle.to_radians().sin()).abs() <= 1e-5 * expected,
+        "{y:e}"
+    );
+}
+
+/// With an output height at every node, the largest resultant moment of the histories
+/// (√(Mx² + My²) of a pin at a height and sample) is the envelope's largest.
+#[test]
+fn the_envelope_holds_the_largest_resultant_moment_of_the_histories() {
+    let mut inputs = inputs();
+    let heights: Vec<f64> = (0..=12).map(|n| n as f64 * 0.6 / 12.0).collect();
+    inputs["output"]["heights"] = json!(heights);
+    let output = run(&inputs);
+    let moments = output
+        .histories
+        .iter()
+        .find(|h| h.name == "bending_moments")
+        .unwrap();
+    let column = |name: String| &moments.series.iter().find(|(n, _)| *n == name).unwrap().1;
+    let mut largest = 0.0f64;
+    for height in &heights {
+        for pin in 0..7 {
+            let (x, y) = (
+                column(format!("p{pin}x@{height}")),
+                column(format!("p{pin}y@{height}")),
+            );
+            largest = x.iter().zip(y).fold(largest, |m, (x, y)| m.max(x.hypot(*y)));
+        }
+    }
+    let envelope = output.document["max_bending"]["moment"].as_f64().unwrap();
+    assert!(largest > 0.0);
+    assert!(
+        (envelope - largest).abs() <= 1e-12 * largest,
+        "envelope {envelope:e}, histories {largest:e}"
+    );
+}

@@ -88,7 +88,9 @@ pub fn examples_json(registry: &Registry) -> String {
     // A sweep names its process: offered only where that process is.
     let offered = |e: &&Example| {
         let body: serde_json::Value = serde_json::from_str(e.body).unwrap_or_default();
-        body["process"].as_str().is_some_and(|id| registry.get(id).is_some())
+        body["process"]
+            .as_str()
+            .is_some_and(|id| registry.get(id).is_some())
     };
     let sweeps = SWEEP_EXAMPLES.iter().filter(offered).map(|e| (e, None));
     let items: Vec<String> = jobs
