@@ -70,6 +70,32 @@ pub struct BeamInput {
     #[serde(default)]
     #[schema(default = "contacts")]
     pub static_correction: StaticCorrectionInput,
+    /// Shear deformation and rotary inertia: a Timoshenko beam (stubby spans, tubes on
+    /// close supports), with the interdependent interpolation element; absent, the beam
+    /// is Euler–Bernoulli.
+    #[serde(default)]
+    pub timoshenko: Option<TimoshenkoInput>,
+}
+
+/// What a Timoshenko beam needs beyond Euler–Bernoulli: G = E / 2(1 + ν) and the shear
+/// coefficient κ of its section.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TimoshenkoInput {
+    /// Poisson's ratio ν (dimensionless, between −1 and 0.5).
+    #[serde(default = "default_poisson_ratio")]
+    #[schema(default = 0.3, exclusive_minimum = -1.0, exclusive_maximum = 0.5)]
+    pub poisson_ratio: f64,
+    /// Shear coefficient κ (dimensionless, in (0, 1]); default for a tube, Cowper's
+    /// 6(1 + ν)(1 + m²)² / ((7 + 6ν)(1 + m²)² + (20 + 12ν)m²), m = inner / outer diameter
+    /// (0.886 for a solid rod at ν = 0.3, 0.53 for a thin tube); required for an
+    /// explicit section.
+    #[schema(exclusive_minimum = 0.0, maximum = 1.0)]
+    pub shear_coefficient: Option<f64>,
+}
+
+fn default_poisson_ratio() -> f64 {
+    0.3
 }
 
 /// Static correction of the modal basis: `none` or `contacts`.
@@ -245,6 +271,21 @@ impl BeamInput {
             elements: self.elements.given().unwrap_or(auto::START_ELEMENTS),
             foot: self.supports.foot.into(),
             top: self.supports.top.into(),
+            shear: self.timoshenko.map(|t| crate::physics::beam::Shear {
+                coefficient: t.shear_coefficient.unwrap_or(match self.section {
+                    SectionInput::Tube {
+                        outer_diameter,
+                        inner_diameter,
+                    } => crate::physics::beam::tube_shear_coefficient(
+                        outer_diameter,
+                        inner_diameter,
+                        t.poisson_ratio,
+                    ),
+                    // Refused in `validate` (`timoshenko/shear_coefficient` is required).
+                    SectionInput::Explicit { .. } => 1.0,
+                }),
+                poisson_ratio: t.poisson_ratio,
+            }),
         }
     }
 
@@ -333,7 +374,24 @@ impl BeamInput {
     /// Every problem with the beam and its truncation, as physics issues relative to it.
     pub fn validate(&self) -> Vec<InputIssue> {
         let spec = self.spec();
-        let mut issues = spec.validate();
+        let mut issues: Vec<InputIssue> = spec
+            .validate()
+            .into_iter()
+            .map(|issue| match issue.field.as_str() {
+                "shear/coefficient" => InputIssue::new("timoshenko/shear_coefficient", issue.reason),
+                "shear/poisson_ratio" => InputIssue::new("timoshenko/poisson_ratio", issue.reason),
+                _ => issue,
+            })
+            .collect();
+        if let (Some(t), SectionInput::Explicit { .. }) = (self.timoshenko, self.section)
+            && t.shear_coefficient.is_none()
+        {
+            issues.push(InputIssue::new(
+                "timoshenko/shear_coefficient",
+                "is required with an explicit section (its shape sets κ: 0.886 for a solid rod, 0.53 for a thin \
+                 tube)",
+            ));
+        }
         if let CountInput::Given(modes) = self.modes
             && spec.elements >= 1
             && (modes == 0 || modes > spec.free_dof_count())

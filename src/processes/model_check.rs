@@ -46,6 +46,7 @@ impl StandIn {
                 elements: 2,
                 foot: Support::Clamped,
                 top,
+                shear: None,
             };
             ModalBasis::compute(&spec, 1)
         };

@@ -1,6 +1,9 @@
-//! Euler–Bernoulli beam: section, material, supports, and the finite-element model with
-//! 2-node Hermite cubic elements (DOFs per node: deflection w (m), rotation θ (rad)) and
-//! consistent mass.
+//! Euler–Bernoulli or Timoshenko beam: section, material, supports, and the
+//! finite-element model with 2-node elements (DOFs per node: deflection w (m), rotation θ
+//! (rad)) and consistent mass: Hermite cubics for Euler–Bernoulli; for Timoshenko (shear
+//! deformation and rotary inertia), the interdependent interpolation of Friedman and
+//! Kosmatka (1993), exact for a uniform beam under end loads, with Φ = 12EI/(κGAh²) and
+//! the Hermite element recovered at Φ = 0.
 //!
 //! Nodes are numbered from the foot (x = 0) to the top (x = L); the global DOF of node
 //! `n` are `2n` (w) and `2n + 1` (θ). Matrices are dense, row-major, over all DOFs;
@@ -171,6 +174,27 @@ pub struct BeamSpec {
     pub foot: Support,
     /// Support at the top (x = L); free by default.
     pub top: Support,
+    /// Shear deformation and rotary inertia (Timoshenko); `None` for Euler–Bernoulli.
+    pub shear: Option<Shear>,
+}
+
+/// What a Timoshenko beam adds to Euler–Bernoulli: the shear stiffness κGA (with
+/// G = E / 2(1 + ν)) and the rotary inertia ρI of the section.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shear {
+    /// Shear coefficient κ (dimensionless): 0.5 to 0.53 for a thin tube, 0.9 for a solid
+    /// rod (Cowper: 6(1 + ν)/(7 + 6ν) for a solid circle).
+    pub coefficient: f64,
+    /// Poisson's ratio ν (dimensionless).
+    pub poisson_ratio: f64,
+}
+
+/// Timoshenko shear coefficient of a tube (Cowper 1966), m = d_i / d_o:
+/// κ = 6(1 + ν)(1 + m²)² / ((7 + 6ν)(1 + m²)² + (20 + 12ν) m²).
+pub fn tube_shear_coefficient(outer_diameter: f64, inner_diameter: f64, poisson_ratio: f64) -> f64 {
+    let (m2, nu) = ((inner_diameter / outer_diameter).powi(2), poisson_ratio);
+    let a = (1.0 + m2).powi(2);
+    6.0 * (1.0 + nu) * a / ((7.0 + 6.0 * nu) * a + (20.0 + 12.0 * nu) * m2)
 }
 
 /// Largest mesh accepted: the eigenproblem is dense, O(n³).
@@ -185,6 +209,15 @@ impl BeamSpec {
     /// Bending stiffness EI (N·m²).
     pub fn bending_stiffness(&self) -> f64 {
         self.young_modulus * self.section.inertia()
+    }
+
+    /// Φ = 12 EI / (κ G A h²) of an element of length `h`: the ratio of its shear to its
+    /// bending flexibility; 0 for Euler–Bernoulli.
+    pub fn shear_factor(&self, h: f64) -> f64 {
+        self.shear.map_or(0.0, |shear| {
+            let g = self.young_modulus / (2.0 * (1.0 + shear.poisson_ratio));
+            12.0 * self.bending_stiffness() / (shear.coefficient * g * self.section.area() * h * h)
+        })
     }
 
     /// Every problem with this beam (empty when valid). Fields are relative to the beam.
@@ -229,6 +262,23 @@ impl BeamSpec {
                 ),
             ));
         }
+        if let Some(shear) = self.shear {
+            if !(shear.coefficient.is_finite() && shear.coefficient > 0.0 && shear.coefficient <= 1.0) {
+                issues.push(InputIssue::new(
+                    "shear/coefficient",
+                    format!("must be in (0, 1] (got {})", number(shear.coefficient)),
+                ));
+            }
+            if !(shear.poisson_ratio.is_finite() && shear.poisson_ratio > -1.0 && shear.poisson_ratio < 0.5) {
+                issues.push(InputIssue::new(
+                    "shear/poisson_ratio",
+                    format!(
+                        "must be in (−1, 0.5), the range of a stable isotropic material (got {})",
+                        number(shear.poisson_ratio)
+                    ),
+                ));
+            }
+        }
         if !(1..=MAX_ELEMENTS).contains(&self.elements) {
             issues.push(InputIssue::new(
                 "elements",
@@ -272,6 +322,8 @@ pub struct BeamModel {
     pub mass: Vec<f64>,
     /// DOFs not fixed by the supports, increasing.
     pub free_dofs: Vec<usize>,
+    /// Φ of its elements: 0 for Euler–Bernoulli ([`BeamSpec::shear_factor`]).
+    pub shear_factor: f64,
 }
 
 impl BeamModel {
@@ -282,8 +334,14 @@ impl BeamModel {
         let h = spec.length / elements as f64;
         let ei = spec.bending_stiffness();
         let m = spec.mass_per_length();
-        let k_elem = element_stiffness(ei, h);
-        let m_elem = element_mass(m, h);
+        let phi = spec.shear_factor(h);
+        let (k_elem, m_elem) = match spec.shear {
+            None => (element_stiffness(ei, h), element_mass(m, h)),
+            Some(_) => (
+                timoshenko_stiffness(ei, h, phi),
+                timoshenko_mass(m, spec.density * spec.section.inertia(), h, phi),
+            ),
+        };
         let mut stiffness = vec![0.0; dofs * dofs];
         let mut mass = vec![0.0; dofs * dofs];
         for e in 0..elements {
@@ -311,6 +369,7 @@ impl BeamModel {
             stiffness,
             mass,
             free_dofs,
+            shear_factor: phi,
         }
     }
 
@@ -335,7 +394,10 @@ impl BeamModel {
         let position = (x / h).clamp(0.0, self.elements as f64);
         let node = position.round();
         let of = |element: usize, xi: f64| {
-            let weights = hermite_curvatures(xi, h);
+            let weights = match self.shear_factor {
+                0.0 => hermite_curvatures(xi, h),
+                phi => timoshenko_curvatures(xi, h, phi),
+            };
             (0..4).map(|k| weights[k] * u[2 * element + k]).sum::<f64>()
         };
         if (position - node).abs() <= 1e-9 {
@@ -355,7 +417,11 @@ impl BeamModel {
     /// Hermite interpolation weights of height `x`: w(x) = Σ weights[k] · u[first_dof + k].
     pub fn interpolation(&self, x: f64) -> (usize, [f64; 4]) {
         let (element, xi) = self.locate(x);
-        (2 * element, hermite_shape_functions(xi, self.element_length))
+        let weights = match self.shear_factor {
+            0.0 => hermite_shape_functions(xi, self.element_length),
+            phi => timoshenko_shape_functions(xi, self.element_length, phi),
+        };
+        (2 * element, weights)
     }
 }
 
@@ -383,6 +449,87 @@ pub fn hermite_shape_functions(xi: f64, h: f64) -> [f64; 4] {
         h * (xi - 2.0 * xi2 + xi3),
         3.0 * xi2 - 2.0 * xi3,
         h * (xi3 - xi2),
+    ]
+}
+
+/// Deflection w = Σ Nₖ uₖ of the interdependent Timoshenko element (Friedman and
+/// Kosmatka 1993) of length `h` and shear factor Φ at ξ: the Hermite cubics at Φ = 0.
+pub fn timoshenko_shape_functions(xi: f64, h: f64, phi: f64) -> [f64; 4] {
+    let (xi2, xi3, d) = (xi * xi, xi * xi * xi, 1.0 / (1.0 + phi));
+    [
+        d * (2.0 * xi3 - 3.0 * xi2 - phi * xi + 1.0 + phi),
+        d * h * (xi3 - (2.0 + 0.5 * phi) * xi2 + (1.0 + 0.5 * phi) * xi),
+        d * (-2.0 * xi3 + 3.0 * xi2 + phi * xi),
+        d * h * (xi3 - (1.0 - 0.5 * phi) * xi2 - 0.5 * phi * xi),
+    ]
+}
+
+/// The bending curvature dθ/dx (the moment over EI) of the interdependent Timoshenko
+/// element at ξ, from its rotation interpolation θ = Σ N̂ₖ uₖ
+/// (N̂ = [6(ξ² − ξ)/h, 3ξ² − (4 + Φ)ξ + 1 + Φ, −6(ξ² − ξ)/h, 3ξ² − (2 − Φ)ξ] / (1 + Φ)):
+/// [`hermite_curvatures`] at Φ = 0.
+pub fn timoshenko_curvatures(xi: f64, h: f64, phi: f64) -> [f64; 4] {
+    let d = 1.0 / ((1.0 + phi) * h);
+    [
+        d * 6.0 * (2.0 * xi - 1.0) / h,
+        d * (6.0 * xi - 4.0 - phi),
+        d * 6.0 * (1.0 - 2.0 * xi) / h,
+        d * (6.0 * xi - 2.0 + phi),
+    ]
+}
+
+/// Timoshenko element stiffness (Przemieniecki): EI/((1 + Φ)h³) [[12, 6h, −12, 6h],
+/// [6h, (4 + Φ)h², −6h, (2 − Φ)h²], ...].
+fn timoshenko_stiffness(ei: f64, h: f64, phi: f64) -> [[f64; 4]; 4] {
+    let c = ei / ((1.0 + phi) * h * h * h);
+    let h2 = h * h;
+    [
+        [12.0 * c, 6.0 * h * c, -12.0 * c, 6.0 * h * c],
+        [
+            6.0 * h * c,
+            (4.0 + phi) * h2 * c,
+            -6.0 * h * c,
+            (2.0 - phi) * h2 * c,
+        ],
+        [-12.0 * c, -6.0 * h * c, 12.0 * c, -6.0 * h * c],
+        [
+            6.0 * h * c,
+            (2.0 - phi) * h2 * c,
+            -6.0 * h * c,
+            (4.0 + phi) * h2 * c,
+        ],
+    ]
+}
+
+/// Timoshenko consistent element mass (Przemieniecki): the translational inertia of the
+/// mass per length `m` and the rotary inertia `rho_i` (ρI, kg·m) with the element's
+/// interpolation.
+fn timoshenko_mass(m: f64, rho_i: f64, h: f64, phi: f64) -> [[f64; 4]; 4] {
+    let (p, p2, h2) = (phi, phi * phi, h * h);
+    let t = m * h / ((1.0 + p) * (1.0 + p));
+    let (a, b) = (
+        13.0 / 35.0 + 7.0 * p / 10.0 + p2 / 3.0,
+        (11.0 / 210.0 + 11.0 * p / 120.0 + p2 / 24.0) * h,
+    );
+    let (c, d) = (
+        9.0 / 70.0 + 3.0 * p / 10.0 + p2 / 6.0,
+        (13.0 / 420.0 + 3.0 * p / 40.0 + p2 / 24.0) * h,
+    );
+    let (e, f) = (
+        (1.0 / 105.0 + p / 60.0 + p2 / 120.0) * h2,
+        (1.0 / 140.0 + p / 60.0 + p2 / 120.0) * h2,
+    );
+    let r = rho_i / ((1.0 + p) * (1.0 + p) * h);
+    let (g, k) = (6.0 / 5.0, (1.0 / 10.0 - p / 2.0) * h);
+    let (l, n) = (
+        (2.0 / 15.0 + p / 6.0 + p2 / 3.0) * h2,
+        (-1.0 / 30.0 - p / 6.0 + p2 / 6.0) * h2,
+    );
+    [
+        [t * a + r * g, t * b + r * k, t * c - r * g, -t * d + r * k],
+        [t * b + r * k, t * e + r * l, t * d - r * k, -t * f + r * n],
+        [t * c - r * g, t * d - r * k, t * a + r * g, -t * b - r * k],
+        [-t * d + r * k, -t * f + r * n, -t * b - r * k, t * e + r * l],
     ]
 }
 
@@ -428,6 +575,7 @@ pub(crate) mod tests {
             elements,
             foot: Support::Clamped,
             top: Support::Free,
+            shear: None,
         }
     }
 
@@ -477,6 +625,95 @@ pub(crate) mod tests {
             "tip {} vs {expected}",
             solution[tip]
         );
+    }
+
+    /// A thick tube (L/D = 5) as a Timoshenko beam: κ from Cowper, ν = 0.3.
+    pub(crate) fn thick_timoshenko_tube(elements: usize) -> BeamSpec {
+        let (outer, inner) = (0.2, 0.16);
+        BeamSpec {
+            length: 1.0,
+            section: Section::Tube {
+                outer_diameter: outer,
+                inner_diameter: inner,
+            },
+            shear: Some(Shear {
+                coefficient: tube_shear_coefficient(outer, inner, 0.3),
+                poisson_ratio: 0.3,
+            }),
+            ..default_tube(elements)
+        }
+    }
+
+    /// The interdependent Timoshenko element is exact under end loads: a tip load P on
+    /// a cantilever deflects it by P L³/3EI + P L/κGA (bending plus shear) on any mesh, and
+    /// its static rotation at the tip is the bending one, P L²/2EI; the rigid
+    /// translation keeps the total mass and strains nothing.
+    #[test]
+    fn a_timoshenko_cantilever_adds_the_shear_deflection_exactly() {
+        for elements in [1, 3, 8] {
+            let spec = thick_timoshenko_tube(elements);
+            let model = BeamModel::assemble(&spec);
+            assert!(
+                model.shear_factor > 0.01,
+                "a thick beam: Φ = {}",
+                model.shear_factor
+            );
+            let n = model.dof_count();
+            let free = &model.free_dofs;
+            let k: Vec<f64> = (free.iter().flat_map(|&i| free.iter().map(move |&j| (i, j))))
+                .map(|(i, j)| model.stiffness[i * n + j])
+                .collect();
+            let mut rhs = vec![0.0; free.len()];
+            let tip = free.iter().position(|&d| d == 2 * spec.elements).unwrap();
+            rhs[tip] = 1.0;
+            let solution = solve_dense(&k, &rhs);
+            let shear = spec.shear.unwrap();
+            let g = spec.young_modulus / (2.0 * (1.0 + shear.poisson_ratio));
+            let ei = spec.bending_stiffness();
+            let expected = spec.length.powi(3) / (3.0 * ei)
+                + spec.length / (shear.coefficient * g * spec.section.area());
+            assert!(
+                (solution[tip] - expected).abs() < 1e-9 * expected,
+                "{elements}: {} vs {expected}",
+                solution[tip]
+            );
+            let rotation = solution[tip + 1];
+            let bending = spec.length.powi(2) / (2.0 * ei);
+            assert!(
+                (rotation - bending).abs() < 1e-9 * bending,
+                "{elements}: θ {rotation} vs {bending}"
+            );
+            // The moment along the beam is P (L − z), whatever the shear.
+            let mut u = vec![0.0; n];
+            for (f, d) in free.iter().enumerate() {
+                u[*d] = solution[f];
+            }
+            for z in [0.0, 0.3, 0.5, 1.0] {
+                let moment = ei * model.curvature_at(z, &u);
+                assert!(
+                    (moment - (spec.length - z)).abs() < 1e-9,
+                    "{elements}: M({z}) = {moment}"
+                );
+            }
+            let r: Vec<f64> = (0..n).map(|d| if d % 2 == 0 { 1.0 } else { 0.0 }).collect();
+            let quad = |matrix: &[f64]| -> f64 {
+                (0..n)
+                    .map(|i| (0..n).map(|j| r[i] * matrix[i * n + j] * r[j]).sum::<f64>())
+                    .sum()
+            };
+            let mass = spec.mass_per_length() * spec.length;
+            assert!((quad(&model.mass) - mass).abs() < 1e-12 * mass);
+            assert!(quad(&model.stiffness).abs() < 1e-6);
+        }
+    }
+
+    /// Cowper's κ: 6(1 + ν)/(7 + 6ν) for a solid circle, → 2(1 + ν)/(4 + 3ν) for a thin tube.
+    #[test]
+    fn cowpers_shear_coefficients_of_a_rod_and_a_thin_tube() {
+        let nu = 0.3;
+        assert!((tube_shear_coefficient(1.0, 0.0, nu) - 6.0 * 1.3 / (7.0 + 1.8)).abs() < 1e-15);
+        let thin = tube_shear_coefficient(1.0, 0.999_999, nu);
+        assert!((thin - 2.0 * 1.3 / (4.0 + 0.9)).abs() < 1e-6, "{thin}");
     }
 
     fn solve_dense(matrix: &[f64], rhs: &[f64]) -> Vec<f64> {

@@ -518,3 +518,57 @@ fn the_envelope_holds_the_largest_moment_of_the_histories() {
         "envelope {envelope:e}, histories {largest:e}"
     );
 }
+
+/// `pin.timoshenko`: a thick pinned–pinned tube's first frequency is the exact
+/// Timoshenko one (the lower root of (ρ²I/κG) ω⁴ − (ρA + ρI k² + ρEI k²/κG) ω² + EI k⁴,
+/// k = π/L, κ Cowper's for the tube), below Euler–Bernoulli's; bad values are refused at
+/// their members.
+#[test]
+fn a_timoshenko_pin_has_the_exact_thick_beam_frequency() {
+    let (length, outer, inner, nu) = (0.3, 0.05f64, 0.04f64, 0.3);
+    let (e, rho) = (2.1e11, 7800.0);
+    let pin = |timoshenko: Value| {
+        json!({"length": length, "young_modulus": e, "density": rho,
+               "section": {"type": "tube", "outer_diameter": outer, "inner_diameter": inner},
+               "supports": {"foot": "pinned", "top": "pinned"},
+               "elements": 40, "modes": 2, "timoshenko": timoshenko})
+    };
+    let row = |pin: Value| {
+        json!({"pin": pin, "pins": 1, "contacts": [],
+               "initial": {"tip_displacements": [0.0]},
+               "solver": {"duration": 1e-4, "check": "none"}})
+    };
+    let frequency = |pin: Value| run(&row(pin)).document["frequencies_hz"][0].as_f64().unwrap();
+    let thick = frequency(pin(json!({"poisson_ratio": nu})));
+    let slender = frequency(pin(Value::Null));
+    let area = std::f64::consts::PI / 4.0 * (outer.powi(2) - inner.powi(2));
+    let inertia = std::f64::consts::PI / 64.0 * (outer.powi(4) - inner.powi(4));
+    let m2 = (inner / outer).powi(2);
+    let kappa = 6.0 * (1.0 + nu) * (1.0 + m2).powi(2)
+        / ((7.0 + 6.0 * nu) * (1.0 + m2).powi(2) + (20.0 + 12.0 * nu) * m2);
+    let kg = kappa * e / (2.0 * (1.0 + nu));
+    let k = std::f64::consts::PI / length;
+    let (a, b, c) = (
+        rho * rho * inertia / kg,
+        rho * area + rho * inertia * k * k + rho * e * inertia * k * k / kg,
+        e * inertia * k.powi(4),
+    );
+    let exact = ((b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a)).sqrt() / (2.0 * std::f64::consts::PI);
+    assert!((thick / exact - 1.0).abs() < 1e-4, "{thick} Hz vs {exact} Hz");
+    assert!(
+        thick < 0.97 * slender,
+        "{thick} Hz vs Euler–Bernoulli {slender} Hz"
+    );
+
+    let mut bad = row(pin(json!({"poisson_ratio": 0.6, "shear_coefficient": 0.0})));
+    assert_eq!(
+        pointers(&bad),
+        [
+            "/inputs/pin/timoshenko/shear_coefficient",
+            "/inputs/pin/timoshenko/poisson_ratio"
+        ]
+    );
+    bad["pin"]["section"] = json!({"type": "explicit", "area": area, "inertia": inertia});
+    bad["pin"]["timoshenko"] = json!({});
+    assert_eq!(pointers(&bad), ["/inputs/pin/timoshenko/shear_coefficient"]);
+}

@@ -21,6 +21,7 @@ pub(super) fn pin(elements: usize) -> BeamSpec {
         elements,
         foot: Support::Clamped,
         top: Support::Free,
+        shear: None,
     }
 }
 
@@ -244,6 +245,7 @@ fn pseudo_modes_at_crowded_heights_chosen_by_pivoted_cholesky() {
         elements: 60,
         foot: Support::Clamped,
         top: Support::Free,
+        shear: None,
     };
     let (modes, k) = (20, 4e6);
     let heights: Vec<f64> = (1..=60).map(|i| 0.03 * i as f64).collect();

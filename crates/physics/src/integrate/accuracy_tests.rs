@@ -64,6 +64,7 @@ impl Row {
             elements: 30,
             foot: Support::Clamped,
             top: Support::Free,
+            shear: None,
         };
         ModalBasis::compute(&spec, self.modes).expect("valid pin")
     }
