@@ -3,8 +3,12 @@
 //! Data flows one way: HTTP/CLI → validated process inputs → queue → worker →
 //! physics → results store → HTTP. The physics core is pure (no IO, no async).
 
+/// Labels and a note attached to a job, checked (a leaf above the processes' errors).
+pub mod annotations;
 /// The `chocmodal` command line (serve, run).
 pub mod cli;
+/// The per-contact statistics table of a results document (CLI and HTTP, one writer).
+pub mod contact_table;
 /// CSV as every output writes it: one number format, one quoting rule (a leaf).
 pub mod csv_format;
 /// Request bodies as JSON values, with pointer-bearing errors (numbers out of range).
@@ -14,6 +18,8 @@ pub mod json_body;
 pub use chocmodal_physics as physics;
 /// JSON pointers of serde paths (a leaf: nothing else in the crate is imported).
 pub mod pointer;
+/// Solver version, build and inputs hash stamped on every results document (a leaf).
+pub mod provenance;
 /// RFC 9457 problem details shared by the HTTP API and the CLI.
 pub mod problem;
 /// One module per process: JSON inputs (validated) → physics → results document + histories.

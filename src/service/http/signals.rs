@@ -231,7 +231,9 @@ pub struct ListQuery {
     pub limit: Option<u32>,
     /// Opaque position from a `next` link.
     pub cursor: Option<i64>,
-    /// OGC format parameter (accepted, ignored).
+    /// `json`, or `html` (the dashboard's page): chosen by the service's negotiator
+    /// (`format` is an alias); without it, the one `Accept` prefers.
+    #[serde(alias = "format")]
     pub f: Option<String>,
 }
 
@@ -311,8 +313,9 @@ pub async fn delete(
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct SamplesQuery {
-    /// `csv` (`time,acceleration`) or `json` (`{"time", "acceleration"}`); default from
-    /// `Accept` (CSV when it prefers `text/csv`), else JSON.
+    /// Chosen by the service's negotiator (`f` is an alias): `csv` or `json`; without
+    /// it, the one `Accept` prefers (q-values honoured), else JSON.
+    #[serde(alias = "f")]
     pub format: Option<String>,
 }
 
@@ -333,19 +336,20 @@ pub async fn samples(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
     Path(signal_id): Path<String>,
-    ApiQuery(query): ApiQuery<SamplesQuery>,
-    headers: HeaderMap,
+    // Checks the query; its `format` is the negotiator's (`format: Format`).
+    ApiQuery(_): ApiQuery<SamplesQuery>,
+    format: Format,
 ) -> Result<Response, ApiError> {
-    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
     let record = state
         .signals
         .record(tenant.as_str(), &signal_id)
         .await?
         .ok_or_else(|| Problem::no_such_signal(&signal_id))?;
     let record = Arc::new(record);
-    let chunks: Box<dyn Iterator<Item = String> + Send> = match format {
-        Format::Csv => Box::new(signal_record::csv_chunks(record, STREAM_ROWS)),
-        Format::Json => Box::new(signal_record::json_chunks(record, STREAM_ROWS)),
+    let chunks: Box<dyn Iterator<Item = String> + Send> = if format == Format::Csv {
+        Box::new(signal_record::csv_chunks(record, STREAM_ROWS))
+    } else {
+        Box::new(signal_record::json_chunks(record, STREAM_ROWS))
     };
     let stream =
         futures_util::stream::iter(chunks.map(|chunk| Ok::<_, std::convert::Infallible>(Bytes::from(chunk))));
@@ -389,11 +393,10 @@ pub async fn spectrum(
     Extension(tenant): Extension<Tenant>,
     Path(signal_id): Path<String>,
     query: Result<Query<Vec<(String, String)>>, axum::extract::rejection::QueryRejection>,
-    headers: HeaderMap,
+    format: Format,
 ) -> Result<Response, ApiError> {
     let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
     let request = parse_spectrum_query(&pairs, &[])?.request;
-    let format = Format::from_query(request.format.as_deref(), Format::preferred(&headers))?;
     let metadata = state
         .signals
         .get(tenant.as_str(), &signal_id)
@@ -430,9 +433,10 @@ pub async fn spectrum(
             .collect(),
         pga: metadata.pga,
     };
-    let body = match format {
-        Format::Json => serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))?,
-        Format::Csv => spectra_csv(&document.frequencies, &document.pseudo_acceleration).into_bytes(),
+    let body = if format == Format::Csv {
+        spectra_csv(&document.frequencies, &document.pseudo_acceleration).into_bytes()
+    } else {
+        serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))?
     };
     Ok((
         [(

@@ -226,7 +226,9 @@ pub struct SweepListQuery {
     pub limit: Option<u32>,
     /// Opaque position from a `next` link.
     pub cursor: Option<i64>,
-    /// Accepted and ignored (OGC format parameter).
+    /// `json`, or `html` (the dashboard's page): chosen by the service's negotiator
+    /// (`format` is an alias); without it, the one `Accept` prefers.
+    #[serde(alias = "format")]
     pub f: Option<String>,
 }
 
@@ -306,9 +308,10 @@ pub async fn dismiss(
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct SweepResultsQuery {
-    /// `json` (the table with aggregates) or `csv` (the table only); default: JSON, or
-    /// CSV when `Accept` prefers `text/csv`.
+    /// Chosen by the service's negotiator (`f` is an alias): `csv` or `json`; without
+    /// it, the one `Accept` prefers (q-values honoured), else JSON.
     #[param(pattern = "^(csv|json)$")]
+    #[serde(alias = "f")]
     pub format: Option<String>,
 }
 
@@ -333,10 +336,11 @@ pub async fn results(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
     Path(sweep_id): Path<String>,
-    ApiQuery(query): ApiQuery<SweepResultsQuery>,
+    // Checks the query; its `format` is the negotiator's (`format: Format`).
+    ApiQuery(_): ApiQuery<SweepResultsQuery>,
     headers: HeaderMap,
+    format: Format,
 ) -> Result<Response, ApiError> {
-    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
     let csv = format == Format::Csv;
     let record = find(&state, &tenant, &sweep_id).await?;
     let status = sweep_status(&state, &tenant, &record).await?;
