@@ -64,7 +64,10 @@ fn main() {
 
 /// Sets `CHOCMODAL_BUILD_COMMIT` for the compiler (see the module documentation).
 fn record_build_commit() {
-    if let Some(commit) = std::env::var("CHOCMODAL_BUILD_COMMIT").ok().filter(|c| !c.trim().is_empty()) {
+    if let Some(commit) = std::env::var("CHOCMODAL_BUILD_COMMIT")
+        .ok()
+        .filter(|c| !c.trim().is_empty())
+    {
         println!("cargo::rustc-env=CHOCMODAL_BUILD_COMMIT={}", commit.trim());
         return;
     }

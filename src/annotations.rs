@@ -64,7 +64,10 @@ impl Annotations {
             Some(Value::String(text)) if text.chars().count() > MAX_NOTE_CHARS => {
                 errors.push(FieldError::new(
                     "/note",
-                    format!("has {} characters: at most {MAX_NOTE_CHARS}", text.chars().count()),
+                    format!(
+                        "has {} characters: at most {MAX_NOTE_CHARS}",
+                        text.chars().count()
+                    ),
                 ));
                 None
             }
@@ -84,6 +87,18 @@ impl Annotations {
     /// The labels as stored: a JSON array of text.
     pub fn labels_json(&self) -> String {
         serde_json::to_string(&self.labels).expect("text serializes")
+    }
+}
+
+/// Labels as a store keeps them (a JSON array of text), read back.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct StoredLabels(pub Vec<String>);
+
+impl TryFrom<String> for StoredLabels {
+    type Error = serde_json::Error;
+
+    fn try_from(text: String) -> Result<Self, Self::Error> {
+        serde_json::from_str(&text).map(StoredLabels)
     }
 }
 
@@ -118,25 +133,48 @@ mod tests {
 
     #[test]
     fn labels_and_a_note_within_the_limits_are_kept_in_order() {
-        let parsed = Annotations::parse(Some(&json!(["b", "a-1", "zone:B/3", "é"])), Some(&json!("rev. C"))).unwrap();
+        let parsed = Annotations::parse(
+            Some(&json!(["b", "a-1", "zone:B/3", "é"])),
+            Some(&json!("rev. C")),
+        )
+        .unwrap();
         assert_eq!(parsed.labels, ["b", "a-1", "zone:B/3", "é"]);
         assert_eq!(parsed.note.as_deref(), Some("rev. C"));
         assert_eq!(parsed.labels_json(), r#"["b","a-1","zone:B/3","é"]"#);
-        assert_eq!(Annotations::parse(None, Some(&Value::Null)), Ok(Annotations::default()));
+        assert_eq!(
+            Annotations::parse(None, Some(&Value::Null)),
+            Ok(Annotations::default())
+        );
         let longest = "x".repeat(MAX_LABEL_CHARS);
-        assert!(Annotations::parse(Some(&json!([longest])), Some(&json!("n".repeat(MAX_NOTE_CHARS)))).is_ok());
+        assert!(
+            Annotations::parse(Some(&json!([longest])), Some(&json!("n".repeat(MAX_NOTE_CHARS)))).is_ok()
+        );
     }
 
     #[test]
     fn every_bad_label_and_note_is_refused_at_its_pointer() {
         assert_eq!(pointers(json!("a"), json!(null)), ["/labels"]);
         assert_eq!(
-            pointers(json!(["ok", 3, "", "x".repeat(MAX_LABEL_CHARS + 1), "a\nb", " a", "ok"]), json!(4)),
-            ["/labels/1", "/labels/2", "/labels/3", "/labels/4", "/labels/5", "/labels/6", "/note"]
+            pointers(
+                json!(["ok", 3, "", "x".repeat(MAX_LABEL_CHARS + 1), "a\nb", " a", "ok"]),
+                json!(4)
+            ),
+            [
+                "/labels/1",
+                "/labels/2",
+                "/labels/3",
+                "/labels/4",
+                "/labels/5",
+                "/labels/6",
+                "/note"
+            ]
         );
         let many: Vec<String> = (0..=MAX_LABELS).map(|k| format!("l{k}")).collect();
         assert_eq!(pointers(json!(many), json!(null)), ["/labels"]);
-        assert_eq!(pointers(json!([]), json!("n".repeat(MAX_NOTE_CHARS + 1))), ["/note"]);
+        assert_eq!(
+            pointers(json!([]), json!("n".repeat(MAX_NOTE_CHARS + 1))),
+            ["/note"]
+        );
         let errors = Annotations::parse(Some(&json!([{"a": 1}])), None).unwrap_err();
         assert_eq!(errors[0].detail, "must be text");
     }

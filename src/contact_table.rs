@@ -85,7 +85,14 @@ mod tests {
         let table = ContactTable::of(&document).unwrap();
         assert_eq!(
             table.columns,
-            ["contact", "left", "right", "max_force", "impact_statistics.impacts", "wear.work"]
+            [
+                "contact",
+                "left",
+                "right",
+                "max_force",
+                "impact_statistics.impacts",
+                "wear.work"
+            ]
         );
         assert_eq!(table.contacts[1]["contact"], json!(1));
         assert_eq!(

@@ -72,10 +72,12 @@ pub fn parse_execution_request(text: &str) -> Result<ExecutionRequest, Problem> 
             "the body must be a JSON object `{\"inputs\": {...}}`",
         ));
     };
-    if let Some(unknown) = map
-        .keys()
-        .find(|k| !matches!(k.as_str(), "inputs" | "outputs" | "response" | "subscriber" | "labels" | "note"))
-    {
+    if let Some(unknown) = map.keys().find(|k| {
+        !matches!(
+            k.as_str(),
+            "inputs" | "outputs" | "response" | "subscriber" | "labels" | "note"
+        )
+    }) {
         let invalid = InvalidInputs(vec![FieldError::new(
             format!("/{}", crate::pointer::escape(unknown)),
             "unknown member of the execution request",

@@ -18,12 +18,12 @@ pub mod json_body;
 pub use chocmodal_physics as physics;
 /// JSON pointers of serde paths (a leaf: nothing else in the crate is imported).
 pub mod pointer;
-/// Solver version, build and inputs hash stamped on every results document (a leaf).
-pub mod provenance;
 /// RFC 9457 problem details shared by the HTTP API and the CLI.
 pub mod problem;
 /// One module per process: JSON inputs (validated) → physics → results document + histories.
 pub mod processes;
+/// Solver version, build and inputs hash stamped on every results document (a leaf).
+pub mod provenance;
 /// A results document's quality verdict in the words users see (job message, CLI, sweeps).
 pub mod quality_note;
 /// The HTTP service: OGC API – Processes, SQLite job queue, workers, results store.

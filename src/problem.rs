@@ -303,17 +303,6 @@ impl Problem {
         )
     }
 
-    /// 400: the `format` (or `f`) query parameter names a format the resource does not
-    /// have; the detail lists those it has.
-    pub fn unsupported_format(detail: impl Into<String>) -> Self {
-        Self::new(
-            format!("{CHOCMODAL_PROBLEMS}/unsupported-format"),
-            "Unsupported format",
-            400,
-            detail,
-        )
-    }
-
     /// 406: `Accept` excludes every format of the resource; the detail lists them.
     pub fn not_acceptable(detail: impl Into<String>) -> Self {
         Self::new(

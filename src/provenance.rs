@@ -144,7 +144,7 @@ fn push_ecmascript_number(out: &mut String, x: f64) {
             out.push_str(&digits[1..]);
         }
         out.push('e');
-        out.push(if n - 1 >= 0 { '+' } else { '-' });
+        out.push(if n > 0 { '+' } else { '-' });
         out.push_str(&(n - 1).abs().to_string());
     }
 }
@@ -190,13 +190,17 @@ mod tests {
     #[test]
     fn member_order_whitespace_and_number_spelling_do_not_change_the_hash_but_values_do() {
         let a: Value =
-            serde_json::from_str(r#"{"beam": {"modes": 10, "length": 1.0}, "solver": {"time_step": 1e-5}}"#).unwrap();
+            serde_json::from_str(r#"{"beam": {"modes": 10, "length": 1.0}, "solver": {"time_step": 1e-5}}"#)
+                .unwrap();
         let b: Value = serde_json::from_str(
             r#"{ "solver" : { "time_step" : 0.00001 },
                  "beam" : { "length" : 1, "modes" : 10.0 } }"#,
         )
         .unwrap();
-        assert_eq!(canonical_text(&a), r#"{"beam":{"length":1,"modes":10},"solver":{"time_step":0.00001}}"#);
+        assert_eq!(
+            canonical_text(&a),
+            r#"{"beam":{"length":1,"modes":10},"solver":{"time_step":0.00001}}"#
+        );
         assert_eq!(inputs_sha256(&a), inputs_sha256(&b));
         let changed = json!({"beam": {"modes": 11, "length": 1.0}, "solver": {"time_step": 1e-5}});
         assert_ne!(inputs_sha256(&a), inputs_sha256(&changed));
@@ -221,6 +225,9 @@ mod tests {
         let mut document = json!({"numerical": {"impacts": 3}});
         Provenance::of(&json!({"a": 1})).stamp(&mut document);
         assert_eq!(document["provenance"]["solver_version"], SOLVER_VERSION);
-        assert_eq!(document["provenance"]["inputs_sha256"], inputs_sha256(&json!({"a": 1})));
+        assert_eq!(
+            document["provenance"]["inputs_sha256"],
+            inputs_sha256(&json!({"a": 1}))
+        );
     }
 }

@@ -35,7 +35,7 @@ const OUTPUT: &str = "contacts";
             content((ContactTable = "application/json"), (String = "text/csv")),
             headers(("ETag" = String))),
         (status = 304, description = "Unchanged since the `If-None-Match` tag"),
-        (status = 400, description = "A `format` this table has not (`unsupported-format`)",
+        (status = 400, description = "A `format` this table has not (`invalid-query`)",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 404, description = "No such job, results not ready, or a run without contacts",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
@@ -65,8 +65,8 @@ pub async fn contacts(
 
 /// The table of a stored results document in `format`; `None` without contacts.
 fn render(results: &str, format: Format) -> Result<Option<Vec<u8>>, ApiError> {
-    let document: serde_json::Value =
-        serde_json::from_str(results).map_err(|e| ApiError::Internal(format!("stored results unreadable: {e}")))?;
+    let document: serde_json::Value = serde_json::from_str(results)
+        .map_err(|e| ApiError::Internal(format!("stored results unreadable: {e}")))?;
     let Some(table) = ContactTable::of(&document) else {
         return Ok(None);
     };

@@ -187,7 +187,8 @@ pub struct ExecuteRequest {
     /// to these URIs, signed (`Chocmodal-Signature`, see docs/service.md "Job callbacks").
     /// Only hosts the operator allows (`--callback-allow`) are accepted.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub subscriber: Option<SubscriberDocument>,    /// Labels to find the job by (`GET /jobs?label=`): at most 20, each text of 1 to 64
+    pub subscriber: Option<SubscriberDocument>,
+    /// Labels to find the job by (`GET /jobs?label=`): at most 20, each text of 1 to 64
     /// characters without control characters or surrounding spaces, all different.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     #[schema(max_items = 20)]

@@ -4,7 +4,7 @@
 //! Each route template offers a list of [`Format`]s ([`offers`]), its default first.
 //! A GET or HEAD request is answered in:
 //! - the `format` query parameter (or its OGC alias `f`) when given: `json`, `csv`,
-//!   `html`, as the route offers; anything else is a 400 `unsupported-format` naming the
+//!   `html`, as the route offers; anything else is a 400 `invalid-query` naming the
 //!   formats the route has;
 //! - otherwise the offer `Accept` prefers (RFC 9110 §12.5.1): each offer takes the
 //!   quality of the most specific media range that matches it (`text/csv`, then
@@ -105,8 +105,11 @@ pub fn offers(route: &str) -> Option<&'static [Format]> {
 /// Why no representation could be chosen.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Refusal {
-    /// The `format` parameter names a format the route does not offer (400).
-    UnsupportedFormat { asked: String, offered: &'static [Format] },
+    /// The `format` parameter names a format the route does not offer (400 `invalid-query`).
+    UnsupportedFormat {
+        asked: String,
+        offered: &'static [Format],
+    },
     /// `Accept` excludes every format the route offers (406).
     NotAcceptable { offered: &'static [Format] },
     /// `format` and `f` disagree (400).
@@ -123,7 +126,7 @@ impl Refusal {
                 .join(", ")
         };
         match self {
-            Refusal::UnsupportedFormat { asked, offered } => Problem::unsupported_format(format!(
+            Refusal::UnsupportedFormat { asked, offered } => Problem::invalid_query(format!(
                 "this resource is not served as `{asked}`; its formats: {}",
                 list(offered)
             )),
@@ -131,9 +134,9 @@ impl Refusal {
                 "`Accept` excludes every format of this resource: {}",
                 list(offered)
             )),
-            Refusal::Conflicting => Problem::unsupported_format(
-                "`format` and `f` name different formats: give one".to_owned(),
-            ),
+            Refusal::Conflicting => {
+                Problem::invalid_query("`format` and `f` name different formats: give one")
+            }
         }
     }
 }
@@ -214,11 +217,7 @@ pub fn preferred(accept: Option<&str>, offered: &[Format]) -> Option<Format> {
             let (quality, position) = preference(&ranges, format)?;
             (quality > 0.0).then_some((quality, position, order, format))
         })
-        .max_by(|a, b| {
-            a.0.total_cmp(&b.0)
-                .then(b.1.cmp(&a.1))
-                .then(b.2.cmp(&a.2))
-        })
+        .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)).then(b.2.cmp(&a.2)))
         .map(|(_, _, _, format)| format)
 }
 
@@ -300,7 +299,10 @@ pub async fn layer(mut request: Request, next: Next) -> Response {
     if !matches!(*request.method(), Method::GET | Method::HEAD) {
         return next.run(request).await;
     }
-    let route = request.extensions().get::<MatchedPath>().map(|r| r.as_str().to_owned());
+    let route = request
+        .extensions()
+        .get::<MatchedPath>()
+        .map(|r| r.as_str().to_owned());
     let Some(offered) = route.as_deref().and_then(offers) else {
         return next.run(request).await;
     };
@@ -308,7 +310,10 @@ pub async fn layer(mut request: Request, next: Next) -> Response {
         Ok(format) => format,
         Err(refusal) => return refusal.problem().into_response(),
     };
-    let page = route.as_deref().and_then(Page::for_route).filter(|_| format == Format::Html);
+    let page = route
+        .as_deref()
+        .and_then(Page::for_route)
+        .filter(|_| format == Format::Html);
     if page.is_some() {
         // The page has the status of the JSON answer (an unknown job is a 404 page).
         let headers = request.headers_mut();
@@ -323,11 +328,10 @@ pub async fn layer(mut request: Request, next: Next) -> Response {
         Some(page) => dashboard::html_page(page, response.status()),
         None => response,
     };
-    let varies = response
-        .headers()
-        .get_all(header::VARY)
-        .iter()
-        .any(|v| v.to_str().is_ok_and(|v| v.to_ascii_lowercase().contains("accept")));
+    let varies = response.headers().get_all(header::VARY).iter().any(|v| {
+        v.to_str()
+            .is_ok_and(|v| v.to_ascii_lowercase().contains("accept"))
+    });
     if offered.len() > 1 && !varies {
         response
             .headers_mut()
@@ -438,25 +442,58 @@ mod tests {
 
     #[test]
     fn the_format_parameter_overrides_accept_and_names_what_the_route_has() {
-        assert_eq!(choose(JSON_OR_HTML, &headers(CHROMIUM), Some("limit=5&f=json")), Ok(Format::Json));
-        assert_eq!(choose(JSON_OR_HTML, &HeaderMap::new(), Some("f=html")), Ok(Format::Html));
-        assert_eq!(choose(JSON_OR_CSV, &headers("application/json"), Some("format=csv")), Ok(Format::Csv));
-        assert_eq!(choose(JSON_OR_CSV, &HeaderMap::new(), Some("format=CSV")), Ok(Format::Csv));
-        assert_eq!(choose(JSON, &HeaderMap::new(), Some("status=running")), Ok(Format::Json));
+        assert_eq!(
+            choose(JSON_OR_HTML, &headers(CHROMIUM), Some("limit=5&f=json")),
+            Ok(Format::Json)
+        );
+        assert_eq!(
+            choose(JSON_OR_HTML, &HeaderMap::new(), Some("f=html")),
+            Ok(Format::Html)
+        );
+        assert_eq!(
+            choose(JSON_OR_CSV, &headers("application/json"), Some("format=csv")),
+            Ok(Format::Csv)
+        );
+        assert_eq!(
+            choose(JSON_OR_CSV, &HeaderMap::new(), Some("format=CSV")),
+            Ok(Format::Csv)
+        );
+        assert_eq!(
+            choose(JSON, &HeaderMap::new(), Some("status=running")),
+            Ok(Format::Json)
+        );
         let refused = choose(JSON_OR_CSV, &HeaderMap::new(), Some("format=xml")).unwrap_err();
         let problem = refused.problem();
         assert_eq!(problem.status, 400);
-        assert!(problem.detail.contains("`json`") && problem.detail.contains("`csv`"), "{}", problem.detail);
+        assert!(
+            problem.detail.contains("`json`") && problem.detail.contains("`csv`"),
+            "{}",
+            problem.detail
+        );
         assert!(choose(JSON, &HeaderMap::new(), Some("format=csv")).is_err());
-        assert_eq!(choose(JSON, &HeaderMap::new(), Some("f=json&format=csv")), Err(Refusal::Conflicting));
-        assert_eq!(choose(JSON_OR_CSV, &HeaderMap::new(), Some("format=c%73v")), Ok(Format::Csv));
+        assert_eq!(
+            choose(JSON, &HeaderMap::new(), Some("f=json&format=csv")),
+            Err(Refusal::Conflicting)
+        );
+        assert_eq!(
+            choose(JSON_OR_CSV, &HeaderMap::new(), Some("format=c%73v")),
+            Ok(Format::Csv)
+        );
         let refused = choose(JSON_OR_CSV, &headers("application/xml"), None).unwrap_err();
         assert_eq!(refused.problem().status, 406);
     }
 
     #[test]
     fn every_route_with_a_page_offers_html_and_tables_offer_csv() {
-        for route in ["/", "/jobs", "/jobs/{jobId}", "/sweeps", "/sweeps/{sweepId}", "/signals", "/signals/{signalId}"] {
+        for route in [
+            "/",
+            "/jobs",
+            "/jobs/{jobId}",
+            "/sweeps",
+            "/sweeps/{sweepId}",
+            "/signals",
+            "/signals/{signalId}",
+        ] {
             assert_eq!(offers(route), Some(JSON_OR_HTML), "{route}");
         }
         assert_eq!(offers("/jobs/{jobId}/results/contacts"), Some(JSON_OR_CSV));

@@ -18,8 +18,8 @@ use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
 use utoipa::{Modify, OpenApi};
 
 use super::{
-    contacts, impacts, job_inputs, jobs, landing, models, processes, response_spectra, results, signal_models, signals,
-    spectra, sweep_models, sweeps,
+    contacts, impacts, job_inputs, jobs, landing, models, processes, response_spectra, results,
+    signal_models, signals, spectra, sweep_models, sweeps,
 };
 use crate::processes::Registry;
 use crate::service::queue::JobStatus;

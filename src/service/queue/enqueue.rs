@@ -42,8 +42,18 @@ impl JobQueue {
         subscriber: Option<&Subscriber>,
         annotations: &Annotations,
     ) -> Result<Admission<JobRecord>, sqlx::Error> {
-        let enqueue_once =
-            || self.enqueue_once(tenant, process_id, inputs, warnings, max_queued, key, subscriber, annotations);
+        let enqueue_once = || {
+            self.enqueue_once(
+                tenant,
+                process_id,
+                inputs,
+                warnings,
+                max_queued,
+                key,
+                subscriber,
+                annotations,
+            )
+        };
         match enqueue_once().await {
             // A concurrent first use of the same key won: this one now finds it.
             Err(error) if key.is_some() && is_key_taken(&error) => enqueue_once().await,

@@ -123,7 +123,8 @@ pub struct JobRecord {
     pub sweep_id: Option<String>,
     /// Plausibility warnings about its inputs, found at submission (none for jobs
     /// submitted before warnings existed).
-    pub warnings: Vec<crate::processes::Warning>,    /// Labels given at submission (`[]` when none).
+    pub warnings: Vec<crate::processes::Warning>,
+    /// Labels given at submission (`[]` when none).
     pub labels: Vec<String>,
     /// The note given at submission.
     pub note: Option<String>,
@@ -280,12 +281,17 @@ pub struct SweepRecord {
     /// Times in ms since the Unix epoch.
     pub created_at: i64,
     pub updated_at: i64,
+    /// Labels given at creation.
+    #[sqlx(try_from = "String")]
+    pub labels: crate::annotations::StoredLabels,
+    /// The note given at creation.
+    pub note: Option<String>,
 }
 
 /// Columns of [`SweepRecord`] (a literal, for `concat!`).
 macro_rules! sweep_columns {
     () => {
-        "seq, id, process_id, definition, design, policy, runs, dismissed, created_at, updated_at"
+        "seq, id, process_id, definition, design, policy, runs, dismissed, created_at, updated_at, labels, note"
     };
 }
 pub(crate) use sweep_columns;

@@ -93,7 +93,8 @@ impl JobQueue {
             .then(|| serde_json::to_string(&filter.process_ids).unwrap_or_default());
         let sweep_ids = (!filter.sweep_ids.is_empty())
             .then(|| serde_json::to_string(&filter.sweep_ids).unwrap_or_default());
-        let labels = (!filter.labels.is_empty()).then(|| serde_json::to_string(&filter.labels).unwrap_or_default());
+        let labels =
+            (!filter.labels.is_empty()).then(|| serde_json::to_string(&filter.labels).unwrap_or_default());
         let sql = self.db.choose(LIST_SQLITE, LIST_POSTGRES);
         with_pool!(&self.db, pool => {
             sqlx::query_as(sql)

@@ -267,7 +267,8 @@ async fn finish(
                     .iter()
                     .map(store::encode)
                     .collect::<Result<Vec<_>, _>>()?;
-                let mut document = output.document_with_outputs(|name| format!("/jobs/{job_id}/results/{name}"));
+                let mut document =
+                    output.document_with_outputs(|name| format!("/jobs/{job_id}/results/{name}"));
                 provenance.stamp(&mut document);
                 Ok::<_, store::HistoryError>((document, histories))
             })

@@ -7,7 +7,7 @@ from typing import Any, Iterator, Mapping, Optional, Sequence, Union
 
 import httpx
 
-from ._http import RetryPolicy, Transport
+from ._http import Repeated, RetryPolicy, Transport
 from .jobs import Job
 from .signals import Signal, SignalSource, upload_body
 from .sweeps import Sweep
@@ -94,6 +94,8 @@ class Client:
         *,
         idempotency_key: Optional[str] = None,
         subscriber: Optional[Mapping[str, str]] = None,
+        labels: Optional[Sequence[str]] = None,
+        note: Optional[str] = None,
     ) -> Job:
         """Validates and queues a run of ``process`` with ``inputs`` (the members of the
         execution request's ``inputs``, not the ``{"inputs": ...}`` wrapper). Returns
@@ -110,11 +112,20 @@ class Client:
         see :func:`chocmodal.verify_signature`). The service's operator must allow their
         hosts (``--callback-allow``): others are refused with a 422 at
         ``/subscriber/successUri`` (...).
+
+        ``labels`` (at most 20 texts of 1 to 64 characters) and ``note`` (at most 2000
+        characters) are stored with the job and returned in its status; find the jobs
+        with a label by ``client.jobs(label=...)``. Bad ones are refused with a 422 at
+        ``/labels/k`` or ``/note``.
         """
         key = idempotency_key or str(uuid.uuid4())
         body: dict[str, Any] = {"inputs": dict(inputs)}
         if subscriber is not None:
             body["subscriber"] = dict(subscriber)
+        if labels is not None:
+            body["labels"] = list(labels)
+        if note is not None:
+            body["note"] = note
         response = self._transport.request(
             "POST",
             f"/processes/{process}/execution",
@@ -139,11 +150,14 @@ class Client:
         process: Union[str, Sequence[str], None] = None,
         sweep: Union[str, Sequence[str], None] = None,
         in_sweep: Optional[bool] = None,
+        label: Union[str, Sequence[str], None] = None,
         limit: Optional[int] = 100,
     ) -> list[Job]:
         """Jobs newest first, filtered by ``status``, ``process``, ``sweep`` (runs of these
-        sweeps) and ``in_sweep``; at most ``limit`` of them (``None``: every page)."""
-        params = {"status": status, "processID": process, "sweepID": sweep, "inSweep": in_sweep}
+        sweeps), ``in_sweep`` and ``label`` (jobs that have every label given); at most
+        ``limit`` of them (``None``: every page)."""
+        labels = [label] if isinstance(label, str) else list(label or [])
+        params = {"status": status, "processID": process, "sweepID": sweep, "inSweep": in_sweep, "label": Repeated(labels) if labels else None}
         return [Job(self, s["jobID"], s) for s in self._pages("/jobs", "jobs", params, limit)]
 
     # -- sweeps -------------------------------------------------------------------

@@ -100,7 +100,10 @@ pub fn sample_time(k: u64, interval: f64) -> f64 {
     let Some(km) = k.checked_mul(m).filter(|&km| km <= 1 << 53) else {
         return plain;
     };
-    match usize::try_from(scale.unsigned_abs()).ok().and_then(|p| EXACT_POWERS_OF_TEN.get(p)) {
+    match usize::try_from(scale.unsigned_abs())
+        .ok()
+        .and_then(|p| EXACT_POWERS_OF_TEN.get(p))
+    {
         Some(&power) if scale >= 0 => km as f64 * power,
         Some(&power) => km as f64 / power,
         None => plain,
@@ -109,8 +112,8 @@ pub fn sample_time(k: u64, interval: f64) -> f64 {
 
 /// Powers of ten that are exact doubles.
 const EXACT_POWERS_OF_TEN: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17,
-    1e18, 1e19, 1e20, 1e21, 1e22,
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18,
+    1e19, 1e20, 1e21, 1e22,
 ];
 
 /// `x` (finite, positive) as the shortest decimal that reads back as it: (m, e) with
@@ -290,7 +293,14 @@ mod sample_time_tests {
     #[test]
     fn sample_times_are_the_decimals_k_times_the_interval() {
         // (interval, m, e): interval = m × 10^e.
-        for (interval, m, e) in [(1e-3, 1, -3), (1e-4, 1, -4), (2.5e-4, 25, -5), (0.1, 1, -1), (5.0, 5, 0), (20.0, 2, 1)] {
+        for (interval, m, e) in [
+            (1e-3, 1, -3),
+            (1e-4, 1, -4),
+            (2.5e-4, 25, -5),
+            (0.1, 1, -1),
+            (5.0, 5, 0),
+            (20.0, 2, 1),
+        ] {
             assert_eq!(short_decimal(interval), Some((m, e)), "{interval}");
             for k in 0..20_000u64 {
                 let expected: f64 = format!("{}e{e}", k * m).parse().unwrap();

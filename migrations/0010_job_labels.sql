@@ -1,9 +1,0 @@
--- Traceability of jobs: labels (a JSON array of text, `[]` when none) and a free-text
--- note, both given at submission and written in the transaction that queues the job;
--- and the quality verdict of a successful job's results (`good`, `doubtful`, `poor`),
--- written with its results, so that the job list shows it without reading results.
--- NULL verdict: not successful, or finished before verdicts were recorded here.
-
-ALTER TABLE jobs ADD COLUMN labels TEXT NOT NULL DEFAULT '[]';
-ALTER TABLE jobs ADD COLUMN note TEXT;
-ALTER TABLE jobs ADD COLUMN verdict TEXT;
