@@ -16,7 +16,8 @@ use crate::helpers::{
 on_both_backends!(
     labels_and_a_note_are_stored_with_the_job_returned_and_filtered_on,
     the_job_list_shows_the_verdict_of_each_successful_job,
-    a_sweep_keeps_its_labels_and_note_and_the_sweep_list_filters_on_them
+    a_sweep_keeps_its_labels_and_note_and_the_sweep_list_filters_on_them,
+    a_signal_keeps_the_labels_and_note_of_its_upload_and_the_signal_list_filters_on_them
 );
 
 /// Submits `count-steps` with this body; returns the job id.
@@ -277,5 +278,56 @@ async fn a_sweep_keeps_its_labels_and_note_and_the_sweep_list_filters_on_them(ba
         sweep_ids(&app.get_json("/sweeps").await).len(),
         2,
         "the refused sweep queued nothing"
+    );
+}
+
+fn signal_ids(list: &Value) -> Vec<String> {
+    list["signals"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["id"].as_str().unwrap().to_owned())
+        .collect()
+}
+
+async fn a_signal_keeps_the_labels_and_note_of_its_upload_and_the_signal_list_filters_on_them(
+    backend: Backend,
+) {
+    let app = spawn_app_on(backend, |_| {}).await;
+    let record = "time,acceleration\n0,0\n0.01,1\n0.02,0\n";
+    let labelled = app
+        .upload_signal(
+            record,
+            "text/csv",
+            "?label=el-centro&label=scaled%202%2C5&note=PEER%20NGA%20%236",
+        )
+        .await;
+    assert_eq!(labelled["labels"], json!(["el-centro", "scaled 2,5"]));
+    assert_eq!(labelled["note"], "PEER NGA #6");
+    let id = labelled["id"].as_str().unwrap().to_owned();
+    let plain = app.upload_signal(record, "text/csv", "").await;
+    assert_eq!(plain["labels"], json!([]));
+    assert_eq!(
+        app.get_json(&format!("/signals/{id}")).await["labels"],
+        labelled["labels"]
+    );
+    assert_eq!(
+        signal_ids(&app.get_json("/signals?label=el-centro").await),
+        [id.as_str()]
+    );
+    assert_eq!(
+        signal_ids(&app.get_json("/signals?label=el-centro&label=other").await),
+        Vec::<String>::new()
+    );
+    assert_eq!(signal_ids(&app.get_json("/signals").await).len(), 2);
+    let refused = app.post_signal(record, "text/csv", "?label=").await;
+    let problem = assert_problem(refused, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
+    assert_eq!(problem["errors"][0]["pointer"], "/labels/0", "{problem}");
+    let refused = app.post_signal(record, "text/csv", "?colour=red").await;
+    assert_problem(refused, StatusCode::BAD_REQUEST, "/invalid-query").await;
+    assert_eq!(
+        signal_ids(&app.get_json("/signals").await).len(),
+        2,
+        "nothing stored when refused"
     );
 }

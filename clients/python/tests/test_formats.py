@@ -106,7 +106,7 @@ def test_pandas_reads_every_csv_route_with_read_csv(client: chocmodal.Client, se
     sweep = client.submit_sweep(
         "bundle-dynamics", row(0.002), [{"pointer": "/contacts/1/stiffness", "values": [1e5, 2e5]}]
     )
-    sweep.wait(progress=False, timeout=120)
+    sweep.follow(progress=False, timeout=120)
     signal = client.upload_signal(np.sin(np.arange(200) / 10.0), time_step=0.01)
     routes = {
         f"{base}/contact_forces?format=csv": "time",
@@ -216,3 +216,16 @@ def test_bad_labels_are_refused_at_their_pointers(client: chocmodal.Client) -> N
         client.submit("bundle-dynamics", row(0.002), labels=["ok", "x" * 65], note="n" * 2001)
     pointers = [e["pointer"] for e in refused.value.problem.get("errors", [])]
     assert pointers == ["/labels/1", "/note"]
+
+
+def test_sweeps_and_signals_carry_labels_and_notes_too(client: chocmodal.Client) -> None:
+    sweep = client.submit_sweep(
+        "bundle-dynamics", row(0.002), [{"pointer": "/contacts/1/stiffness", "values": [1e5]}],
+        labels=["formats-sweep"], note="one run",
+    )
+    assert sweep.status()["labels"] == ["formats-sweep"] and sweep.status()["note"] == "one run"
+    assert [s.id for s in client.sweeps(label="formats-sweep")] == [sweep.id]
+    signal = client.upload_signal(np.zeros(10), time_step=0.01, labels=["formats-signal", "a, b"], note="zeros")
+    assert signal.metadata["labels"] == ["formats-signal", "a, b"] and signal.metadata["note"] == "zeros"
+    assert [s.id for s in client.signals(label=["formats-signal", "a, b"])] == [signal.id]
+    sweep.follow(progress=False, timeout=120)

@@ -329,7 +329,7 @@ pub async fn list(
 }
 
 /// Every byte but unreserved characters percent-encoded (a query parameter's value).
-fn percent_encoded(text: &str) -> String {
+pub(super) fn percent_encoded(text: &str) -> String {
     text.bytes()
         .map(|b| match b {
             b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' | b'~' => (b as char).to_string(),
