@@ -83,23 +83,17 @@ mod tests {
             {"left": 0, "right": "wall", "max_force": 0.1, "wear": {"work": 1e-7}, "spectrum": [1, 2]}
         ]});
         let table = ContactTable::of(&document).unwrap();
+        // Members in the order the document's maps give them (by name), first seen first.
         assert_eq!(
             table.columns,
-            [
-                "contact",
-                "left",
-                "right",
-                "max_force",
-                "impact_statistics.impacts",
-                "wear.work"
-            ]
+            ["contact", "impact_statistics.impacts", "left", "max_force", "right", "wear.work"]
         );
         assert_eq!(table.contacts[1]["contact"], json!(1));
         assert_eq!(
             table.to_csv(),
-            "contact,left,right,max_force,impact_statistics.impacts,wear.work\n\
-             0,wall,0,2.5,3,\n\
-             1,0,wall,0.1,,1e-7\n"
+            "contact,impact_statistics.impacts,left,max_force,right,wear.work\n\
+             0,3,wall,2.5,0,\n\
+             1,,0,0.1,wall,1e-7\n"
         );
     }
 

@@ -135,7 +135,7 @@ def test_two_histories_of_one_interval_join_on_time_and_on_a_grid_built_by_hand(
 ) -> None:
     a = pd.read_csv(f"{server.url}/jobs/{labelled.id}/results/displacements?format=csv", index_col="time")
     b = pd.read_csv(f"{server.url}/jobs/{shorter.id}/results/displacements?format=csv", index_col="time")
-    joined = a.join(b, how="inner", lsuffix="_a", rsuffix="_b")
+    joined = a.add_suffix("_a").join(b.add_suffix("_b"), how="inner")
     assert len(joined) == len(b) == 41, "0.004 s every 1e-4 s: every sample of the shorter run matches"
     grid = pd.DataFrame(index=pd.Index(np.arange(len(a)) / 10_000, name="time"))
     assert len(grid.join(a, how="inner")) == len(a) == 61, "the times are k / 10000 to the bit"
@@ -214,7 +214,7 @@ def test_labels_a_note_the_verdict_and_the_provenance_travel_with_the_job(
 def test_bad_labels_are_refused_at_their_pointers(client: chocmodal.Client) -> None:
     with pytest.raises(chocmodal.ChocmodalError) as refused:
         client.submit("bundle-dynamics", row(0.002), labels=["ok", "x" * 65], note="n" * 2001)
-    pointers = [e["pointer"] for e in refused.value.problem.get("errors", [])]
+    pointers = [e.pointer for e in refused.value.errors]
     assert pointers == ["/labels/1", "/note"]
 
 
