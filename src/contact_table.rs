@@ -86,7 +86,14 @@ mod tests {
         // Members in the order the document's maps give them (by name), first seen first.
         assert_eq!(
             table.columns,
-            ["contact", "impact_statistics.impacts", "left", "max_force", "right", "wear.work"]
+            [
+                "contact",
+                "impact_statistics.impacts",
+                "left",
+                "max_force",
+                "right",
+                "wear.work"
+            ]
         );
         assert_eq!(table.contacts[1]["contact"], json!(1));
         assert_eq!(
