@@ -84,28 +84,22 @@ impl StepLimit {
     }
 }
 
-/// The time of sample k (s) on a grid of `interval`: the double nearest to k × the
-/// decimal `interval` stands for (its shortest round-trip text, m × 10^e), so that it
-/// prints as that decimal (`0.009`, not the `0.009000000000000001` of `9.0 * 0.001`),
-/// whatever produced it, and two grids of the same interval share their times exactly.
+/// The time of sample (or step) k (s) on a grid of `interval`: the double nearest to
+/// k × the decimal `interval` stands for (m / 10^e, the fewest decimals that read back
+/// as it), so that it prints as that decimal (`0.009`, not the `0.009000000000000001` of
+/// `9.0 * 0.001`) and two grids of the same interval share their times exactly.
 ///
-/// k·m and 10^|e| are exact doubles (k·m ≤ 2^53, |e| ≤ 22), so one product or quotient
-/// rounds the exact value once: the nearest double. An interval with no short decimal
-/// (a step chosen by `auto`: interval / n) falls back to the plain product k × interval.
+/// k·m and 10^e are exact doubles (k·m ≤ 2^53, e ≤ 22), so one quotient rounds the exact
+/// value once: the nearest double. An interval with no such decimal (a step chosen by
+/// `auto`: interval / n) falls back to the plain product k × interval. No allocation:
+/// cheap enough for an event's time inside the stepping loop.
 pub fn sample_time(k: u64, interval: f64) -> f64 {
     let plain = k as f64 * interval;
-    let Some((m, scale)) = short_decimal(interval) else {
+    let Some((m, e)) = short_decimal(interval) else {
         return plain;
     };
-    let Some(km) = k.checked_mul(m).filter(|&km| km <= 1 << 53) else {
-        return plain;
-    };
-    match usize::try_from(scale.unsigned_abs())
-        .ok()
-        .and_then(|p| EXACT_POWERS_OF_TEN.get(p))
-    {
-        Some(&power) if scale >= 0 => km as f64 * power,
-        Some(&power) => km as f64 / power,
+    match k.checked_mul(m).filter(|&km| km <= 1 << 53) {
+        Some(km) => km as f64 / EXACT_POWERS_OF_TEN[e],
         None => plain,
     }
 }
@@ -116,19 +110,16 @@ const EXACT_POWERS_OF_TEN: [f64; 23] = [
     1e19, 1e20, 1e21, 1e22,
 ];
 
-/// `x` (finite, positive) as the shortest decimal that reads back as it: (m, e) with
-/// x ≈ m × 10^e, m an integer.
-fn short_decimal(x: f64) -> Option<(u64, i64)> {
+/// `x` (finite, positive) as m / 10^e with the fewest decimals e that read back as `x`
+/// (m / 10^e rounds to `x`), m ≤ 2^53; `None` when no e ≤ 22 does.
+fn short_decimal(x: f64) -> Option<(u64, usize)> {
     if !(x.is_finite() && x > 0.0) {
         return None;
     }
-    let text = format!("{x:e}");
-    let (mantissa, exponent) = text.split_once('e')?;
-    let fraction_digits = mantissa.split_once('.').map_or(0, |(_, fraction)| fraction.len());
-    let digits: String = mantissa.chars().filter(char::is_ascii_digit).collect();
-    let m = digits.parse::<u64>().ok()?;
-    let exponent = exponent.parse::<i64>().ok()?;
-    Some((m, exponent - i64::try_from(fraction_digits).ok()?))
+    EXACT_POWERS_OF_TEN.iter().enumerate().find_map(|(e, &power)| {
+        let m = (x * power).round();
+        (m >= 1.0 && m <= (1u64 << 53) as f64 && m / power == x).then_some((m as u64, e))
+    })
 }
 
 impl StepSize {
@@ -292,18 +283,19 @@ mod sample_time_tests {
 
     #[test]
     fn sample_times_are_the_decimals_k_times_the_interval() {
-        // (interval, m, e): interval = m × 10^e.
+        // (interval, m, e): interval = m / 10^e.
         for (interval, m, e) in [
-            (1e-3, 1, -3),
-            (1e-4, 1, -4),
-            (2.5e-4, 25, -5),
-            (0.1, 1, -1),
+            (1e-3, 1, 3),
+            (1e-4, 1, 4),
+            (2.5e-4, 25, 5),
+            (0.1, 1, 1),
             (5.0, 5, 0),
-            (20.0, 2, 1),
+            (20.0, 20, 0),
+            (1e-6, 1, 6),
         ] {
             assert_eq!(short_decimal(interval), Some((m, e)), "{interval}");
             for k in 0..20_000u64 {
-                let expected: f64 = format!("{}e{e}", k * m).parse().unwrap();
+                let expected: f64 = format!("{}e-{e}", k * m).parse().unwrap();
                 let t = sample_time(k, interval);
                 assert_eq!(t, expected, "sample {k} of {interval}: {t} instead of {expected}");
             }
