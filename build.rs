@@ -10,6 +10,14 @@
 //! it, and never under CI (`CI` set to anything but empty, `0` or `false`): there a
 //! missing tool fails its tests, saying how to install it.
 //!
+//! It also records the git commit the package is built from, for the `provenance.build`
+//! of every results document (`src/provenance.rs`): `CHOCMODAL_BUILD_COMMIT` when set
+//! (a Docker build or a tarball build that knows its commit), else `git rev-parse HEAD`
+//! of the source tree when it is a git checkout with `git` on the `PATH`; nothing
+//! otherwise (the build still succeeds, and results say `"build": null`). In a checkout
+//! the script reruns when `HEAD` or the branch it names moves, so the recorded commit is
+//! never stale.
+//!
 //! The probe runs with this script: on the first build, and again when this file or one
 //! of the variables in `VARIABLES` changes; not when software is installed or removed
 //! (`touch build.rs` then). Changing one of the variables rebuilds the package.
@@ -18,7 +26,8 @@ use std::path::{Path, PathBuf};
 
 /// Everything the outcome depends on, besides the file system and `PATH` (watching
 /// `PATH` would rebuild the package whenever a tool runs cargo with another one).
-const VARIABLES: [&str; 5] = [
+const VARIABLES: [&str; 6] = [
+    "CHOCMODAL_BUILD_COMMIT",
     "CI",
     "CHOCMODAL_SKIP_POSTGRES_TESTS",
     "CHOCMODAL_SKIP_BROWSER_TESTS",
@@ -33,6 +42,7 @@ fn main() {
     for variable in VARIABLES {
         println!("cargo::rerun-if-env-changed={variable}");
     }
+    record_build_commit();
     println!("cargo::rustc-check-cfg=cfg(chocmodal_skip_postgres_tests)");
     println!("cargo::rustc-check-cfg=cfg(chocmodal_skip_browser_tests)");
     if under_ci() {
@@ -49,6 +59,57 @@ fn main() {
     if let Some(why) = skip("CHOCMODAL_SKIP_BROWSER_TESTS", has_chromium, "headless Chromium") {
         println!("cargo::rustc-cfg=chocmodal_skip_browser_tests");
         println!("cargo::warning=the browser tests are ignored: {why}");
+    }
+}
+
+/// Sets `CHOCMODAL_BUILD_COMMIT` for the compiler (see the module documentation).
+fn record_build_commit() {
+    if let Some(commit) = std::env::var("CHOCMODAL_BUILD_COMMIT")
+        .ok()
+        .filter(|c| !c.trim().is_empty())
+    {
+        println!("cargo::rustc-env=CHOCMODAL_BUILD_COMMIT={}", commit.trim());
+        return;
+    }
+    let git = |args: &[&str]| -> Option<String> {
+        let output = std::process::Command::new("git")
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .ok()?;
+        let text = String::from_utf8(output.stdout).ok()?;
+        (output.status.success() && !text.trim().is_empty()).then(|| text.trim().to_owned())
+    };
+    // Only for the package's own checkout (not a parent repository it was unpacked in).
+    let toplevel = git(&["rev-parse", "--show-toplevel"]).map(PathBuf::from);
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).canonicalize().ok();
+    if toplevel.and_then(|t| t.canonicalize().ok()) != here || here.is_none() {
+        return;
+    }
+    let Some(commit) = git(&["rev-parse", "HEAD"]) else {
+        return;
+    };
+    println!("cargo::rustc-env=CHOCMODAL_BUILD_COMMIT={commit}");
+    // A commit or a checkout moves HEAD or the branch it names (a worktree has its own HEAD).
+    for name in ["HEAD", "packed-refs"] {
+        if let Some(path) = git(&["rev-parse", "--git-path", name]) {
+            watch(&path);
+        }
+    }
+    if let Some(branch) = git(&["symbolic-ref", "-q", "HEAD"])
+        && let Some(path) = git(&["rev-parse", "--git-path", &branch])
+    {
+        watch(&path);
+    }
+}
+
+/// `path` as git printed it (relative to the package's directory, or absolute). Only a
+/// file that exists is watched: cargo reruns a script whose watched file is missing on
+/// every build.
+fn watch(path: &str) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    if path.exists() {
+        println!("cargo::rerun-if-changed={}", path.display());
     }
 }
 

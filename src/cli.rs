@@ -146,10 +146,12 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
     if let Some(dir) = &args.out {
         write_histories(dir, &output).map_err(CliFailure::Failed)?;
     }
-    Ok(output.document_with_outputs(|name| match &args.out {
+    let mut document = output.document_with_outputs(|name| match &args.out {
         Some(dir) => dir.join(format!("{name}.csv")).display().to_string(),
         None => format!("{name}.csv"),
-    }))
+    });
+    crate::provenance::Provenance::of(&inputs).stamp(&mut document);
+    Ok(document)
 }
 
 /// Where the record files a job names are looked for: the job file's directory (the
@@ -211,42 +213,10 @@ fn write_histories(dir: &Path, output: &RunOutput) -> Result<(), String> {
         };
         std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
-    if let Some(text) = contacts_csv(&output.document) {
+    if let Some(table) = crate::contact_table::ContactTable::of(&output.document) {
+        let text = table.to_csv();
         let path = dir.join("contacts.csv");
         std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
     Ok(())
-}
-
-/// The results' `contacts`, one row each: `contact` then every scalar of the entry
-/// (its description, its statistics and its impact statistics, its friction and wear,
-/// dotted), for pandas and spreadsheets. `None` for a process without a contact list.
-fn contacts_csv(document: &serde_json::Value) -> Option<String> {
-    let contacts = document["contacts"].as_array().filter(|c| !c.is_empty())?;
-    let rows: Vec<Vec<(String, serde_json::Value)>> = contacts
-        .iter()
-        .map(crate::processes::metrics::flatten_scalars)
-        .collect();
-    // Every member some contact has (a family's friction or wear), in order of first
-    // appearance: a contact without one leaves its cells empty.
-    let mut header: Vec<&str> = Vec::new();
-    for (name, _) in rows.iter().flatten() {
-        if !header.contains(&name.as_str()) {
-            header.push(name);
-        }
-    }
-    let cell = crate::csv_format::cell;
-    let mut out = format!("contact,{}\n", header.join(","));
-    for (k, row) in rows.iter().enumerate() {
-        let cells: Vec<String> = header
-            .iter()
-            .map(|name| {
-                row.iter()
-                    .find(|(n, _)| n == name)
-                    .map_or_else(String::new, |(_, v)| cell(v))
-            })
-            .collect();
-        out.push_str(&format!("{k},{}\n", cells.join(",")));
-    }
-    Some(out)
 }

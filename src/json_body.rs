@@ -42,8 +42,9 @@ pub fn parse(text: &str) -> Result<Value, Problem> {
     Ok(value)
 }
 
-/// The members of an execution request the service reads: `inputs`, and `subscriber`
-/// as given (the service checks it against its callback policy). `outputs` and
+/// The members of an execution request the service reads: `inputs`, and `subscriber`,
+/// `labels` and `note` as given (the service checks the first against its callback
+/// policy, the others with [`crate::annotations`]). `outputs` and
 /// `response` are accepted and ignored (every execution is asynchronous, every output
 /// is returned).
 #[derive(Debug, Clone, PartialEq)]
@@ -52,6 +53,10 @@ pub struct ExecutionRequest {
     pub inputs: Value,
     /// The `subscriber` member, if present.
     pub subscriber: Option<Value>,
+    /// The `labels` member, if present (checked by [`crate::annotations`]).
+    pub labels: Option<Value>,
+    /// The `note` member, if present.
+    pub note: Option<Value>,
 }
 
 /// Parses an execution request body and returns its `inputs` object.
@@ -67,10 +72,12 @@ pub fn parse_execution_request(text: &str) -> Result<ExecutionRequest, Problem> 
             "the body must be a JSON object `{\"inputs\": {...}}`",
         ));
     };
-    if let Some(unknown) = map
-        .keys()
-        .find(|k| !matches!(k.as_str(), "inputs" | "outputs" | "response" | "subscriber"))
-    {
+    if let Some(unknown) = map.keys().find(|k| {
+        !matches!(
+            k.as_str(),
+            "inputs" | "outputs" | "response" | "subscriber" | "labels" | "note"
+        )
+    }) {
         let invalid = InvalidInputs(vec![FieldError::new(
             format!("/{}", crate::pointer::escape(unknown)),
             "unknown member of the execution request",
@@ -78,8 +85,14 @@ pub fn parse_execution_request(text: &str) -> Result<ExecutionRequest, Problem> 
         return Err(Problem::invalid_inputs(&invalid));
     }
     let subscriber = map.remove("subscriber");
+    let (labels, note) = (map.remove("labels"), map.remove("note"));
     match map.remove("inputs") {
-        Some(inputs @ Value::Object(_)) => Ok(ExecutionRequest { inputs, subscriber }),
+        Some(inputs @ Value::Object(_)) => Ok(ExecutionRequest {
+            inputs,
+            subscriber,
+            labels,
+            note,
+        }),
         Some(_) => Err(Problem::invalid_inputs(&InvalidInputs(vec![FieldError::new(
             "/inputs",
             "must be an object",

@@ -3,8 +3,12 @@
 //! Data flows one way: HTTP/CLI → validated process inputs → queue → worker →
 //! physics → results store → HTTP. The physics core is pure (no IO, no async).
 
+/// Labels and a note attached to a job, checked (a leaf above the processes' errors).
+pub mod annotations;
 /// The `chocmodal` command line (serve, run).
 pub mod cli;
+/// The per-contact statistics table of a results document (CLI and HTTP, one writer).
+pub mod contact_table;
 /// CSV as every output writes it: one number format, one quoting rule (a leaf).
 pub mod csv_format;
 /// Request bodies as JSON values, with pointer-bearing errors (numbers out of range).
@@ -18,6 +22,8 @@ pub mod pointer;
 pub mod problem;
 /// One module per process: JSON inputs (validated) → physics → results document + histories.
 pub mod processes;
+/// Solver version, build and inputs hash stamped on every results document (a leaf).
+pub mod provenance;
 /// A results document's quality verdict in the words users see (job message, CLI, sweeps).
 pub mod quality_note;
 /// The HTTP service: OGC API – Processes, SQLite job queue, workers, results store.

@@ -303,6 +303,16 @@ impl Problem {
         )
     }
 
+    /// 406: `Accept` excludes every format of the resource; the detail lists them.
+    pub fn not_acceptable(detail: impl Into<String>) -> Self {
+        Self::new(
+            format!("{CHOCMODAL_PROBLEMS}/not-acceptable"),
+            "Not Acceptable",
+            406,
+            detail,
+        )
+    }
+
     /// 413: the request body is larger than the configured limit.
     pub fn payload_too_large(detail: impl Into<String>) -> Self {
         Self::new(

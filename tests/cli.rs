@@ -107,6 +107,16 @@ fn a_bundle_run_writes_its_contact_statistics_as_csv() {
         String::from_utf8_lossy(&output.stderr)
     );
     let document: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    // `run` stamps the document as the service does: solver, build, inputs hash.
+    let inputs = body["inputs"].clone();
+    assert_eq!(
+        document["provenance"]["solver_version"],
+        env!("CARGO_PKG_VERSION")
+    );
+    assert_eq!(
+        document["provenance"]["inputs_sha256"],
+        chocmodal::provenance::inputs_sha256(&inputs)
+    );
     let csv = std::fs::read_to_string(out.join("contacts.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();

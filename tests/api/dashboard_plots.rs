@@ -421,6 +421,14 @@ async fn the_job_list_fits_1280_px_shows_where_a_failed_run_stopped_and_hides_sw
         "the table is [width, room, page width, window] = {overflow} px"
     );
     browser.screenshot(&screenshot_dir().join("jobs-1280.png")).await;
+    // The verdict column: the poor run says so, as its status does.
+    let verdict = browser
+        .eval(&format!(
+            "document.querySelector('tr[data-job=\"{alone}\"] [data-verdict]')?.getAttribute('data-verdict')"
+        ))
+        .await;
+    assert_eq!(verdict, status["verdict"], "{status}");
+    assert!(status["verdict"].is_string(), "{status}");
     // The failed run's bar stops at 60 %.
     let bar = browser
         .eval(&format!(

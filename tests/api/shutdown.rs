@@ -130,7 +130,16 @@ async fn while_draining_reads_are_answered_writes_get_503_and_a_second_signal_ha
     // Queued after the signal with a worker slot free: nothing claims it.
     let late = app
         .queue
-        .enqueue("default", counting::ID, &job_of_seconds(1), &[], None, None, None)
+        .enqueue(
+            "default",
+            counting::ID,
+            &job_of_seconds(1),
+            &[],
+            None,
+            None,
+            None,
+            &Default::default(),
+        )
         .await
         .unwrap();
     let late = match late {

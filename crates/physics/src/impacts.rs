@@ -570,7 +570,7 @@ impl ContactImpacts {
             contact_time: sums.steps as f64 * dt,
             impulse: sums.force * dt,
             max_force,
-            max_force_time: step as f64 * dt,
+            max_force_time: crate::integrate::sample_time(step, dt),
         }
     }
 

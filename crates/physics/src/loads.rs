@@ -135,7 +135,9 @@ impl Table {
     /// interval shorter when `end` is not a multiple).
     pub fn sample(signal: impl Fn(f64) -> f64, interval: f64, end: f64) -> Self {
         let whole = (end / interval).floor() as usize;
-        let mut time: Vec<f64> = (0..=whole).map(|k| k as f64 * interval).collect();
+        let mut time: Vec<f64> = (0..=whole as u64)
+            .map(|k| crate::integrate::sample_time(k, interval))
+            .collect();
         if end - whole as f64 * interval > 1e-9 * interval {
             time.push(end);
         }

@@ -327,7 +327,11 @@ fn row17_envelopes_reach_the_reported_maxima_that_samples_miss() {
     }
     assert_eq!(doc["output_interval"], 1e-4);
     for (k, t) in forces.time.iter().enumerate() {
-        assert_eq!(*t, k as f64 * 1e-4, "sample {k}");
+        assert_eq!(
+            *t,
+            format!("{k}e-4").parse::<f64>().unwrap(),
+            "sample {k}: k × 1e-4 as a decimal"
+        );
     }
     assert_eq!(force_peaks.time, forces.time);
 }

@@ -13,12 +13,12 @@
 
 use std::sync::Arc;
 
-use axum::extract::{MatchedPath, Request, State};
-use axum::http::{HeaderValue, Method, StatusCode, header};
+use axum::extract::{Request, State};
+use axum::http::{HeaderValue, StatusCode, header};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 
-use super::dashboard::{self, Page};
+use super::dashboard;
 use crate::problem::Problem;
 use crate::service::auth::{Tenant, TokenTable};
 
@@ -39,15 +39,6 @@ fn is_open(policy: &AuthPolicy, path: &str) -> bool {
         || (policy.metrics_public && path == "/metrics")
 }
 
-/// The dashboard page a browser asks for, if the request is one.
-fn page_asked(request: &Request) -> Option<Page> {
-    if !matches!(*request.method(), Method::GET | Method::HEAD) {
-        return None;
-    }
-    let page = Page::for_route(request.extensions().get::<MatchedPath>()?.as_str())?;
-    dashboard::negotiation::wants_html(request.headers(), request.uri().query()).then_some(page)
-}
-
 /// The bearer token of an `Authorization` header (scheme case-insensitive).
 fn bearer_token(value: &HeaderValue) -> Option<&str> {
     let text = value.to_str().ok()?;
@@ -59,7 +50,7 @@ fn bearer_token(value: &HeaderValue) -> Option<&str> {
 }
 
 fn unauthorized(request: &Request, detail: &str, challenge: &'static str) -> Response {
-    let mut response = match page_asked(request) {
+    let mut response = match super::negotiation::wants_page(request) {
         Some(page) => {
             let mut page = dashboard::html_page(page, StatusCode::UNAUTHORIZED);
             page.headers_mut()

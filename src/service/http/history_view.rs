@@ -9,54 +9,13 @@ use axum::response::{IntoResponse, Response};
 use super::AppState;
 use super::conditional::{entity_tag, if_none_match};
 use super::error::ApiError;
+pub(super) use super::negotiation::Format;
 use super::results::{successful, with_retry_after};
 use super::streamed::{Rendered, WriteBody, held_bytes, streamed, working_bytes};
 use crate::problem::Problem;
 use crate::service::auth::Tenant;
 use crate::service::queue::read::JobOutcome;
 use crate::service::store::StoredHistory;
-
-/// The representation asked for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Format {
-    Csv,
-    Json,
-}
-
-impl Format {
-    /// The `format` query parameter, or `default` without one; 400 on anything else.
-    pub(super) fn from_query(format: Option<&str>, default: Format) -> Result<Format, ApiError> {
-        match format {
-            Some("csv") => Ok(Format::Csv),
-            Some("json") => Ok(Format::Json),
-            Some(other) => {
-                Err(Problem::invalid_query(format!("`format` must be `csv` or `json`, not `{other}`")).into())
-            }
-            None => Ok(default),
-        }
-    }
-
-    /// CSV when `Accept` names `text/csv` before (or without) `application/json`.
-    pub(super) fn preferred(headers: &HeaderMap) -> Format {
-        let accept = headers
-            .get(header::ACCEPT)
-            .and_then(|v| v.to_str().ok())
-            .unwrap_or_default();
-        let csv = match (accept.find("text/csv"), accept.find("application/json")) {
-            (Some(c), Some(j)) => c < j,
-            (Some(_), None) => true,
-            _ => false,
-        };
-        if csv { Format::Csv } else { Format::Json }
-    }
-
-    pub(super) fn content_type(self) -> &'static str {
-        match self {
-            Format::Csv => "text/csv; charset=utf-8",
-            Format::Json => "application/json",
-        }
-    }
-}
 
 /// 400 unless each bound of a window that is given is finite; `unit` goes in the reason.
 pub(super) fn require_finite(bounds: [(&str, Option<f64>); 2], unit: &str) -> Result<(), ApiError> {

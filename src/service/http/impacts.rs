@@ -20,8 +20,10 @@ use crate::service::store;
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct ImpactsQuery {
-    /// `csv` or `json` (default: JSON, or CSV when `Accept` prefers `text/csv`).
+    /// Chosen by the service's negotiator (`f` is an alias): `csv` or `json`; without
+    /// it, the one `Accept` prefers (q-values honoured), else JSON.
     #[param(pattern = "^(csv|json)$")]
+    #[serde(alias = "f")]
     pub format: Option<String>,
     /// Only these contacts, comma-separated indices (e.g. `3,17`); default: all.
     pub contact: Option<String>,
@@ -74,8 +76,8 @@ pub async fn impacts(
     Path(job_id): Path<String>,
     ApiQuery(query): ApiQuery<ImpactsQuery>,
     headers: HeaderMap,
+    format: Format,
 ) -> Result<Response, ApiError> {
-    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
     let contacts = parse_contacts(query.contact.as_deref())?;
     if query.limit == Some(0) {
         return Err(Problem::invalid_query("`limit` must be at least 1").into());

@@ -8,6 +8,7 @@ use super::AppState;
 use super::conditional::tagged;
 use super::error::ApiError;
 use super::models::{JobList, Link, StatusInfo};
+use crate::annotations::label_fault;
 use crate::problem::Problem;
 use crate::service::auth::Tenant;
 use crate::service::queue::JobStatus;
@@ -30,8 +31,9 @@ struct ListQuery {
 }
 
 /// Parses `status`, `processID`, `sweepID` (each repeatable and comma-separated),
-/// `inSweep` (`true` or `false`), `limit`, `cursor`; `f` is accepted and ignored (OGC
-/// format parameter); anything else is refused.
+/// `label` (repeatable, one label each: jobs with all of them), `inSweep` (`true` or
+/// `false`), `limit`, `cursor`; `f` and `format` are the negotiator's
+/// ([`super::negotiation`]); anything else is refused.
 fn parse_list_query(pairs: &[(String, String)]) -> Result<ListQuery, Problem> {
     let mut query = ListQuery {
         limit: DEFAULT_LIMIT,
@@ -57,6 +59,12 @@ fn parse_list_query(pairs: &[(String, String)]) -> Result<ListQuery, Problem> {
                 .filter
                 .sweep_ids
                 .extend(value.split(',').filter(|s| !s.is_empty()).map(str::to_owned)),
+            "label" => {
+                if let Some(fault) = label_fault(value) {
+                    return Err(Problem::invalid_query(format!("`label` `{value}` {fault}")));
+                }
+                query.filter.labels.push(value.clone());
+            }
             "inSweep" => {
                 query.filter.in_sweep = Some(match value.as_str() {
                     "true" => true,
@@ -83,10 +91,10 @@ fn parse_list_query(pairs: &[(String, String)]) -> Result<ListQuery, Problem> {
                     Problem::invalid_query("`cursor` must be the value given in a `next` link")
                 })?);
             }
-            "f" => {}
+            "f" | "format" => {}
             other => {
                 return Err(Problem::invalid_query(format!(
-                    "unknown query parameter `{other}` (expected status, processID, sweepID, inSweep, limit, cursor)"
+                    "unknown query parameter `{other}` (expected status, processID, sweepID, label, inSweep, limit, cursor)"
                 )));
             }
         }
@@ -112,6 +120,9 @@ fn list_href(query: &ListQuery, cursor: Option<i64>) -> String {
             encode_component(&query.filter.sweep_ids.join(","))
         ));
     }
+    for label in &query.filter.labels {
+        href.push_str(&format!("&label={}", encode_component(label).replace(',', "%2C")));
+    }
     if let Some(in_sweep) = query.filter.in_sweep {
         href.push_str(&format!("&inSweep={in_sweep}"));
     }
@@ -136,14 +147,16 @@ fn encode_component(text: &str) -> String {
 /// List jobs
 ///
 /// Newest first. Filters: `status`, `processID` and `sweepID` (repeatable, or
-/// comma-separated values), `inSweep` (`false`: only jobs submitted on their own, no
-/// sweep run; `true`: only sweep runs). Paging: `limit` jobs per page; the `next` link (keyset `cursor`) gives the
+/// comma-separated values), `label` (repeatable: only jobs that have every label named),
+/// `inSweep` (`false`: only jobs submitted on their own, no sweep run; `true`: only
+/// sweep runs). Each job says its `verdict` once successful. Paging: `limit` jobs per page; the `next` link (keyset `cursor`) gives the
 /// following page, stable while new jobs arrive.
 #[utoipa::path(get, path = "/jobs", operation_id = "getJobs", tag = "Jobs",
     params(
         ("status" = Option<String>, Query, description = "Only jobs in these statuses, e.g. `running,accepted`"),
         ("processID" = Option<String>, Query, description = "Only jobs of these processes"),
         ("sweepID" = Option<String>, Query, description = "Only runs of these sweeps"),
+        ("label" = Option<Vec<String>>, Query, explode = true, description = "Only jobs that have this label; repeat it for jobs that have all of them (`label=a&label=b`)"),
         ("inSweep" = Option<bool>, Query, description = "`false`: only jobs submitted on their own (no sweep run); `true`: only runs of sweeps"),
         ("limit" = Option<u32>, Query, description = "Jobs per page, 1 to 1000 (default 10)", minimum = 1, maximum = 1000),
         ("cursor" = Option<i64>, Query, description = "Opaque position from a `next` link"),

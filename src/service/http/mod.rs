@@ -5,6 +5,7 @@
 
 pub mod auth;
 pub mod conditional;
+pub mod contacts;
 pub mod cors;
 pub mod dashboard;
 pub mod error;
@@ -16,6 +17,7 @@ pub mod job_inputs;
 pub mod jobs;
 pub mod landing;
 pub mod models;
+pub mod negotiation;
 pub mod openapi;
 pub mod processes;
 pub mod response_spectra;
@@ -39,6 +41,7 @@ use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use tokio::sync::Notify;
 use tower_http::catch_panic::CatchPanicLayer;
+use tower_http::compression::CompressionLayer;
 use tower_http::timeout::TimeoutLayer;
 use tower_http::trace::{DefaultMakeSpan, DefaultOnResponse, TraceLayer};
 use tracing::Level;
@@ -124,6 +127,7 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/jobs/{jobId}/results", get(results::results))
         .route("/jobs/{jobId}/inputs", get(job_inputs::inputs))
         .route("/jobs/{jobId}/results/impacts", get(impacts::impacts))
+        .route("/jobs/{jobId}/results/contacts", get(contacts::contacts))
         .route("/jobs/{jobId}/results/{output}", get(results::output))
         .route("/jobs/{jobId}/results/{output}/spectrum", get(spectra::spectrum))
         .route(
@@ -147,8 +151,9 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/sweeps/{sweepId}/results", get(sweeps::results))
         .merge(dashboard::routes())
         .fallback(not_found)
-        // HTML for browsers on the routes that have a page (innermost: it sees the route).
-        .layer(middleware::from_fn(dashboard::negotiate))
+        // The representation of every GET (innermost: it sees the route): the `format`
+        // parameter or `Accept`, and HTML for browsers on the routes that have a page.
+        .layer(middleware::from_fn(negotiation::layer))
         .layer(middleware::from_fn_with_state(
             state.clone(),
             refuse_writes_while_stopping,
@@ -174,6 +179,9 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         None => routes,
     };
     routes
+        // Compression inside the tag weakening (a response goes outward through both).
+        .layer(compression())
+        .layer(middleware::map_response(weaken_tags_of_encoded_bodies))
         .layer(middleware::from_fn_with_state(state.clone(), track_request))
         .layer(
             TraceLayer::new_for_http()
@@ -183,6 +191,33 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .with_state(state)
 }
 
+/// gzip or zstd bodies for clients that accept them (`Accept-Encoding`, q-values
+/// honoured; zstd preferred on a tie), streamed bodies included (each chunk compressed
+/// as it is written). tower-http's default predicate leaves alone bodies under 32 bytes,
+/// images, gRPC and server-sent events.
+fn compression() -> CompressionLayer {
+    CompressionLayer::new().no_br().no_deflate()
+}
+
+/// An `ETag` names the bytes of one representation (RFC 9110 §8.8.3): a compressed body
+/// is other bytes, so its tag becomes weak (`W/"..."`). `If-None-Match` compares tags
+/// weakly ([`conditional::if_none_match`]), so revalidation still answers 304.
+async fn weaken_tags_of_encoded_bodies(mut response: Response) -> Response {
+    if !response.headers().contains_key(header::CONTENT_ENCODING) {
+        return response;
+    }
+    let weak = response
+        .headers()
+        .get(header::ETAG)
+        .and_then(|tag| tag.to_str().ok())
+        .filter(|tag| !tag.starts_with("W/"))
+        .and_then(|tag| header::HeaderValue::from_str(&format!("W/{tag}")).ok());
+    if let Some(weak) = weak {
+        response.headers_mut().insert(header::ETAG, weak);
+    }
+    response
+}
+
 /// The worker role's optional port: liveness and metrics only.
 pub fn health_router(state: AppState) -> Router {
     Router::new()
@@ -190,6 +225,7 @@ pub fn health_router(state: AppState) -> Router {
         .route("/readyz", get(landing::readyz))
         .route("/metrics", get(landing::metrics))
         .fallback(not_found)
+        .layer(compression())
         .with_state(state)
 }
 

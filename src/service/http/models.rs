@@ -72,6 +72,15 @@ pub struct StatusInfo {
     /// inputs that look like a mistake (a unit slip, nothing exciting the model, ...).
     /// Empty with `"warnings": "off"` among the inputs.
     pub warnings: Vec<crate::processes::Warning>,
+    /// The labels given at submission (empty when none): `GET /jobs?label=` filters on them.
+    pub labels: Vec<String>,
+    /// The note given at submission.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+    /// `quality.verdict` of the results of a successful job: `good`, `doubtful` or
+    /// `poor` (absent until it succeeds).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<String>,
     pub links: Vec<Link>,
 }
 
@@ -113,6 +122,9 @@ impl StatusInfo {
             finished: job.finished_at.map(rfc3339),
             updated: rfc3339(job.updated_at),
             warnings: job.warnings.clone(),
+            labels: job.labels.clone(),
+            note: job.note.clone(),
+            verdict: job.verdict.clone(),
             links,
         }
     }
@@ -176,6 +188,15 @@ pub struct ExecuteRequest {
     /// Only hosts the operator allows (`--callback-allow`) are accepted.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub subscriber: Option<SubscriberDocument>,
+    /// Labels to find the job by (`GET /jobs?label=`): at most 20, each text of 1 to 64
+    /// characters without control characters or surrounding spaces, all different.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[schema(max_items = 20)]
+    pub labels: Vec<String>,
+    /// A free-text note (at most 2000 characters), returned with the job's status.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(max_length = 2000)]
+    pub note: Option<String>,
 }
 
 /// Where a job's outcome and progress are POSTed (each URI optional; absolute `http` or
@@ -207,6 +228,9 @@ pub struct Results {
     pub outputs: serde_json::Value,
     /// How right the result is (every process; see docs/accuracy.md).
     pub quality: crate::processes::report::QualityReport,
+    /// Where the result comes from: solver version, build, and the SHA-256 of the
+    /// canonical JSON of the submitted inputs (docs/service.md "Provenance").
+    pub provenance: crate::provenance::Provenance,
 }
 
 /// One named column of a history.

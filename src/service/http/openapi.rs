@@ -18,8 +18,8 @@ use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
 use utoipa::{Modify, OpenApi};
 
 use super::{
-    impacts, job_inputs, jobs, landing, models, processes, response_spectra, results, signal_models, signals,
-    spectra, sweep_models, sweeps,
+    contacts, impacts, job_inputs, jobs, landing, models, processes, response_spectra, results,
+    signal_models, signals, spectra, sweep_models, sweeps,
 };
 use crate::processes::Registry;
 use crate::service::queue::JobStatus;
@@ -234,6 +234,7 @@ impl Modify for ResourceLinks {
         results::results,
         results::output,
         impacts::impacts,
+        contacts::contacts,
         spectra::spectrum,
         response_spectra::response_spectrum,
         sweeps::create,
@@ -263,11 +264,13 @@ impl Modify for ResourceLinks {
         models::SubscriberDocument,
         models::Results,
         crate::processes::report::QualityReport,
+        crate::provenance::Provenance,
         crate::processes::report::StepHalvingReport,
         models::HistoryDocument,
         models::Series,
         ResultOutputSchema,
         impacts::ImpactPage,
+        crate::contact_table::ContactTable,
         spectra::SpectrumDocument,
         spectra::SpectrumComparison,
         response_spectra::HistoryResponseSpectrum,

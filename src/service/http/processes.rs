@@ -12,9 +12,10 @@ use super::error::ApiError;
 use super::extract::ExecutionInputs;
 use super::idempotency::{IdempotencyHeader, key_reused, mark_replayed};
 use super::models::{ExecuteRequest, Link, ProcessDescription, ProcessList, ProcessSummary, StatusInfo};
+use crate::annotations::Annotations;
 use crate::json_body::ExecutionRequest;
 use crate::problem::Problem;
-use crate::processes::Process;
+use crate::processes::{InvalidInputs, Process};
 use crate::service::auth::Tenant;
 use crate::service::callbacks::Subscriber;
 use crate::service::queue::Admission;
@@ -27,17 +28,25 @@ fn request_hash(
     process_id: &str,
     inputs: &serde_json::Value,
     subscriber: Option<&Subscriber>,
+    labels: Option<&serde_json::Value>,
+    note: Option<&serde_json::Value>,
 ) -> RequestHash {
-    match subscriber {
-        None => RequestHash::of_json(Kind::Job, process_id, inputs),
-        Some(subscriber) => {
-            let request = serde_json::Map::from_iter([
-                ("inputs".to_owned(), inputs.clone()),
-                ("subscriber".to_owned(), subscriber.to_json()),
-            ]);
-            RequestHash::of_json(Kind::Job, process_id, &serde_json::Value::Object(request))
+    // The members besides `inputs` that make another request (none: the inputs alone,
+    // as keys were hashed before callbacks and labels existed).
+    let mut request = serde_json::Map::new();
+    if let Some(subscriber) = subscriber {
+        request.insert("subscriber".to_owned(), subscriber.to_json());
+    }
+    for (name, value) in [("labels", labels), ("note", note)] {
+        if let Some(value) = value.filter(|v| !v.is_null()) {
+            request.insert(name.to_owned(), value.clone());
         }
     }
+    if request.is_empty() {
+        return RequestHash::of_json(Kind::Job, process_id, inputs);
+    }
+    request.insert("inputs".to_owned(), inputs.clone());
+    RequestHash::of_json(Kind::Job, process_id, &serde_json::Value::Object(request))
 }
 
 /// `Preference-Applied` (RFC 7240): which `Prefer` preference the answer honours.
@@ -155,8 +164,14 @@ pub async fn execute(
         .registry
         .get(&process_id)
         .ok_or_else(|| Problem::no_such_process(&process_id))?;
-    let ExecutionInputs(ExecutionRequest { inputs, subscriber }) = body?;
+    let ExecutionInputs(ExecutionRequest {
+        inputs,
+        subscriber,
+        labels,
+        note,
+    }) = body?;
     let subscriber = Subscriber::parse(subscriber.as_ref(), &state.callbacks, tenant.as_str());
+    let annotations = Annotations::parse(labels.as_ref(), note.as_ref());
     let keyed = key.map(|key| KeyedRequest {
         key,
         kind: Kind::Job,
@@ -164,6 +179,8 @@ pub async fn execute(
             &process_id,
             &inputs,
             subscriber.as_ref().ok().and_then(Option::as_ref),
+            labels.as_ref(),
+            note.as_ref(),
         ),
     });
     // The stored signals the inputs refer to, the tenant's only: resolved now, so that an
@@ -177,14 +194,22 @@ pub async fn execute(
             .await
             .map_err(|e| ApiError::Internal(format!("validation panicked: {e}")))?
     };
-    // Every refusal at once: the inputs' and the subscriber's.
-    let (validated, subscriber) = match (validated, subscriber) {
-        (Ok(validated), Ok(subscriber)) => (validated, subscriber),
-        (Err(mut invalid), Err(refused)) => {
-            invalid.0.extend(refused.0);
-            return Err(Problem::invalid_inputs(&invalid).into());
+    // Every refusal at once: the inputs', the subscriber's, the labels' and the note's.
+    let (validated, subscriber, annotations) = match (validated, subscriber, annotations) {
+        (Ok(validated), Ok(subscriber), Ok(annotations)) => (validated, subscriber, annotations),
+        (validated, subscriber, annotations) => {
+            let mut errors = Vec::new();
+            if let Err(invalid) = validated {
+                errors.extend(invalid.0);
+            }
+            if let Err(refused) = subscriber {
+                errors.extend(refused.0);
+            }
+            if let Err(faults) = annotations {
+                errors.extend(faults);
+            }
+            return Err(Problem::invalid_inputs(&InvalidInputs(errors)).into());
         }
-        (Err(invalid), Ok(_)) | (Ok(_), Err(invalid)) => return Err(Problem::invalid_inputs(&invalid).into()),
     };
     state
         .limits
@@ -200,6 +225,7 @@ pub async fn execute(
             state.max_queued_jobs,
             keyed.as_ref(),
             subscriber.as_ref(),
+            &annotations,
         )
         .await?;
     let mut headers = HeaderMap::new();

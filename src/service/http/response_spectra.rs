@@ -44,7 +44,6 @@ pub(super) struct SpectrumRequest {
     pub f_max: f64,
     /// Frequencies of the grid, log-spaced.
     pub points: usize,
-    pub format: Option<String>,
 }
 
 /// A parsed response-spectrum query: the request, and the values of the route's own
@@ -96,7 +95,6 @@ pub(super) fn parse_spectrum_query(
         f_min: DEFAULT_F_MIN,
         f_max: DEFAULT_F_MAX,
         points: DEFAULT_POINTS,
-        format: None,
     };
     let mut own = Vec::new();
     for (key, value) in pairs {
@@ -124,7 +122,8 @@ pub(super) fn parse_spectrum_query(
                         Problem::invalid_query(format!("`points` must be an integer from 2 to {MAX_POINTS}"))
                     })?;
             }
-            "format" => request.format = Some(value.clone()),
+            // The negotiator's (`super::negotiation`), checked there.
+            "format" | "f" => {}
             other => {
                 let expected: Vec<&str> = ["damping", "f_min", "f_max", "points", "format"]
                     .into_iter()
@@ -229,6 +228,7 @@ pub async fn response_spectrum(
     Path((job_id, output)): Path<(String, String)>,
     query: Result<Query<Vec<(String, String)>>, axum::extract::rejection::QueryRejection>,
     headers: HeaderMap,
+    format: Format,
 ) -> Result<Response, ApiError> {
     let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
     let SpectrumQuery { request, extra } = parse_spectrum_query(&pairs, &["series"])?;
@@ -237,7 +237,6 @@ pub async fn response_spectrum(
         [(_, name)] if !name.is_empty() && !name.contains(',') => Some(name.clone()),
         _ => return Err(Problem::invalid_query("`series` names one column, once").into()),
     };
-    let format = Format::from_query(request.format.as_deref(), Format::preferred(&headers))?;
     let job = state
         .queue
         .get(tenant.as_str(), &job_id)

@@ -25,8 +25,10 @@ use crate::service::{store, thinning};
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct HistoryQuery {
-    /// `csv` or `json` (default: JSON, or CSV when `Accept` prefers `text/csv`).
+    /// Chosen by the service's negotiator (`f` is an alias): `csv` or `json`; without
+    /// it, the one `Accept` prefers (q-values honoured), else JSON.
     #[param(pattern = "^(csv|json)$")]
+    #[serde(alias = "f")]
     pub format: Option<String>,
     /// Start of the window (s), inclusive.
     pub t_start: Option<f64>,
@@ -149,8 +151,8 @@ pub async fn output(
     Path((job_id, output)): Path<(String, String)>,
     ApiQuery(mut query): ApiQuery<HistoryQuery>,
     headers: HeaderMap,
+    format: Format,
 ) -> Result<Response, ApiError> {
-    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
     let long_header = match query.header.as_deref() {
         None | Some("short") => false,
         Some("long") => true,

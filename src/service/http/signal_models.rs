@@ -38,6 +38,11 @@ pub struct SignalMetadata {
     pub arias_intensity: f64,
     /// When it was uploaded (RFC 3339, UTC).
     pub created: String,
+    /// The labels given at upload (empty when none): `GET /signals?label=` filters on them.
+    pub labels: Vec<String>,
+    /// The note given at upload.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
     /// `self`, the samples (CSV and JSON), the response spectrum.
     pub links: Vec<Link>,
 }
@@ -59,6 +64,8 @@ impl SignalMetadata {
             pga_time: record.pga_time,
             arias_intensity: record.arias_intensity,
             created: rfc3339(record.created_at),
+            labels: record.labels.0.clone(),
+            note: record.note.clone(),
             links: vec![
                 Link::new(&href, "self", "application/json"),
                 Link::new(format!("{href}/samples"), "data", "text/csv").titled("The samples as CSV"),

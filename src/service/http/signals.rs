@@ -23,6 +23,7 @@ use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
 use super::models::Link;
 use super::response_spectra::{parse_spectrum_query, spectra_csv};
 use super::signal_models::{DampedSpectrum, SignalList, SignalMetadata, SignalSpectrum};
+use crate::annotations::{Annotations, label_fault};
 use crate::physics::response_spectrum::{self, log_spaced};
 use crate::problem::Problem;
 use crate::service::auth::Tenant;
@@ -35,14 +36,63 @@ use crate::signal_record::{self, RecordError, RecordFormat};
 /// Rows per chunk of a streamed record.
 const STREAM_ROWS: usize = 4096;
 
-/// Query of `POST /signals`.
-#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
-#[serde(deny_unknown_fields)]
+/// Query of `POST /signals` (documentation; [`parse_upload_query`] reads it, since
+/// `label` repeats).
+#[derive(Debug, utoipa::IntoParams)]
 #[into_params(parameter_in = Query)]
 pub struct UploadQuery {
     /// Samples per second (Hz, positive) of a CSV record of accelerations alone (one
     /// column); times are then k / sampling_rate from 0.
     pub sampling_rate: Option<f64>,
+    /// A label of the signal (repeatable; at most 20, each 1 to 64 characters without
+    /// control characters or surrounding spaces): `GET /signals?label=` filters on them.
+    #[param(explode = true)]
+    pub label: Option<Vec<String>>,
+    /// A free-text note (at most 2000 characters), returned with the metadata.
+    pub note: Option<String>,
+}
+
+/// What `POST /signals` is asked besides the record.
+#[derive(Debug, Default)]
+struct Upload {
+    sampling_rate: Option<f64>,
+    labels: Vec<String>,
+    note: Option<String>,
+}
+
+/// What an idempotency key's request hash covers besides the body (labels and a note
+/// only when given, so that keys stored before them still match).
+fn upload_description(format: RecordFormat, sampling_rate: Option<f64>, annotations: &Annotations) -> String {
+    let mut text = format!("{format:?} sampling_rate={sampling_rate:?}");
+    if !annotations.labels.is_empty() || annotations.note.is_some() {
+        text.push_str(&format!(
+            " labels={:?} note={:?}",
+            annotations.labels, annotations.note
+        ));
+    }
+    text
+}
+
+/// `sampling_rate`, `label` (repeatable) and `note`; anything else is refused.
+fn parse_upload_query(pairs: &[(String, String)]) -> Result<Upload, Problem> {
+    let mut upload = Upload::default();
+    for (key, value) in pairs {
+        match key.as_str() {
+            "sampling_rate" => {
+                upload.sampling_rate = Some(value.parse().map_err(|_| {
+                    Problem::invalid_query(format!("`sampling_rate`: `{value}` is not a number"))
+                })?)
+            }
+            "label" => upload.labels.push(value.clone()),
+            "note" => upload.note = Some(value.clone()),
+            other => {
+                return Err(Problem::invalid_query(format!(
+                    "unknown query parameter `{other}` (expected sampling_rate, label, note)"
+                )));
+            }
+        }
+    }
+    Ok(upload)
 }
 
 impl From<SignalReadError> for ApiError {
@@ -104,11 +154,19 @@ fn upload_format(headers: &HeaderMap, text: &str) -> Result<RecordFormat, ApiErr
 pub async fn create(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
-    ApiQuery(query): ApiQuery<UploadQuery>,
+    query: Result<Query<Vec<(String, String)>>, axum::extract::rejection::QueryRejection>,
     IdempotencyHeader(key): IdempotencyHeader,
     headers: HeaderMap,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Response, ApiError> {
+    let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
+    let query = parse_upload_query(&pairs)?;
+    // Labels and a note are given in the query (the body is the record): a fault is a
+    // 422 at `/labels/k` or `/note`, as in an execution request.
+    let labels = serde_json::Value::from(query.labels.clone());
+    let note = query.note.clone().map(serde_json::Value::from);
+    let annotations = Annotations::parse(Some(&labels), note.as_ref())
+        .map_err(|errors| Problem::invalid_inputs(&crate::processes::InvalidInputs(errors)))?;
     if let Some(rate) = query.sampling_rate
         && !(rate.is_finite() && rate > 0.0)
     {
@@ -137,7 +195,7 @@ pub async fn create(
         kind: Kind::Signal,
         hash: RequestHash::of_bytes(
             Kind::Signal,
-            &format!("{format:?} sampling_rate={:?}", query.sampling_rate),
+            &upload_description(format, query.sampling_rate, &annotations),
             &bytes,
         ),
     });
@@ -167,7 +225,7 @@ pub async fn create(
     })?;
     let created = state
         .signals
-        .create(tenant.as_str(), &record, keyed.as_ref())
+        .create(tenant.as_str(), &record, keyed.as_ref(), &annotations)
         .await
         .map_err(|error| match error {
             CreateError::Database(error) => ApiError::Database(error),
@@ -221,9 +279,9 @@ pub async fn metadata(
     Ok(Json(SignalMetadata::from_record(&record)))
 }
 
-/// Query of `GET /signals`.
-#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
-#[serde(deny_unknown_fields)]
+/// Query of `GET /signals` (documentation; [`parse_list_query`] reads it, since
+/// `label` repeats).
+#[derive(Debug, utoipa::IntoParams)]
 #[into_params(parameter_in = Query)]
 pub struct ListQuery {
     /// Signals per page, 1 to 1000 (default 10).
@@ -231,8 +289,48 @@ pub struct ListQuery {
     pub limit: Option<u32>,
     /// Opaque position from a `next` link.
     pub cursor: Option<i64>,
-    /// OGC format parameter (accepted, ignored).
+    /// Only signals with this label; repeat it for signals with all of them.
+    #[param(explode = true)]
+    pub label: Option<Vec<String>>,
+    /// `json`, or `html` (the dashboard's page): chosen by the service's negotiator
+    /// (`format` is an alias); without it, the one `Accept` prefers.
     pub f: Option<String>,
+}
+
+/// `limit`, `cursor`, `label` (repeatable); `f` and `format` are the negotiator's.
+fn parse_list_query(pairs: &[(String, String)]) -> Result<(u32, Option<i64>, Vec<String>), Problem> {
+    let (mut limit, mut cursor, mut labels) = (DEFAULT_LIMIT, None, Vec::new());
+    for (key, value) in pairs {
+        match key.as_str() {
+            "limit" => {
+                limit = value
+                    .parse()
+                    .ok()
+                    .filter(|n| (1..=MAX_LIMIT).contains(n))
+                    .ok_or_else(|| {
+                        Problem::invalid_query(format!("`limit` must be an integer from 1 to {MAX_LIMIT}"))
+                    })?
+            }
+            "cursor" => {
+                cursor = Some(value.parse().map_err(|_| {
+                    Problem::invalid_query("`cursor` must be the value given in a `next` link")
+                })?)
+            }
+            "label" => {
+                if let Some(fault) = label_fault(value) {
+                    return Err(Problem::invalid_query(format!("`label` `{value}` {fault}")));
+                }
+                labels.push(value.clone());
+            }
+            "f" | "format" => {}
+            other => {
+                return Err(Problem::invalid_query(format!(
+                    "unknown query parameter `{other}` (expected limit, cursor, label)"
+                )));
+            }
+        }
+    }
+    Ok((limit, cursor, labels))
 }
 
 /// List signals
@@ -248,25 +346,25 @@ pub struct ListQuery {
 pub async fn list(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
-    ApiQuery(query): ApiQuery<ListQuery>,
+    query: Result<Query<Vec<(String, String)>>, axum::extract::rejection::QueryRejection>,
 ) -> Result<Json<SignalList>, ApiError> {
-    let limit = query.limit.unwrap_or(DEFAULT_LIMIT);
-    if !(1..=MAX_LIMIT).contains(&limit) {
-        return Err(
-            Problem::invalid_query(format!("`limit` must be an integer from 1 to {MAX_LIMIT}")).into(),
-        );
-    }
+    let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
+    let (limit, cursor, labels) = parse_list_query(&pairs)?;
     let mut signals = state
         .signals
-        .list(tenant.as_str(), limit + 1, query.cursor)
+        .list(tenant.as_str(), limit + 1, cursor, &labels)
         .await?;
     let more = signals.len() > limit as usize;
     signals.truncate(limit as usize);
+    let labels: String = labels
+        .iter()
+        .map(|label| format!("&label={}", super::sweeps::percent_encoded(label)))
+        .collect();
     let href = |cursor: Option<i64>| match cursor {
-        Some(cursor) => format!("/signals?limit={limit}&cursor={cursor}"),
-        None => format!("/signals?limit={limit}"),
+        Some(cursor) => format!("/signals?limit={limit}&cursor={cursor}{labels}"),
+        None => format!("/signals?limit={limit}{labels}"),
     };
-    let mut links = vec![Link::new(href(query.cursor), "self", "application/json")];
+    let mut links = vec![Link::new(href(cursor), "self", "application/json")];
     if let (true, Some(last)) = (more, signals.last()) {
         links.push(Link::new(href(Some(last.seq)), "next", "application/json"));
     }
@@ -311,8 +409,9 @@ pub async fn delete(
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct SamplesQuery {
-    /// `csv` (`time,acceleration`) or `json` (`{"time", "acceleration"}`); default from
-    /// `Accept` (CSV when it prefers `text/csv`), else JSON.
+    /// Chosen by the service's negotiator (`f` is an alias): `csv` or `json`; without
+    /// it, the one `Accept` prefers (q-values honoured), else JSON.
+    #[serde(alias = "f")]
     pub format: Option<String>,
 }
 
@@ -333,19 +432,20 @@ pub async fn samples(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
     Path(signal_id): Path<String>,
-    ApiQuery(query): ApiQuery<SamplesQuery>,
-    headers: HeaderMap,
+    // Checks the query; its `format` is the negotiator's (`format: Format`).
+    ApiQuery(_): ApiQuery<SamplesQuery>,
+    format: Format,
 ) -> Result<Response, ApiError> {
-    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
     let record = state
         .signals
         .record(tenant.as_str(), &signal_id)
         .await?
         .ok_or_else(|| Problem::no_such_signal(&signal_id))?;
     let record = Arc::new(record);
-    let chunks: Box<dyn Iterator<Item = String> + Send> = match format {
-        Format::Csv => Box::new(signal_record::csv_chunks(record, STREAM_ROWS)),
-        Format::Json => Box::new(signal_record::json_chunks(record, STREAM_ROWS)),
+    let chunks: Box<dyn Iterator<Item = String> + Send> = if format == Format::Csv {
+        Box::new(signal_record::csv_chunks(record, STREAM_ROWS))
+    } else {
+        Box::new(signal_record::json_chunks(record, STREAM_ROWS))
     };
     let stream =
         futures_util::stream::iter(chunks.map(|chunk| Ok::<_, std::convert::Infallible>(Bytes::from(chunk))));
@@ -389,11 +489,10 @@ pub async fn spectrum(
     Extension(tenant): Extension<Tenant>,
     Path(signal_id): Path<String>,
     query: Result<Query<Vec<(String, String)>>, axum::extract::rejection::QueryRejection>,
-    headers: HeaderMap,
+    format: Format,
 ) -> Result<Response, ApiError> {
     let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
     let request = parse_spectrum_query(&pairs, &[])?.request;
-    let format = Format::from_query(request.format.as_deref(), Format::preferred(&headers))?;
     let metadata = state
         .signals
         .get(tenant.as_str(), &signal_id)
@@ -430,9 +529,10 @@ pub async fn spectrum(
             .collect(),
         pga: metadata.pga,
     };
-    let body = match format {
-        Format::Json => serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))?,
-        Format::Csv => spectra_csv(&document.frequencies, &document.pseudo_acceleration).into_bytes(),
+    let body = if format == Format::Csv {
+        spectra_csv(&document.frequencies, &document.pseudo_acceleration).into_bytes()
+    } else {
+        serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))?
     };
     Ok((
         [(

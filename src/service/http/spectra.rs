@@ -24,7 +24,9 @@ use crate::service::{store, thinning};
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct SpectrumQuery {
-    /// `csv` (`frequency,<series...>`) or `json` (default).
+    /// Chosen by the service's negotiator (`f` is an alias): `csv` or `json`; without
+    /// it, the one `Accept` prefers (q-values honoured), else JSON.
+    #[serde(alias = "f")]
     pub format: Option<String>,
     /// Lowest frequency kept (Hz), inclusive.
     pub f_min: Option<f64>,
@@ -109,8 +111,8 @@ pub async fn spectrum(
     Path((job_id, output)): Path<(String, String)>,
     ApiQuery(mut query): ApiQuery<SpectrumQuery>,
     headers: HeaderMap,
+    format: Format,
 ) -> Result<Response, ApiError> {
-    let format = Format::from_query(query.format.as_deref(), Format::Json)?;
     require_finite([("f_min", query.f_min), ("f_max", query.f_max)], "Hz")?;
     // The per-impact table is no time series.
     if output == crate::processes::impact_report::TABLE {

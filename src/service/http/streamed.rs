@@ -20,6 +20,7 @@ use std::time::Duration;
 
 use axum::body::{Body, Bytes};
 use axum::http::HeaderValue;
+use futures_util::StreamExt;
 use tokio::runtime::Handle;
 use tokio::sync::{OwnedSemaphorePermit, Semaphore, mpsc};
 
@@ -123,7 +124,9 @@ pub fn held_bytes(permit: OwnedSemaphorePermit, bytes: Vec<u8>) -> Body {
         let bytes = bytes?;
         Some((Ok::<_, io::Error>(Bytes::from(bytes)), (None, permit)))
     });
-    Body::from_stream(stream)
+    // Fused: a layer that polls again after the end (the compression encoder does) must
+    // see the end again, not a panic of `unfold`.
+    Body::from_stream(stream.fuse())
 }
 
 /// A body that `write` writes on the blocking pool as the client takes it; `permit` is
@@ -155,7 +158,7 @@ pub fn streamed(permit: OwnedSemaphorePermit, write: WriteBody) -> Body {
     let chunks = futures_util::stream::unfold(receiver, |mut receiver| async move {
         receiver.recv().await.map(|chunk| (chunk, receiver))
     });
-    Body::from_stream(chunks)
+    Body::from_stream(chunks.fuse())
 }
 
 /// The writer of a streamed body: fills a chunk, then hands it to the connection,
@@ -229,7 +232,6 @@ mod tests {
 
     #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
     async fn a_streamed_body_is_the_bytes_written_in_chunks() {
-        use futures_util::StreamExt;
         let memory = ResponseMemory::new(1 << 20);
         let text: Vec<u8> = (0..(3 * CHUNK_BYTES + 17))
             .map(|k| b'a' + (k % 26) as u8)

@@ -83,6 +83,11 @@ pub struct SweepStatus {
     /// The sweep request as normalized: process, base inputs, axes, design, samples, seed, policy.
     #[schema(value_type = Object)]
     pub definition: serde_json::Value,
+    /// The labels given with the sweep (empty when none): `GET /sweeps?label=` filters on them.
+    pub labels: Vec<String>,
+    /// The note given with the sweep.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
     pub links: Vec<Link>,
 }
 
@@ -150,6 +155,8 @@ impl SweepStatus {
             }),
             updated: rfc3339(counts.updated_at.unwrap_or(0).max(record.updated_at)),
             definition: serde_json::from_str(&record.definition).unwrap_or(serde_json::Value::Null),
+            labels: record.labels.0.clone(),
+            note: record.note.clone(),
             links,
         }
     }

@@ -2,7 +2,7 @@
 //! the sweep list, dismissal, and its results table with aggregates.
 
 use axum::Json;
-use axum::extract::{Extension, Path, State};
+use axum::extract::{Extension, Path, Query, State};
 use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 
@@ -15,6 +15,7 @@ use super::idempotency::{IdempotencyHeader, key_reused, mark_replayed};
 use super::jobs::{DEFAULT_LIMIT, MAX_LIMIT};
 use super::models::Link;
 use super::sweep_models::{SweepList, SweepResults, SweepStatus};
+use crate::annotations::{Annotations, label_fault};
 use crate::problem::Problem;
 use crate::processes::{InvalidInputs, Process, TooCostly};
 use crate::service::auth::Tenant;
@@ -38,7 +39,7 @@ use crate::sweep::{SweepDefinition, SweepError};
 /// with the same `Idempotency-Key` and request gets the same sweep back.
 #[utoipa::path(post, path = "/sweeps", operation_id = "createSweep", tag = "Sweeps",
     params(("Idempotency-Key" = Option<String>, Header, description = "Optional, 1 to 255 visible ASCII characters: a retry with the same key and the same request gets the same resource back (same id, `201`, same `Location`, plus `Idempotent-Replayed: true`) instead of creating another; the same key with another request is a 422 `idempotency-key-reused`. Keys are per tenant and kept as long as the resource they created.")),
-    request_body(content = crate::sweep::SweepRequest, description = "The process, base inputs and axes"),
+    request_body(content = crate::sweep::SweepRequest, description = "The process, base inputs and axes; optionally `labels` (at most 20 texts of 1 to 64 characters) and a `note` (at most 2000 characters), as for a job: returned in the sweep's status, `GET /sweeps?label=` filters on them"),
     responses(
         (status = 201, description = "Sweep queued", body = SweepStatus,
             headers(("Location" = String, description = "`/sweeps/{sweepId}`"))),
@@ -61,12 +62,19 @@ pub async fn create(
     IdempotencyHeader(key): IdempotencyHeader,
     body: Result<JsonBody, ApiError>,
 ) -> Result<Response, ApiError> {
-    let JsonBody(body) = body?;
+    let JsonBody(mut body) = body?;
     let keyed = key.map(|key| KeyedRequest {
         key,
         kind: Kind::Sweep,
         hash: RequestHash::of_json(Kind::Sweep, "", &body),
     });
+    // Labels and a note are the sweep's, not part of its definition.
+    let (labels, note) = match &mut body {
+        serde_json::Value::Object(members) => (members.remove("labels"), members.remove("note")),
+        _ => (None, None),
+    };
+    let annotations = Annotations::parse(labels.as_ref(), note.as_ref())
+        .map_err(|errors| Problem::invalid_inputs(&InvalidInputs(errors)))?;
     // The tenant's stored signals the base inputs or an axis refer to.
     let signals = state.signals.library(tenant.as_str(), &body).await?;
     let registry = state.registry.clone();
@@ -100,6 +108,7 @@ pub async fn create(
                 design: spec.design.as_str(),
                 policy: spec.policy.as_str(),
                 runs: &runs,
+                annotations: &annotations,
             },
             state.max_queued_jobs,
             keyed.as_ref(),
@@ -216,25 +225,66 @@ pub async fn status(
     Ok(tagged(&headers, "application/json", body, extra))
 }
 
-/// Query of `GET /sweeps`.
-#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
-#[serde(deny_unknown_fields)]
-#[into_params(parameter_in = Query)]
-pub struct SweepListQuery {
-    /// Sweeps per page, 1 to 1000 (default 10).
-    #[param(minimum = 1, maximum = 1000)]
-    pub limit: Option<u32>,
-    /// Opaque position from a `next` link.
-    pub cursor: Option<i64>,
-    /// Accepted and ignored (OGC format parameter).
-    pub f: Option<String>,
+/// The query of `GET /sweeps`: `limit` (1 to 1000, default 10), `cursor`, `label`
+/// (repeatable: sweeps with every label named); `f` and `format` are the negotiator's
+/// ([`super::negotiation`]); anything else is refused.
+#[derive(Debug, Default)]
+struct SweepListQuery {
+    limit: Option<u32>,
+    cursor: Option<i64>,
+    labels: Vec<String>,
+}
+
+fn parse_list_query(pairs: &[(String, String)]) -> Result<SweepListQuery, Problem> {
+    let mut query = SweepListQuery::default();
+    for (key, value) in pairs {
+        match key.as_str() {
+            "limit" => {
+                query.limit = Some(
+                    value
+                        .parse()
+                        .ok()
+                        .filter(|n| (1..=MAX_LIMIT).contains(n))
+                        .ok_or_else(|| {
+                            Problem::invalid_query(format!(
+                                "`limit` must be an integer from 1 to {MAX_LIMIT}"
+                            ))
+                        })?,
+                )
+            }
+            "cursor" => {
+                query.cursor = Some(value.parse().map_err(|_| {
+                    Problem::invalid_query("`cursor` must be the value given in a `next` link")
+                })?)
+            }
+            "label" => {
+                if let Some(fault) = label_fault(value) {
+                    return Err(Problem::invalid_query(format!("`label` `{value}` {fault}")));
+                }
+                query.labels.push(value.clone());
+            }
+            "f" | "format" => {}
+            other => {
+                return Err(Problem::invalid_query(format!(
+                    "unknown query parameter `{other}` (expected limit, cursor, label)"
+                )));
+            }
+        }
+    }
+    Ok(query)
 }
 
 /// List sweeps
 ///
-/// Newest first, `limit` per page; the `next` link gives older ones.
+/// Newest first, `limit` per page; the `next` link gives older ones. `label`
+/// (repeatable): only the sweeps that have every label named.
 #[utoipa::path(get, path = "/sweeps", operation_id = "getSweeps", tag = "Sweeps",
-    params(SweepListQuery),
+    params(
+        ("limit" = Option<u32>, Query, description = "Sweeps per page, 1 to 1000 (default 10)", minimum = 1, maximum = 1000),
+        ("cursor" = Option<i64>, Query, description = "Opaque position from a `next` link"),
+        ("label" = Option<Vec<String>>, Query, explode = true, description = "Only sweeps that have this label; repeat it for sweeps that have all of them"),
+        ("f" = Option<String>, Query, description = "`json`, or `html` (the dashboard's page); `format` is an alias; default from `Accept`"),
+    ),
     responses(
         (status = 200, description = "A page of sweeps", body = SweepList),
         (status = 400, description = "Invalid query parameter", body = super::openapi::ProblemSchema,
@@ -242,25 +292,27 @@ pub struct SweepListQuery {
 pub async fn list(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
-    ApiQuery(query): ApiQuery<SweepListQuery>,
+    query: Result<Query<Vec<(String, String)>>, axum::extract::rejection::QueryRejection>,
 ) -> Result<Response, ApiError> {
+    let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
+    let query = parse_list_query(&pairs)?;
     let limit = query.limit.unwrap_or(DEFAULT_LIMIT);
-    if !(1..=MAX_LIMIT).contains(&limit) {
-        return Err(
-            Problem::invalid_query(format!("`limit` must be an integer from 1 to {MAX_LIMIT}")).into(),
-        );
-    }
     let mut sweeps = state
         .queue
-        .list_sweeps(tenant.as_str(), limit + 1, query.cursor)
+        .list_sweeps(tenant.as_str(), limit + 1, query.cursor, &query.labels)
         .await?;
     let more = sweeps.len() > limit as usize;
     sweeps.truncate(limit as usize);
     let ids: Vec<String> = sweeps.iter().map(|s| s.id.clone()).collect();
     let counts = state.queue.sweep_counts(tenant.as_str(), &ids).await?;
+    let labels: String = query
+        .labels
+        .iter()
+        .map(|label| format!("&label={}", percent_encoded(label)))
+        .collect();
     let href = |cursor: Option<i64>| match cursor {
-        Some(cursor) => format!("/sweeps?limit={limit}&cursor={cursor}"),
-        None => format!("/sweeps?limit={limit}"),
+        Some(cursor) => format!("/sweeps?limit={limit}&cursor={cursor}{labels}"),
+        None => format!("/sweeps?limit={limit}{labels}"),
     };
     let mut links = vec![Link::new(href(query.cursor), "self", "application/json")];
     if let (true, Some(last)) = (more, sweeps.last()) {
@@ -274,6 +326,16 @@ pub async fn list(
         links,
     };
     Ok(Json(list).into_response())
+}
+
+/// Every byte but unreserved characters percent-encoded (a query parameter's value).
+pub(super) fn percent_encoded(text: &str) -> String {
+    text.bytes()
+        .map(|b| match b {
+            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' | b'~' => (b as char).to_string(),
+            _ => format!("%{b:02X}"),
+        })
+        .collect()
 }
 
 /// Dismiss a sweep
@@ -306,9 +368,10 @@ pub async fn dismiss(
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct SweepResultsQuery {
-    /// `json` (the table with aggregates) or `csv` (the table only); default: JSON, or
-    /// CSV when `Accept` prefers `text/csv`.
+    /// Chosen by the service's negotiator (`f` is an alias): `csv` or `json`; without
+    /// it, the one `Accept` prefers (q-values honoured), else JSON.
     #[param(pattern = "^(csv|json)$")]
+    #[serde(alias = "f")]
     pub format: Option<String>,
 }
 
@@ -333,10 +396,11 @@ pub async fn results(
     State(state): State<AppState>,
     Extension(tenant): Extension<Tenant>,
     Path(sweep_id): Path<String>,
-    ApiQuery(query): ApiQuery<SweepResultsQuery>,
+    // Checks the query; its `format` is the negotiator's (`format: Format`).
+    ApiQuery(_): ApiQuery<SweepResultsQuery>,
     headers: HeaderMap,
+    format: Format,
 ) -> Result<Response, ApiError> {
-    let format = Format::from_query(query.format.as_deref(), Format::preferred(&headers))?;
     let csv = format == Format::Csv;
     let record = find(&state, &tenant, &sweep_id).await?;
     let status = sweep_status(&state, &tenant, &record).await?;
@@ -392,11 +456,14 @@ fn run_record(run: SweepRun, process: Option<&dyn Process>) -> RunRecord {
         .results
         .as_deref()
         .and_then(|text| serde_json::from_str(text).ok());
-    let metrics = match (&document, process) {
+    let mut metrics = match (&document, process) {
         (Some(document), Some(process)) => process.summary_metrics(document),
         (Some(document), None) => crate::processes::metrics::flatten_scalars(document),
         (None, _) => Vec::new(),
     };
+    // Where a run's result comes from is the sweep's (one solver, one build; the run's
+    // inputs are its axis columns), not a metric to tabulate or aggregate.
+    metrics.retain(|(name, _)| !name.starts_with("provenance."));
     RunRecord {
         run: usize::try_from(run.run).unwrap_or(0),
         job: run.job_id,

@@ -17,7 +17,7 @@ impl JobQueue {
             let dismissed: Option<JobRecord> = sqlx::query_as(concat!(
                 "UPDATE jobs SET status = 'dismissed', cancel_requested = TRUE, message = 'dismissed', \
                      finished_at = COALESCE(finished_at, $2), updated_at = $2, lease_owner = NULL, \
-                     lease_expires_at = NULL, results = NULL \
+                     lease_expires_at = NULL, results = NULL, verdict = NULL \
                  WHERE id = $1 AND tenant = $3 AND status <> 'dismissed' RETURNING ",
                 record_columns!()
             ))

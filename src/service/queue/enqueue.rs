@@ -15,6 +15,7 @@
 use super::content_hash::content_hash;
 use super::idempotency::{IdempotencyStore, KeyedRequest, Prior, is_key_taken};
 use super::{Admission, JobQueue, JobRecord, record_columns};
+use crate::annotations::Annotations;
 use crate::service::callbacks::{Subscriber, outbox};
 use crate::service::db::{TenantQueueLock, with_pool};
 
@@ -25,8 +26,8 @@ pub(crate) const BEGIN_WRITE_POSTGRES: &str = "BEGIN";
 
 impl JobQueue {
     /// Inserts an accepted job of `tenant` for `process_id` with its (already validated)
-    /// inputs and their plausibility warnings (and its `subscriber`, stored in the same
-    /// transaction: [`crate::service::callbacks`]), unless `tenant` already has `max_queued`
+    /// inputs and their plausibility warnings, its labels and note (and its `subscriber`,
+    /// stored in the same transaction: [`crate::service::callbacks`]), unless `tenant` already has `max_queued`
     /// accepted jobs. With `key`, a job the key already created for the same request is
     /// returned instead ([`Admission::Replayed`]), and another request with that key is
     /// refused ([`Admission::KeyConflict`]).
@@ -39,16 +40,23 @@ impl JobQueue {
         max_queued: Option<u64>,
         key: Option<&KeyedRequest>,
         subscriber: Option<&Subscriber>,
+        annotations: &Annotations,
     ) -> Result<Admission<JobRecord>, sqlx::Error> {
-        match self
-            .enqueue_once(tenant, process_id, inputs, warnings, max_queued, key, subscriber)
-            .await
-        {
+        let enqueue_once = || {
+            self.enqueue_once(
+                tenant,
+                process_id,
+                inputs,
+                warnings,
+                max_queued,
+                key,
+                subscriber,
+                annotations,
+            )
+        };
+        match enqueue_once().await {
             // A concurrent first use of the same key won: this one now finds it.
-            Err(error) if key.is_some() && is_key_taken(&error) => {
-                self.enqueue_once(tenant, process_id, inputs, warnings, max_queued, key, subscriber)
-                    .await
-            }
+            Err(error) if key.is_some() && is_key_taken(&error) => enqueue_once().await,
             outcome => outcome,
         }
     }
@@ -62,6 +70,7 @@ impl JobQueue {
         max_queued: Option<u64>,
         key: Option<&KeyedRequest>,
         subscriber: Option<&Subscriber>,
+        annotations: &Annotations,
     ) -> Result<Admission<JobRecord>, sqlx::Error> {
         let warnings = serde_json::to_string(warnings).expect("warnings serialize");
         let id = uuid::Uuid::new_v4().to_string();
@@ -88,8 +97,8 @@ impl JobQueue {
             }
             let inserted: Option<JobRecord> = sqlx::query_as(concat!(
                 "INSERT INTO jobs (id, tenant, process_id, inputs, status, progress, message, created_at, \
-                     updated_at, content_hash, warnings) \
-                 SELECT $1, $6, $2, $3, 'accepted', 0, 'queued', $4, $4, $5, $8 \
+                     updated_at, content_hash, warnings, labels, note) \
+                 SELECT $1, $6, $2, $3, 'accepted', 0, 'queued', $4, $4, $5, $8, $9, $10 \
                  WHERE $7 IS NULL OR (SELECT COUNT(*) FROM jobs WHERE tenant = $6 AND status = 'accepted') < $7 \
                  RETURNING ",
                 record_columns!()
@@ -102,6 +111,8 @@ impl JobQueue {
             .bind(tenant)
             .bind(max_queued.map(|n| i64::try_from(n).unwrap_or(i64::MAX)))
             .bind(&warnings)
+            .bind(annotations.labels_json())
+            .bind(&annotations.note)
             .fetch_optional(&mut *tx)
             .await?;
             if let (Some(record), Some(request)) = (&inserted, key) {

@@ -11,6 +11,11 @@ use crate::quality_note::finished_message;
 use crate::service::db::with_pool;
 use crate::service::store::StoredHistory;
 
+/// `quality.verdict` of a results document, if it has one.
+pub(super) fn verdict(results: &serde_json::Value) -> Option<&str> {
+    results["quality"]["verdict"].as_str()
+}
+
 /// The lease guard shared by every statement below (parameters $1, $2, $3).
 macro_rules! guard {
     () => {
@@ -22,7 +27,7 @@ impl JobQueue {
     /// Marks the job successful with its results document and histories (one transaction:
     /// the row and its histories appear together or not at all). The status message is
     /// `finished`, with the quality verdict and its reasons when they are not good
-    /// ([`finished_message`]).
+    /// ([`finished_message`]); the verdict is also kept on its own, for the job list.
     pub async fn complete(
         &self,
         lease: &Lease,
@@ -38,7 +43,7 @@ impl JobQueue {
             let updated = sqlx::query(concat!(
                 "UPDATE jobs SET status = 'successful', progress = 100, message = $6, \
                      finished_at = $4, updated_at = $4, lease_owner = NULL, lease_expires_at = NULL, \
-                     results = $5",
+                     results = $5, verdict = $7",
                 guard!()
             ))
             .bind(&lease.job_id)
@@ -47,6 +52,7 @@ impl JobQueue {
             .bind(now)
             .bind(results.to_string())
             .bind(&message)
+            .bind(verdict(results))
             .execute(&mut *tx)
             .await?;
             if updated.rows_affected() != 1 {

@@ -124,6 +124,12 @@ pub struct JobRecord {
     /// Plausibility warnings about its inputs, found at submission (none for jobs
     /// submitted before warnings existed).
     pub warnings: Vec<crate::processes::Warning>,
+    /// Labels given at submission (`[]` when none).
+    pub labels: Vec<String>,
+    /// The note given at submission.
+    pub note: Option<String>,
+    /// `quality.verdict` of a successful job's results (`good`, `doubtful`, `poor`).
+    pub verdict: Option<String>,
 }
 
 /// Columns of [`JobRecord`] for `SELECT` and `RETURNING` clauses (a literal, for `concat!`:
@@ -131,7 +137,7 @@ pub struct JobRecord {
 macro_rules! record_columns {
     () => {
         "seq, id, process_id, status, progress, message, created_at, started_at, finished_at, \
-         updated_at, attempt, sweep_id, warnings"
+         updated_at, attempt, sweep_id, warnings, labels, note, verdict"
     };
 }
 pub(crate) use record_columns;
@@ -172,6 +178,15 @@ where
                     None => Vec::new(),
                 }
             },
+            labels: {
+                let text: String = row.try_get("labels")?;
+                serde_json::from_str(&text).map_err(|e| sqlx::Error::ColumnDecode {
+                    index: "labels".into(),
+                    source: Box::new(e),
+                })?
+            },
+            note: row.try_get("note")?,
+            verdict: row.try_get("verdict")?,
         })
     }
 }
@@ -266,12 +281,17 @@ pub struct SweepRecord {
     /// Times in ms since the Unix epoch.
     pub created_at: i64,
     pub updated_at: i64,
+    /// Labels given at creation.
+    #[sqlx(try_from = "String")]
+    pub labels: crate::annotations::StoredLabels,
+    /// The note given at creation.
+    pub note: Option<String>,
 }
 
 /// Columns of [`SweepRecord`] (a literal, for `concat!`).
 macro_rules! sweep_columns {
     () => {
-        "seq, id, process_id, definition, design, policy, runs, dismissed, created_at, updated_at"
+        "seq, id, process_id, definition, design, policy, runs, dismissed, created_at, updated_at, labels, note"
     };
 }
 pub(crate) use sweep_columns;

@@ -7,7 +7,8 @@ use crate::service::db::with_pool;
 use crate::service::store::StoredHistory;
 
 /// `GET /jobs`. Each list filter is one parameter, a JSON array of text (NULL: any),
-/// whatever its length.
+/// whatever its length; a job matches the labels filter ($8) when it has every label
+/// named.
 const LIST_SQLITE: &str = concat!(
     "SELECT ",
     record_columns!(),
@@ -17,6 +18,8 @@ const LIST_SQLITE: &str = concat!(
        AND ($3 IS NULL OR seq < $3) \
        AND ($5 IS NULL OR sweep_id IN (SELECT value FROM json_each($5))) \
        AND ($7 IS NULL OR (sweep_id IS NOT NULL) = $7) \
+       AND ($8 IS NULL OR NOT EXISTS (SELECT 1 FROM json_each($8) AS wanted \
+            WHERE wanted.value NOT IN (SELECT value FROM json_each(jobs.labels)))) \
        AND tenant = $6 \
      ORDER BY seq DESC LIMIT $4"
 );
@@ -29,6 +32,7 @@ const LIST_POSTGRES: &str = concat!(
        AND ($3 IS NULL OR seq < $3) \
        AND ($5 IS NULL OR sweep_id IN (SELECT json_array_elements_text(CAST($5 AS json)))) \
        AND (CAST($7 AS boolean) IS NULL OR (sweep_id IS NOT NULL) = $7) \
+       AND (CAST($8 AS text) IS NULL OR CAST(labels AS jsonb) @> CAST($8 AS jsonb)) \
        AND tenant = $6 \
      ORDER BY seq DESC LIMIT $4"
 );
@@ -42,6 +46,8 @@ pub struct JobFilter {
     pub sweep_ids: Vec<String>,
     /// `Some(false)`: only jobs submitted on their own; `Some(true)`: only sweep runs.
     pub in_sweep: Option<bool>,
+    /// Only jobs that have every one of these labels.
+    pub labels: Vec<String>,
 }
 
 /// A job with what it produced: results document (successful) or problem (failed).
@@ -87,6 +93,8 @@ impl JobQueue {
             .then(|| serde_json::to_string(&filter.process_ids).unwrap_or_default());
         let sweep_ids = (!filter.sweep_ids.is_empty())
             .then(|| serde_json::to_string(&filter.sweep_ids).unwrap_or_default());
+        let labels =
+            (!filter.labels.is_empty()).then(|| serde_json::to_string(&filter.labels).unwrap_or_default());
         let sql = self.db.choose(LIST_SQLITE, LIST_POSTGRES);
         with_pool!(&self.db, pool => {
             sqlx::query_as(sql)
@@ -97,6 +105,7 @@ impl JobQueue {
                 .bind(&sweep_ids)
                 .bind(tenant)
                 .bind(filter.in_sweep)
+                .bind(&labels)
                 .fetch_all(pool)
                 .await
         })

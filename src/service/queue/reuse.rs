@@ -13,20 +13,20 @@ use crate::service::db::with_pool;
 
 /// Completes the leased job ($1–$3) with results $5 copied from job $6, only while $6
 /// is still successful; $7 is the status message (the reuse, and the results' quality
-/// verdict when it is not good). SQLite: this first write takes the database's write lock, so
+/// verdict when it is not good), $8 the verdict. SQLite: this first write takes the database's write lock, so
 /// the source cannot change before the histories are copied. PostgreSQL: the source
 /// row is locked `FOR SHARE` (a dismissal or purge of it waits for this transaction).
 const TAKE_SQLITE: &str = "\
     UPDATE jobs SET status = 'successful', progress = 100, finished_at = $4, updated_at = $4, \
         lease_owner = NULL, lease_expires_at = NULL, results = $5, \
-        message = $7 \
+        message = $7, verdict = $8 \
     WHERE id = $1 AND lease_owner = $2 AND attempt = $3 AND status = 'running' \
         AND EXISTS (SELECT 1 FROM jobs WHERE id = $6 AND status = 'successful')";
 
 const TAKE_POSTGRES: &str = "\
     UPDATE jobs SET status = 'successful', progress = 100, finished_at = $4, updated_at = $4, \
         lease_owner = NULL, lease_expires_at = NULL, results = $5, \
-        message = $7 \
+        message = $7, verdict = $8 \
     WHERE id = $1 AND lease_owner = $2 AND attempt = $3 AND status = 'running' \
         AND EXISTS (SELECT 1 FROM jobs source WHERE source.id = $6 AND source.status = 'successful' \
             FOR SHARE OF source)";
@@ -62,11 +62,14 @@ impl JobQueue {
                 &format!("/jobs/{source_id}/"),
                 &format!("/jobs/{}/", lease.job_id),
             );
-            let message = serde_json::from_str::<serde_json::Value>(&results)
+            let document = serde_json::from_str::<serde_json::Value>(&results).ok();
+            let message = document
+                .as_ref()
                 .map(|document| {
-                    finished_message(&document, Some(&format!("reused the results of job {source_id}")))
+                    finished_message(document, Some(&format!("reused the results of job {source_id}")))
                 })
-                .unwrap_or_else(|_| format!("finished: reused the results of job {source_id}"));
+                .unwrap_or_else(|| format!("finished: reused the results of job {source_id}"));
+            let verdict = document.as_ref().and_then(super::finish::verdict).map(str::to_owned);
             let now = self.now();
             let mut tx = pool.begin().await?;
             let updated = sqlx::query(take)
@@ -77,6 +80,7 @@ impl JobQueue {
                 .bind(&results)
                 .bind(&source_id)
                 .bind(&message)
+                .bind(&verdict)
                 .execute(&mut *tx)
                 .await?;
             if updated.rows_affected() != 1 {

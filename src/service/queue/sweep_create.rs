@@ -57,6 +57,8 @@ pub struct NewSweep<'a> {
     pub policy: &'a str,
     /// Every run, in run order.
     pub runs: &'a [NewRun],
+    /// Labels and note of the sweep.
+    pub annotations: &'a crate::annotations::Annotations,
 }
 
 /// One run of a new sweep.
@@ -141,8 +143,8 @@ impl JobQueue {
             }
             let record: Option<SweepRecord> = sqlx::query_as(concat!(
                 "INSERT INTO sweeps (id, tenant, process_id, definition, design, policy, runs, created_at, \
-                     updated_at) \
-                 SELECT $1, $8, $2, $3, $4, $5, $6, $7, $7 \
+                     updated_at, labels, note) \
+                 SELECT $1, $8, $2, $3, $4, $5, $6, $7, $7, $11, $12 \
                  WHERE $9 IS NULL \
                     OR (SELECT COUNT(*) FROM jobs WHERE tenant = $8 AND status = 'accepted') + $10 <= $9 \
                  RETURNING ",
@@ -158,6 +160,8 @@ impl JobQueue {
             .bind(sweep.tenant)
             .bind(max_queued.map(|n| i64::try_from(n).unwrap_or(i64::MAX)))
             .bind(queued_runs as i64)
+            .bind(sweep.annotations.labels_json())
+            .bind(&sweep.annotations.note)
             .fetch_optional(&mut *tx)
             .await?;
             if record.is_some() {

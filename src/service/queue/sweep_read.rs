@@ -58,6 +58,24 @@ impl SweepCounts {
     }
 }
 
+/// `GET /sweeps`: a page of the tenant's sweeps ($3) older than $1, at most $2, with
+/// every label of the JSON array $4 (NULL: any).
+const LIST_SWEEPS_SQLITE: &str = concat!(
+    "SELECT ",
+    sweep_columns!(),
+    " FROM sweeps WHERE ($1 IS NULL OR seq < $1) AND tenant = $3 \
+       AND ($4 IS NULL OR NOT EXISTS (SELECT 1 FROM json_each($4) AS wanted \
+            WHERE wanted.value NOT IN (SELECT value FROM json_each(sweeps.labels)))) \
+     ORDER BY seq DESC LIMIT $2"
+);
+const LIST_SWEEPS_POSTGRES: &str = concat!(
+    "SELECT ",
+    sweep_columns!(),
+    " FROM sweeps WHERE ($1 IS NULL OR seq < $1) AND tenant = $3 \
+       AND (CAST($4 AS text) IS NULL OR CAST(labels AS jsonb) @> CAST($4 AS jsonb)) \
+     ORDER BY seq DESC LIMIT $2"
+);
+
 /// An ended run of a sweep with what it produced.
 #[derive(Debug, Clone)]
 pub struct SweepRun {
@@ -87,24 +105,24 @@ impl JobQueue {
     }
 
     /// Up to `limit` sweeps of `tenant`, newest first, strictly older than sequence
-    /// `before` when given.
+    /// `before` when given; with `labels`, only the sweeps that have all of them.
     pub async fn list_sweeps(
         &self,
         tenant: &str,
         limit: u32,
         before: Option<i64>,
+        labels: &[String],
     ) -> Result<Vec<SweepRecord>, sqlx::Error> {
+        let labels = (!labels.is_empty()).then(|| serde_json::to_string(labels).unwrap_or_default());
+        let sql = self.db.choose(LIST_SWEEPS_SQLITE, LIST_SWEEPS_POSTGRES);
         with_pool!(&self.db, pool => {
-            sqlx::query_as(concat!(
-                "SELECT ",
-                sweep_columns!(),
-                " FROM sweeps WHERE ($1 IS NULL OR seq < $1) AND tenant = $3 ORDER BY seq DESC LIMIT $2"
-            ))
-            .bind(before)
-            .bind(i64::from(limit))
-            .bind(tenant)
-            .fetch_all(pool)
-            .await
+            sqlx::query_as(sql)
+                .bind(before)
+                .bind(i64::from(limit))
+                .bind(tenant)
+                .bind(&labels)
+                .fetch_all(pool)
+                .await
         })
     }
 

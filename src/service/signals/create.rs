@@ -2,6 +2,7 @@
 //! compressed samples.
 
 use super::{SignalRecord, SignalStore, signal_columns};
+use crate::annotations::Annotations;
 use crate::physics::accelerogram::RecordSummary;
 use crate::physics::loads::Table;
 use crate::processes::History;
@@ -40,11 +41,12 @@ impl SignalStore {
         tenant: &str,
         record: &Table,
         key: Option<&KeyedRequest>,
+        annotations: &Annotations,
     ) -> Result<Keyed<SignalRecord>, CreateError> {
-        match self.create_once(tenant, record, key).await {
+        match self.create_once(tenant, record, key, annotations).await {
             // A concurrent first use of the same key won: this one now finds it.
             Err(CreateError::Database(error)) if key.is_some() && is_key_taken(&error) => {
-                self.create_once(tenant, record, key).await
+                self.create_once(tenant, record, key, annotations).await
             }
             outcome => outcome,
         }
@@ -55,6 +57,7 @@ impl SignalStore {
         tenant: &str,
         record: &Table,
         key: Option<&KeyedRequest>,
+        annotations: &Annotations,
     ) -> Result<Keyed<SignalRecord>, CreateError> {
         let summary = RecordSummary::of(record)
             .ok_or_else(|| CreateError::Unchecked("fewer than 2 samples or times not increasing".into()))?;
@@ -86,8 +89,8 @@ impl SignalStore {
             let created: SignalRecord = sqlx::query_as(concat!(
                 "INSERT INTO signals (id, tenant, samples, start_time, duration, sampling_interval, \
                      shortest_interval, longest_interval, uniform, pga, pga_time, arias_intensity, data, \
-                     created_at) \
-                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14) RETURNING ",
+                     created_at, labels, note) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16) RETURNING ",
                 signal_columns!()
             ))
             .bind(&id)
@@ -104,6 +107,8 @@ impl SignalStore {
             .bind(summary.arias_intensity)
             .bind(&stored.data)
             .bind(now)
+            .bind(annotations.labels_json())
+            .bind(&annotations.note)
             .fetch_one(&mut *tx)
             .await?;
             if let Some(request) = key {

@@ -45,13 +45,18 @@ pub struct SignalRecord {
     pub arias_intensity: f64,
     /// When it was stored (ms since the Unix epoch).
     pub created_at: i64,
+    /// Labels given at upload.
+    #[sqlx(try_from = "String")]
+    pub labels: crate::annotations::StoredLabels,
+    /// The note given at upload.
+    pub note: Option<String>,
 }
 
 /// Columns of [`SignalRecord`] (a literal, for `concat!`: queries are static strings).
 macro_rules! signal_columns {
     () => {
         "seq, id, samples, start_time, duration, sampling_interval, shortest_interval, \
-         longest_interval, uniform, pga, pga_time, arias_intensity, created_at"
+         longest_interval, uniform, pga, pga_time, arias_intensity, created_at, labels, note"
     };
 }
 pub(crate) use signal_columns;

@@ -13,6 +13,24 @@ use crate::service::store::{self, StoredHistory};
 /// signals than this is refused at the ids left out, as unknown).
 pub const MAX_REFERENCED: usize = 1000;
 
+/// `GET /signals`: the tenant's ($1) signals older than $2, at most $3, with every label
+/// of the JSON array $4 (NULL: any).
+const LIST_SQLITE: &str = concat!(
+    "SELECT ",
+    signal_columns!(),
+    " FROM signals WHERE tenant = $1 AND ($2 IS NULL OR seq < $2) \
+       AND ($4 IS NULL OR NOT EXISTS (SELECT 1 FROM json_each($4) AS wanted \
+            WHERE wanted.value NOT IN (SELECT value FROM json_each(signals.labels)))) \
+     ORDER BY seq DESC LIMIT $3"
+);
+const LIST_POSTGRES: &str = concat!(
+    "SELECT ",
+    signal_columns!(),
+    " FROM signals WHERE tenant = $1 AND ($2 IS NULL OR seq < $2) \
+       AND (CAST($4 AS text) IS NULL OR CAST(labels AS jsonb) @> CAST($4 AS jsonb)) \
+     ORDER BY seq DESC LIMIT $3"
+);
+
 impl SignalStore {
     /// Signal `id` if `tenant` owns it.
     pub async fn get(&self, tenant: &str, id: &str) -> Result<Option<SignalRecord>, sqlx::Error> {
@@ -30,24 +48,24 @@ impl SignalStore {
     }
 
     /// Up to `limit` signals of `tenant`, newest first, strictly older than the one with
-    /// sequence number `before` when given.
+    /// sequence number `before` when given; with `labels`, only those with all of them.
     pub async fn list(
         &self,
         tenant: &str,
         limit: u32,
         before: Option<i64>,
+        labels: &[String],
     ) -> Result<Vec<SignalRecord>, sqlx::Error> {
+        let labels = (!labels.is_empty()).then(|| serde_json::to_string(labels).unwrap_or_default());
+        let sql = self.db.choose(LIST_SQLITE, LIST_POSTGRES);
         with_pool!(&self.db, pool => {
-            sqlx::query_as(concat!(
-                "SELECT ",
-                signal_columns!(),
-                " FROM signals WHERE tenant = $1 AND ($2 IS NULL OR seq < $2) ORDER BY seq DESC LIMIT $3"
-            ))
-            .bind(tenant)
-            .bind(before)
-            .bind(i64::from(limit))
-            .fetch_all(pool)
-            .await
+            sqlx::query_as(sql)
+                .bind(tenant)
+                .bind(before)
+                .bind(i64::from(limit))
+                .bind(&labels)
+                .fetch_all(pool)
+                .await
         })
     }
 

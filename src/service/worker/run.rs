@@ -8,6 +8,7 @@
 //! The outcome is then written under the lease guard, and retried while the storage
 //! refuses it ([`super::persist`]).
 
+use crate::provenance::Provenance;
 use std::ops::ControlFlow;
 use std::panic::AssertUnwindSafe;
 use std::time::{Duration, Instant};
@@ -111,6 +112,8 @@ pub(super) async fn run_job(
 
     let (sender, mut receiver) = oneshot::channel::<ThreadOutcome>();
     let thread_control = control.clone();
+    // Stamped on the results document where it is assembled ([`finish`]).
+    let provenance = Provenance::of(&job.inputs);
     let inputs = job.inputs;
     let spawned = std::thread::Builder::new()
         .name(format!("job-{short}"))
@@ -216,7 +219,7 @@ pub(super) async fn run_job(
         Ok(Ok(output)) => output.document["quality"]["verdict"].as_str().map(str::to_owned),
         _ => None,
     };
-    let outcome_label = finish(ctx, &lease, outcome, ending).await;
+    let outcome_label = finish(ctx, &lease, outcome, ending, provenance).await;
     ctx.metrics
         .observe_job(&process_id, outcome_label, started.elapsed());
     if let (Some(verdict), "successful") = (verdict, outcome_label) {
@@ -240,7 +243,13 @@ struct Ending {
 }
 
 /// Writes the outcome of a run under its lease; returns the outcome's metric label.
-async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, ending: Ending) -> &'static str {
+async fn finish(
+    ctx: &WorkerContext,
+    lease: &Lease,
+    outcome: ThreadOutcome,
+    ending: Ending,
+    provenance: Provenance,
+) -> &'static str {
     let Ending {
         lost,
         handing_back,
@@ -258,7 +267,9 @@ async fn finish(ctx: &WorkerContext, lease: &Lease, outcome: ThreadOutcome, endi
                     .iter()
                     .map(store::encode)
                     .collect::<Result<Vec<_>, _>>()?;
-                let document = output.document_with_outputs(|name| format!("/jobs/{job_id}/results/{name}"));
+                let mut document =
+                    output.document_with_outputs(|name| format!("/jobs/{job_id}/results/{name}"));
+                provenance.stamp(&mut document);
                 Ok::<_, store::HistoryError>((document, histories))
             })
             .await;

@@ -189,8 +189,13 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"{type(value).__name__} is not JSON serializable")
 
 
+class Repeated(list):
+    """A query parameter sent once per value (``label=a&label=b``), not comma-joined."""
+
+
 def _query(params: Optional[Mapping[str, Any]]) -> Optional[dict[str, Any]]:
-    """Drops ``None`` values; lists become comma-separated; booleans ``true``/``false``."""
+    """Drops ``None`` values; lists become comma-separated (a :class:`Repeated` list is
+    repeated); booleans ``true``/``false``."""
     if params is None:
         return None
     out: dict[str, Any] = {}
@@ -199,6 +204,8 @@ def _query(params: Optional[Mapping[str, Any]]) -> Optional[dict[str, Any]]:
             continue
         if isinstance(value, bool):
             out[key] = "true" if value else "false"
+        elif isinstance(value, Repeated):
+            out[key] = [str(v) for v in value]
         elif isinstance(value, (list, tuple)):
             out[key] = ",".join(str(v) for v in value)
         else:

@@ -7,7 +7,7 @@ from typing import Any, Iterator, Mapping, Optional, Sequence, Union
 
 import httpx
 
-from ._http import RetryPolicy, Transport
+from ._http import Repeated, RetryPolicy, Transport
 from .jobs import Job
 from .signals import Signal, SignalSource, upload_body
 from .sweeps import Sweep
@@ -94,6 +94,8 @@ class Client:
         *,
         idempotency_key: Optional[str] = None,
         subscriber: Optional[Mapping[str, str]] = None,
+        labels: Optional[Sequence[str]] = None,
+        note: Optional[str] = None,
     ) -> Job:
         """Validates and queues a run of ``process`` with ``inputs`` (the members of the
         execution request's ``inputs``, not the ``{"inputs": ...}`` wrapper). Returns
@@ -110,11 +112,20 @@ class Client:
         see :func:`chocmodal.verify_signature`). The service's operator must allow their
         hosts (``--callback-allow``): others are refused with a 422 at
         ``/subscriber/successUri`` (...).
+
+        ``labels`` (at most 20 texts of 1 to 64 characters) and ``note`` (at most 2000
+        characters) are stored with the job and returned in its status; find the jobs
+        with a label by ``client.jobs(label=...)``. Bad ones are refused with a 422 at
+        ``/labels/k`` or ``/note``.
         """
         key = idempotency_key or str(uuid.uuid4())
         body: dict[str, Any] = {"inputs": dict(inputs)}
         if subscriber is not None:
             body["subscriber"] = dict(subscriber)
+        if labels is not None:
+            body["labels"] = list(labels)
+        if note is not None:
+            body["note"] = note
         response = self._transport.request(
             "POST",
             f"/processes/{process}/execution",
@@ -139,11 +150,14 @@ class Client:
         process: Union[str, Sequence[str], None] = None,
         sweep: Union[str, Sequence[str], None] = None,
         in_sweep: Optional[bool] = None,
+        label: Union[str, Sequence[str], None] = None,
         limit: Optional[int] = 100,
     ) -> list[Job]:
         """Jobs newest first, filtered by ``status``, ``process``, ``sweep`` (runs of these
-        sweeps) and ``in_sweep``; at most ``limit`` of them (``None``: every page)."""
-        params = {"status": status, "processID": process, "sweepID": sweep, "inSweep": in_sweep}
+        sweeps), ``in_sweep`` and ``label`` (jobs that have every label given); at most
+        ``limit`` of them (``None``: every page)."""
+        labels = [label] if isinstance(label, str) else list(label or [])
+        params = {"status": status, "processID": process, "sweepID": sweep, "inSweep": in_sweep, "label": Repeated(labels) if labels else None}
         return [Job(self, s["jobID"], s) for s in self._pages("/jobs", "jobs", params, limit)]
 
     # -- sweeps -------------------------------------------------------------------
@@ -160,14 +174,20 @@ class Client:
         policy: Optional[str] = None,
         invalid_runs: Optional[str] = None,
         idempotency_key: Optional[str] = None,
+        labels: Optional[Sequence[str]] = None,
+        note: Optional[str] = None,
     ) -> Sweep:
         """Queues a sweep: ``process`` run with ``inputs`` over ``axes`` (see
         :mod:`chocmodal.axes`). ``design`` (``grid``, ``monte_carlo``,
         ``latin_hypercube``), ``samples`` (draws per grid cell, with random axes),
         ``seed``, ``policy`` (``continue`` or ``fail_fast``), ``invalid_runs``
-        (``refuse`` or ``record``): left out, the service's defaults apply."""
+        (``refuse`` or ``record``): left out, the service's defaults apply. ``labels``
+        and ``note`` are the sweep's (``client.sweeps(label=...)``)."""
         request: dict[str, Any] = {"process": process, "inputs": dict(inputs), "axes": [dict(a) for a in axes]}
-        options = {"design": design, "samples": samples, "seed": seed, "policy": policy, "invalid_runs": invalid_runs}
+        options = {
+            "design": design, "samples": samples, "seed": seed, "policy": policy, "invalid_runs": invalid_runs,
+            "labels": list(labels) if labels is not None else None, "note": note,
+        }
         request.update({k: v for k, v in options.items() if v is not None})
         return self.submit_sweep_request(request, idempotency_key=idempotency_key)
 
@@ -189,9 +209,12 @@ class Client:
         sweep.status()
         return sweep
 
-    def sweeps(self, *, limit: Optional[int] = 100) -> list[Sweep]:
-        """Sweeps newest first, at most ``limit`` (``None``: every page)."""
-        return [Sweep(self, s["sweepID"], s) for s in self._pages("/sweeps", "sweeps", {}, limit)]
+    def sweeps(self, *, label: Union[str, Sequence[str], None] = None, limit: Optional[int] = 100) -> list[Sweep]:
+        """Sweeps newest first, those with every ``label`` given, at most ``limit``
+        (``None``: every page)."""
+        labels = [label] if isinstance(label, str) else list(label or [])
+        params = {"label": Repeated(labels) if labels else None}
+        return [Sweep(self, s["sweepID"], s) for s in self._pages("/sweeps", "sweeps", params, limit)]
 
     # -- signals ------------------------------------------------------------------
 
@@ -203,11 +226,19 @@ class Client:
         time: Optional[Sequence[float]] = None,
         sampling_rate: Optional[float] = None,
         idempotency_key: Optional[str] = None,
+        labels: Optional[Sequence[str]] = None,
+        note: Optional[str] = None,
     ) -> Signal:
         """Stores an accelerogram (m/s²) and returns it: a NumPy array with ``time_step``
         (s), ``sampling_rate`` (Hz) or ``time`` (s); a pandas Series indexed by time;
-        or a file (path or open file) of CSV ``time,acceleration`` (or JSON)."""
+        or a file (path or open file) of CSV ``time,acceleration`` (or JSON).
+        ``labels`` and ``note`` are stored with it (``client.signals(label=...)``)."""
         body, content_type, params = upload_body(source, time_step=time_step, time=time, sampling_rate=sampling_rate)
+        params = dict(params)
+        if labels:
+            params["label"] = Repeated(labels)
+        if note is not None:
+            params["note"] = note
         response = self._transport.request(
             "POST",
             "/signals",
@@ -225,9 +256,12 @@ class Client:
         """A stored signal by id."""
         return Signal(self, self._transport.get_json(f"/signals/{signal_id}"))
 
-    def signals(self, *, limit: Optional[int] = 100) -> list[Signal]:
-        """Stored signals newest first, at most ``limit`` (``None``: every page)."""
-        return [Signal(self, s) for s in self._pages("/signals", "signals", {}, limit)]
+    def signals(self, *, label: Union[str, Sequence[str], None] = None, limit: Optional[int] = 100) -> list[Signal]:
+        """Stored signals newest first, those with every ``label`` given, at most
+        ``limit`` (``None``: every page)."""
+        labels = [label] if isinstance(label, str) else list(label or [])
+        params = {"label": Repeated(labels) if labels else None}
+        return [Signal(self, s) for s in self._pages("/signals", "signals", params, limit)]
 
     # -- paging -------------------------------------------------------------------
 

@@ -19,6 +19,7 @@ import pandas as pd
 __all__ = [
     "history_frame",
     "contacts_frame",
+    "contact_table_frame",
     "pins_frame",
     "impacts_frame",
     "spectrum_frame",
@@ -170,6 +171,19 @@ def contacts_frame(contacts: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
     with dots (``impact_statistics.rms_force``), lists (histograms) kept as objects."""
     frame = pd.json_normalize([dict(c) for c in contacts], sep=".")
     frame.index = pd.RangeIndex(len(frame), name="contact")
+    frame.attrs["units"] = _units_by_last_segment(["contact", *frame.columns], CONTACT_UNITS)
+    return frame
+
+
+def contact_table_frame(text: str) -> pd.DataFrame:
+    """The service's per-contact statistics table (``/jobs/{jobId}/results/contacts``,
+    CSV) as a DataFrame indexed by ``contact``, the columns as the service names them
+    (``max_force``, ``impact_statistics.rms_force``); a body named by its pin number reads
+    as that number, a wall as ``"wall"``."""
+    frame = pd.read_csv(io.StringIO(text), index_col="contact")
+    for name in ("left", "right"):
+        if name in frame.columns:
+            frame[name] = [int(v) if str(v).lstrip("-").isdigit() else v for v in frame[name]]
     frame.attrs["units"] = _units_by_last_segment(["contact", *frame.columns], CONTACT_UNITS)
     return frame
 

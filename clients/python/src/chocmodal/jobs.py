@@ -223,17 +223,46 @@ class Job:
         return frame
 
     def contacts(self) -> pd.DataFrame:
-        """The per-contact statistics of the results (``contacts``), indexed by contact
-        k (history column ``c<k>``): ``left``, ``right``, ``height``, ``gap``,
+        """The per-contact statistics table the service serves
+        (``/jobs/{jobId}/results/contacts``, read as CSV with ``pd.read_csv``), indexed by
+        contact k (history column ``c<k>``): ``left``, ``right``, ``height``, ``gap``,
         ``max_force``, ``max_force_time``, ``impacts``, ``contact_time``, ``impulse``,
-        ``impact_statistics.*``..."""
-        results = self.results()
-        contacts = results.get("contacts")
-        if contacts is None:
-            raise KeyError(f"job {self.id}: its results have no per-contact statistics (`contacts`)")
-        frame = frames.contacts_frame(contacts)
+        ``impact_statistics.*``... The same table as ``chocmodal run --out``'s
+        ``contacts.csv``. A process without contacts raises :class:`ChocmodalError` (404)."""
+        response = self._client._transport.request(
+            "GET", f"/jobs/{self.id}/results/contacts", params={"format": "csv"}, headers={"Accept": "text/csv"}
+        )
+        frame = frames.contact_table_frame(response.text)
         frame.attrs["job"] = self.id
         return frame
+
+    def url(self, path: str = "") -> str:
+        """The absolute URL of this job's resource ``path`` (``/results/contacts?format=csv``):
+        ``pd.read_csv(job.url("/results/contacts?format=csv"))`` reads a table directly
+        (add ``storage_options={"Authorization": "Bearer ..."}`` on a service with tokens)."""
+        return self._client._transport.url(f"/jobs/{self.id}{path}")
+
+    @property
+    def labels(self) -> list[str]:
+        """The labels the job was submitted with (last status read)."""
+        return list((self._status or {}).get("labels") or [])
+
+    @property
+    def note(self) -> Optional[str]:
+        """The note the job was submitted with (last status read)."""
+        return (self._status or {}).get("note")
+
+    @property
+    def verdict(self) -> Optional[str]:
+        """``quality.verdict`` of a successful job (last status read): ``good``,
+        ``doubtful``, ``poor``; ``None`` before it succeeds."""
+        return (self._status or {}).get("verdict")
+
+    def provenance(self) -> dict[str, Any]:
+        """Where the results come from: ``solver``, ``solver_version``, ``build`` (git
+        commit, or ``None``) and ``inputs_sha256`` (SHA-256 of the canonical JSON of the
+        inputs, RFC 8785: equal for equivalent submissions)."""
+        return dict(self.results().get("provenance") or {})
 
     def pins(self) -> pd.DataFrame:
         """The per-pin extremes of the results (``pins``), indexed by pin."""

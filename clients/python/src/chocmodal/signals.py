@@ -24,8 +24,8 @@ SignalSource = Union["np.ndarray[Any, Any]", Sequence[float], pd.Series, str, "o
 class Signal:
     """One stored signal. ``metadata`` holds ``samples``, ``start``, ``duration``,
     ``sampling_interval``, ``sampling_rate``, ``uniform``, ``pga``, ``pga_time``,
-    ``arias_intensity``, ``created``. Refer to it from a job's inputs with
-    :meth:`reference`."""
+    ``arias_intensity``, ``created``, ``labels``, ``note``. Refer to it from a job's
+    inputs with :meth:`reference`."""
 
     def __init__(self, client: "Client", metadata: dict[str, Any], *, replayed: bool = False):
         self._client = client

@@ -460,7 +460,8 @@ fn peaks_keep_the_extremes_that_samples_miss() {
     }
 }
 
-/// Samples fall on exactly k × interval, and `auto` divides the interval asked for.
+/// Samples fall on k × interval written as a decimal (the double nearest to k × 10^-4,
+/// not the product k × 1e-4), and `auto` divides the interval asked for.
 #[test]
 fn samples_are_at_exact_multiples_of_the_interval() {
     let row = Row::plausible();
@@ -475,7 +476,7 @@ fn samples_are_at_exact_multiples_of_the_interval() {
     let every = (1e-4 / simulation.step.time_step).round();
     assert!((every * simulation.step.time_step / 1e-4 - 1.0).abs() < 1e-12);
     for (k, t) in simulation.time.iter().enumerate() {
-        assert_eq!(*t, k as f64 * 1e-4, "sample {k}");
+        assert_eq!(*t, format!("{k}e-4").parse::<f64>().unwrap(), "sample {k}");
     }
 }
 

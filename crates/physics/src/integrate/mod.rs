@@ -49,7 +49,7 @@ pub use crate::impacts::{ImpactCounting, ImpactHistogram, ImpactStatistics, Impa
 pub use model::{Model, NORMAL_LENGTH_TOLERANCE, Plane, Settings, TimeStep, WallMotion};
 pub use plan::Plan;
 pub use quality::{Check, Quality, StepHalving, Verdict};
-pub use step_size::{DEFAULT_TOLERANCE, StepLimit, StepSize, critical_time_step};
+pub use step_size::{DEFAULT_TOLERANCE, StepLimit, StepSize, critical_time_step, sample_time};
 
 /// Why a run produced no result.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -443,7 +443,8 @@ pub(super) fn record_closed_contact(
     stats.impulse += force * dt;
     if force > stats.max_force {
         stats.max_force = force;
-        stats.max_force_time = n as f64 * dt;
+        // On the grid of the step (the times of an every-step history).
+        stats.max_force_time = super::step_size::sample_time(n, dt);
     }
     if clock.loads(force) {
         impacts.record(clock, log, at, force, (penetration, previous), dissipation);

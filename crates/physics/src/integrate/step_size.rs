@@ -84,6 +84,44 @@ impl StepLimit {
     }
 }
 
+/// The time of sample (or step) k (s) on a grid of `interval`: the double nearest to
+/// k × the decimal `interval` stands for (m / 10^e, the fewest decimals that read back
+/// as it), so that it prints as that decimal (`0.009`, not the `0.009000000000000001` of
+/// `9.0 * 0.001`) and two grids of the same interval share their times exactly.
+///
+/// k·m and 10^e are exact doubles (k·m ≤ 2^53, e ≤ 22), so one quotient rounds the exact
+/// value once: the nearest double. An interval with no such decimal (a step chosen by
+/// `auto`: interval / n) falls back to the plain product k × interval. No allocation:
+/// cheap enough for an event's time inside the stepping loop.
+pub fn sample_time(k: u64, interval: f64) -> f64 {
+    let plain = k as f64 * interval;
+    let Some((m, e)) = short_decimal(interval) else {
+        return plain;
+    };
+    match k.checked_mul(m).filter(|&km| km <= 1 << 53) {
+        Some(km) => km as f64 / EXACT_POWERS_OF_TEN[e],
+        None => plain,
+    }
+}
+
+/// Powers of ten that are exact doubles.
+const EXACT_POWERS_OF_TEN: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18,
+    1e19, 1e20, 1e21, 1e22,
+];
+
+/// `x` (finite, positive) as m / 10^e with the fewest decimals e that read back as `x`
+/// (m / 10^e rounds to `x`), m ≤ 2^53; `None` when no e ≤ 22 does.
+fn short_decimal(x: f64) -> Option<(u64, usize)> {
+    if !(x.is_finite() && x > 0.0) {
+        return None;
+    }
+    EXACT_POWERS_OF_TEN.iter().enumerate().find_map(|(e, &power)| {
+        let m = (x * power).round();
+        (m >= 1.0 && m <= (1u64 << 53) as f64 && m / power == x).then_some((m as u64, e))
+    })
+}
+
 impl StepSize {
     /// Time steps of a run of `duration` (never past it).
     pub fn steps(&self, duration: f64) -> u64 {
@@ -236,5 +274,38 @@ pub fn resolve(model: &Model<'_>, settings: &Settings) -> Result<StepSize, Simul
                 limited_by,
             })
         }
+    }
+}
+
+#[cfg(test)]
+mod sample_time_tests {
+    use super::*;
+
+    #[test]
+    fn sample_times_are_the_decimals_k_times_the_interval() {
+        // (interval, m, e): interval = m / 10^e.
+        for (interval, m, e) in [
+            (1e-3, 1, 3),
+            (1e-4, 1, 4),
+            (2.5e-4, 25, 5),
+            (0.1, 1, 1),
+            (5.0, 5, 0),
+            (20.0, 20, 0),
+            (1e-6, 1, 6),
+        ] {
+            assert_eq!(short_decimal(interval), Some((m, e)), "{interval}");
+            for k in 0..20_000u64 {
+                let expected: f64 = format!("{}e-{e}", k * m).parse().unwrap();
+                let t = sample_time(k, interval);
+                assert_eq!(t, expected, "sample {k} of {interval}: {t} instead of {expected}");
+            }
+        }
+        // The plain product prints badly, the sample time does not.
+        assert_eq!(format!("{}", 9.0 * 1e-3), "0.009000000000000001");
+        assert_eq!(format!("{}", sample_time(9, 1e-3)), "0.009");
+        assert_eq!(format!("{}", sample_time(3, 0.1)), "0.3");
+        // An interval with no short decimal: the plain product.
+        let odd = 1.0 / 3.0e4;
+        assert_eq!(sample_time(7, odd), 7.0 * odd);
     }
 }

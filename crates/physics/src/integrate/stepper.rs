@@ -86,8 +86,8 @@ pub(super) fn integrate(
             run.check_divergence(n as f64 * step.time_step)?;
         }
         if n % output_every == 0 {
-            // Exactly k × interval, not a sum of steps.
-            run.record_sample((n / output_every) as f64 * interval);
+            // k × interval as the decimal it stands for, not a sum of steps.
+            run.record_sample(super::step_size::sample_time(n / output_every, interval));
         }
         if n % PROGRESS_EVERY == 0 && progress(n as f64 / total_steps as f64).is_break() {
             return Err(SimulationError::Cancelled);

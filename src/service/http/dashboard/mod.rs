@@ -1,7 +1,8 @@
 //! The dashboard: HTML pages for people, on the same addresses as the JSON API.
 //!
 //! A browser asking for `/`, `/jobs`, `/jobs/{jobId}`, `/sweeps`, `/sweeps/{sweepId}`,
-//! `/signals` or `/signals/{signalId}` gets a small HTML page ([`negotiation`] decides);
+//! `/signals` or `/signals/{signalId}` gets a small HTML page ([`super::negotiation`]
+//! decides);
 //! every other client gets the JSON exactly as before. The page's scripts then read the
 //! JSON API like any client and draw the plots in the browser (line plots with the
 //! vendored uPlot, maps, histograms and bars as SVG). `/ui/submit` is the submit form, `/ui/assets/{file}`
@@ -9,12 +10,10 @@
 //! the binary ([`assets`]), nothing fetched from elsewhere.
 
 pub mod assets;
-pub mod negotiation;
 
 use axum::Router;
-use axum::extract::{MatchedPath, Path, Request, State};
-use axum::http::{HeaderMap, HeaderValue, Method, StatusCode, header};
-use axum::middleware::Next;
+use axum::extract::{Path, State};
+use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::get;
 
@@ -122,38 +121,6 @@ pub fn html_page(page: Page, status: StatusCode) -> Response {
     response
         .headers_mut()
         .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
-    response
-}
-
-/// Content negotiation on the API routes that have a page (a layer on the router).
-///
-/// A request that wants HTML ([`negotiation::wants_html`]) still goes to the JSON
-/// handler, as a JSON request, so that the page has the resource's status (an unknown
-/// job is a 404 page, a bad query a 400 page); its body is the page. Every answer of
-/// these routes says `Vary: Accept`.
-pub async fn negotiate(mut request: Request, next: Next) -> Response {
-    let page = request
-        .extensions()
-        .get::<MatchedPath>()
-        .and_then(|route| Page::for_route(route.as_str()));
-    let (Some(page), true) = (page, matches!(*request.method(), Method::GET | Method::HEAD)) else {
-        return next.run(request).await;
-    };
-    let html = negotiation::wants_html(request.headers(), request.uri().query());
-    if html {
-        let headers = request.headers_mut();
-        headers.insert(header::ACCEPT, HeaderValue::from_static("application/json"));
-        headers.remove(header::IF_NONE_MATCH);
-    }
-    let response = next.run(request).await;
-    let mut response = if html {
-        html_page(page, response.status())
-    } else {
-        response
-    };
-    response
-        .headers_mut()
-        .append(header::VARY, HeaderValue::from_static("accept"));
     response
 }
 

@@ -26,10 +26,16 @@ function jobRow(job) {
     ? h('a', {href: `/sweeps/${job.sweepID}`, title: job.sweepID}, shortId(job.sweepID)) : '';
   return h('tr', {'data-job': job.jobID, 'data-status': job.status},
     h('td', {}, h('a', {href: `/jobs/${job.jobID}`, title: job.jobID, class: 'mono'}, shortId(job.jobID))),
-    h('td', {}, job.processID),
+    // Labels (each a link to the jobs that have it) and the note under the process: no
+    // column of their own, so that the table still fits 1280 px.
+    h('td', {}, job.processID, (job.labels || []).length ? h('div', {class: 'labels'},
+      job.labels.map((label) => h('a', {class: 'chip', 'data-label': label,
+        href: `/jobs?label=${encodeURIComponent(label)}`}, label))) : null,
+    job.note ? h('div', {class: 'message', title: job.note}, job.note) : null),
     h('td', {}, badge(job.status), job.message && (job.status === 'failed'
         || (job.status === 'successful' && job.message !== 'finished'))
       ? h('div', {class: 'message', title: job.message}, job.message) : null),
+    h('td', {}, job.verdict ? h('span', {class: `badge ${job.verdict}`, 'data-verdict': job.verdict}, job.verdict) : ''),
     h('td', {}, progressCell(job)),
     h('td', {}, timeCell(job.created)),
     h('td', {}, timeCell(job.finished)),
@@ -40,7 +46,7 @@ function jobRow(job) {
 function jobTable(jobs) {
   if (!jobs.length) return h('p', {class: 'muted'}, 'No jobs yet. ', h('a', {href: '/ui/submit'}, 'Submit one.'));
   return h('div', {class: 'scroll'}, h('table', {class: 'list', 'data-list': 'jobs'},
-    h('thead', {}, h('tr', {}, ['Job', 'Process', 'Status', 'Progress', 'Created', 'Finished', 'Run time', 'Sweep']
+    h('thead', {}, h('tr', {}, ['Job', 'Process', 'Status', 'Verdict', 'Progress', 'Created', 'Finished', 'Run time', 'Sweep']
       .map((c) => h('th', {}, c)))),
     h('tbody', {}, jobs.map(jobRow))));
 }
