@@ -4,7 +4,8 @@
 //!   successful runs of each grid cell of the list axes (one cell without list axes):
 //!   count, mean, sample standard deviation (divisor n − 1; 0 for one run), min, max and
 //!   the 5 %, 50 %, 95 % quantiles (linear interpolation between order statistics: the
-//!   p-quantile of sorted x₀..xₙ₋₁ is at position p·(n − 1)).
+//!   p-quantile of sorted x₀..xₙ₋₁ is at position p·(n − 1)), and the one-sided
+//!   95 %/95 % upper bound of Wilks ([`super::wilks`]; from 59 runs).
 //! - Calibration grids (rows with `comparison.f_err`): the validity map, run by run
 //!   (valid when f_err < threshold, the run's own `comparison.threshold`, else 0.2; a
 //!   failed run, e.g. diverged, is not valid), and for each combination of the other
@@ -157,6 +158,12 @@ pub struct Statistics {
     pub q05: f64,
     pub q50: f64,
     pub q95: f64,
+    /// The one-sided 95 %/95 % upper tolerance bound (Wilks, distribution-free): the
+    /// value the 95 % quantile stays below with 95 % confidence, the `bound_95_95_rank`-th
+    /// largest; null below 59 runs.
+    pub bound_95_95: Option<f64>,
+    /// Its rank from the top (1: the largest, from 59 runs; 2 from 93; 3 from 124).
+    pub bound_95_95_rank: Option<usize>,
 }
 
 /// Statistics of `values` (finite numbers); `None` when empty.
@@ -182,6 +189,8 @@ pub fn statistics(values: &[f64]) -> Option<Statistics> {
         q05: quantile(&sorted, 0.05),
         q50: quantile(&sorted, 0.50),
         q95: quantile(&sorted, 0.95),
+        bound_95_95: super::wilks::upper_bound(&sorted).map(|(value, _)| value),
+        bound_95_95_rank: super::wilks::upper_bound(&sorted).map(|(_, rank)| rank),
     })
 }
 
@@ -370,6 +379,11 @@ mod tests {
         assert!((stats.q50 - 2.5).abs() < 1e-15);
         assert!((stats.q05 - 1.15).abs() < 1e-12, "{}", stats.q05);
         assert!((stats.q95 - 3.85).abs() < 1e-12, "{}", stats.q95);
+        assert_eq!(
+            (stats.bound_95_95, stats.bound_95_95_rank),
+            (None, None),
+            "4 runs bound nothing"
+        );
     }
 
     #[test]

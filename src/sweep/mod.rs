@@ -31,6 +31,8 @@ pub mod request;
 pub mod sampling;
 pub mod spec;
 pub mod table;
+/// Distribution-free bounds on quantiles (Wilks).
+pub mod wilks;
 
 pub use definition::SweepDefinition;
 pub use request::{AxisKind, Design, InvalidRuns, Policy, SweepAxis, SweepRequest};

@@ -537,6 +537,16 @@ async fn monte_carlo_aggregates_match_the_law_and_the_rows() {
         (sum["mean"].as_f64(), sum["std"].as_f64(), sum["q95"].as_f64()),
         (Some(1.0), Some(0.0), Some(1.0))
     );
+
+    // The Wilks 95 %/95 % bound of 400 runs: the values above the 95 % quantile are
+    // binomial (400, 0.05), mean 20, standard deviation 4.36, so the rank from the top
+    // that is at or above it with 95 % confidence is about 20 − 1.645 × 4.36 ≈ 13; the
+    // bound is that order statistic of the rows.
+    let rank = drawn["bound_95_95_rank"].as_u64().unwrap() as usize;
+    assert!((11..=14).contains(&rank), "rank {rank}");
+    let mut sorted = values.clone();
+    sorted.sort_by(f64::total_cmp);
+    assert_eq!(drawn["bound_95_95"].as_f64(), Some(sorted[sorted.len() - rank]));
 }
 
 async fn identical_runs_are_computed_once_across_single_jobs_and_sweeps(backend: Backend) {

@@ -64,7 +64,8 @@ def test_monte_carlo_statistics_are_those_of_the_results_table(monte_carlo: choc
     table = monte_carlo.results()
     statistics = monte_carlo.statistics()
     assert statistics.index.names == ["metric"], "one cell: no list axis"
-    assert list(statistics.columns) == ["count", "mean", "std", "min", "max", "q05", "q50", "q95"]
+    assert list(statistics.columns) == [
+        "count", "mean", "std", "min", "max", "q05", "q50", "q95", "bound_95_95", "bound_95_95_rank"]
     assert not any(name.endswith("seed") for name in statistics.index), "seeds name draws, not metrics"
     for metric in ("max_contact_force.force", "impacts", "contacts.1.max_force"):
         values = table[metric].astype(float)

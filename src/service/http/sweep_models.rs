@@ -190,7 +190,9 @@ pub struct SweepResults {
     #[schema(value_type = Vec<Object>)]
     pub rows: Vec<serde_json::Map<String, serde_json::Value>>,
     /// `statistics` (random designs: per grid cell of the list axes, count, mean, std,
-    /// min, max, q05, q50, q95 of every numeric column but seeds over the successful runs) or
+    /// min, max, q05, q50, q95, and the one-sided 95 %/95 % upper bound of Wilks
+    /// `bound_95_95` with its rank from the top `bound_95_95_rank` (null below 59 runs), of
+    /// every numeric column but seeds over the successful runs) or
     /// `calibration` (grids with `comparison.f_err`: validity map, cheapest valid
     /// `/solver/time_step`, `/beam/modes`, `/beam/elements`); and `quality` when the
     /// runs carry a verdict: `{"runs", "good", "unchecked", "doubtful", "poor", "by_axis": [{"axis",

@@ -21,7 +21,7 @@ __all__ = ["Sweep", "SWEEP_ENDED"]
 #: Sweep statuses after which nothing changes any more.
 SWEEP_ENDED = frozenset({"successful", "partial", "failed", "dismissed"})
 
-_STATISTICS = ["count", "mean", "std", "min", "max", "q05", "q50", "q95"]
+_STATISTICS = ["count", "mean", "std", "min", "max", "q05", "q50", "q95", "bound_95_95", "bound_95_95_rank"]
 _VERDICTS = ["runs", "good", "unchecked", "doubtful", "poor"]
 
 
@@ -122,7 +122,8 @@ class Sweep:
     def statistics(self) -> pd.DataFrame:
         """Statistics over the successful runs of every numeric metric (random designs):
         one row per (grid cell of the list axes, metric), columns ``count, mean, std,
-        min, max, q05, q50, q95``. The cell's axis values are index levels before
+        min, max, q05, q50, q95, bound_95_95, bound_95_95_rank`` (the Wilks 95 %/95 % upper
+        bound and its rank from the top, NaN below 59 runs). The cell's axis values are index levels before
         ``metric``."""
         cells = self.aggregates().get("statistics") or []
         records: list[dict[str, Any]] = []

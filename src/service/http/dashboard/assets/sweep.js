@@ -217,15 +217,18 @@ function monteCarloCard(groups, doc, definition) {
     replace(plotBox, histogram({id: 'histogram', title: `${state.metric} over ${group.runs} runs (${cellLabel(group)})`,
       values: rows.map((row) => row[state.metric]).filter((v) => typeof v === 'number'), xLabel: state.metric,
       caption: h('span', {class: 'muted'}, ` mean ${fmt(stats.mean)}, std ${fmt(stats.std)}, min ${fmt(stats.min)}, ` +
-        `q05 ${fmt(stats.q05)}, median ${fmt(stats.q50)}, q95 ${fmt(stats.q95)}, max ${fmt(stats.max)}`),
+        `q05 ${fmt(stats.q05)}, median ${fmt(stats.q50)}, q95 ${fmt(stats.q95)}, max ${fmt(stats.max)}` +
+        (stats.bound_95_95 == null ? ' (a 95 %/95 % bound needs 59 runs)' : `, 95 %/95 % bound ${fmt(stats.bound_95_95)}`)),
       markers: [{x: stats.q05, label: 'q05'}, {x: stats.q50, label: 'median'}, {x: stats.q95, label: 'q95'},
         {x: stats.mean, label: 'mean'}]}));
     replace(tableBox, h('details', {}, h('summary', {}, `statistics of every column (${cellLabel(group)})`),
       h('div', {class: 'scroll'}, h('table', {class: 'list', 'data-statistics': ''},
-        h('thead', {}, h('tr', {}, ['column', 'count', 'mean', 'std', 'min', 'q05', 'q50', 'q95', 'max'].map((c) => h('th', {}, c)))),
+        h('thead', {}, h('tr', {}, ['column', 'count', 'mean', 'std', 'min', 'q05', 'q50', 'q95', 'max', 'bound 95/95'].map((c) => h('th', {}, c)))),
         h('tbody', {}, Object.entries(group.metrics).map(([name, s]) => h('tr', {class: name === state.metric ? 'selected' : null},
           h('td', {}, h('a', {href: '#', onclick: (event) => { event.preventDefault(); state.metric = name; draw(); }}, name)),
-          [s.count, s.mean, s.std, s.min, s.q05, s.q50, s.q95, s.max].map((v) => h('td', {}, fmt(v))))))))));
+          [s.count, s.mean, s.std, s.min, s.q05, s.q50, s.q95, s.max].map((v) => h('td', {}, fmt(v)))
+            .concat([h('td', {title: s.bound_95_95 == null ? 'Wilks: needs 59 runs' : `Wilks: value ${s.bound_95_95_rank} from the top`},
+              s.bound_95_95 == null ? '—' : fmt(s.bound_95_95))]))))))));
   };
   const controls = h('div', {class: 'filters'},
     h('label', {}, 'metric ', h('select', {onchange: (event) => { state.metric = event.target.value; draw(); }},
