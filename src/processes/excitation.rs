@@ -222,3 +222,17 @@ pub fn plane_signal(
         }
     }
 }
+
+/// The stored signals among the excitation members `members` (name in
+/// `/inputs/excitation`, value), with their pointers.
+pub fn signal_slots<'a>(
+    members: impl IntoIterator<Item = (&'static str, &'a mut Option<BaseAccelerationInput>)>,
+) -> Vec<crate::processes::signal_input::SignalSlot<'a>> {
+    members
+        .into_iter()
+        .filter_map(|(member, signal)| {
+            let signal = signal.as_mut()?.signal_mut()?;
+            Some((format!("/inputs/excitation/{member}"), signal))
+        })
+        .collect()
+}

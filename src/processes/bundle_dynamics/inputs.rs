@@ -415,18 +415,12 @@ pub struct ExcitationInput {
 impl ExcitationInput {
     /// The stored signals referenced, with their pointers.
     pub fn signal_references(&mut self) -> Vec<crate::processes::signal_input::SignalSlot<'_>> {
-        [
+        crate::processes::excitation::signal_slots([
             ("base_acceleration", &mut self.base_acceleration),
             ("wall_acceleration", &mut self.wall_acceleration),
             ("left_wall_acceleration", &mut self.left_wall_acceleration),
             ("right_wall_acceleration", &mut self.right_wall_acceleration),
-        ]
-        .into_iter()
-        .filter_map(|(member, signal)| {
-            let signal = signal.as_mut()?.signal_mut()?;
-            Some((format!("/inputs/excitation/{member}"), signal))
-        })
-        .collect()
+        ])
     }
 
     /// The member that gives the left (`right` false) or right wall's motion, if any.

@@ -316,20 +316,14 @@ pub struct HexExcitationInput {
 impl HexExcitationInput {
     /// The stored signals referenced, with their pointers.
     pub fn signal_references(&mut self) -> Vec<crate::processes::signal_input::SignalSlot<'_>> {
-        [
+        crate::processes::excitation::signal_slots([
             ("base_acceleration", &mut self.base_acceleration),
             ("base_acceleration_x", &mut self.base_acceleration_x),
             ("base_acceleration_y", &mut self.base_acceleration_y),
             ("wrapper_acceleration", &mut self.wrapper_acceleration),
             ("wrapper_acceleration_x", &mut self.wrapper_acceleration_x),
             ("wrapper_acceleration_y", &mut self.wrapper_acceleration_y),
-        ]
-        .into_iter()
-        .filter_map(|(member, signal)| {
-            let signal = signal.as_mut()?.signal_mut()?;
-            Some((format!("/inputs/excitation/{member}"), signal))
-        })
-        .collect()
+        ])
     }
 }
 

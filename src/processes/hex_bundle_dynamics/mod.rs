@@ -207,9 +207,33 @@ pub struct HexPinResult {
     pub x: LineExtremes,
     /// Bending along y.
     pub y: LineExtremes,
+    /// Its largest resultant deflection √(x² + y²) (m) over the mesh nodes at every
+    /// output time, where and when.
+    pub deflection: ResultantDeflection,
     /// Its largest bending (the resultant of x and y) over its height and the output
     /// samples.
     pub bending: Bending,
+}
+
+/// A pin's largest resultant deflection.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
+pub struct ResultantDeflection {
+    /// max √(x² + y²) (m).
+    pub max_deflection: f64,
+    /// Height where it occurred (m).
+    pub height: f64,
+    /// When (s): an output sample.
+    pub time: f64,
+}
+
+impl ResultantDeflection {
+    fn of(extreme: &crate::physics::integrate::PinExtreme) -> Self {
+        Self {
+            max_deflection: extreme.max_abs_deflection,
+            height: extreme.height,
+            time: extreme.time,
+        }
+    }
 }
 
 /// The `hex-bundle-dynamics` process.
@@ -518,6 +542,7 @@ impl Simulation for HexBundleDynamics {
                     position: [position.x, position.y],
                     x: LineExtremes::of_line(&simulation, heights, p),
                     y: LineExtremes::of_line(&simulation, heights, pin_count + p),
+                    deflection: ResultantDeflection::of(&simulation.resultant_extremes[p]),
                     bending: flexure.bending(&simulation.pin_curvatures[p]),
                 }
             })

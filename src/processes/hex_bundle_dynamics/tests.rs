@@ -484,6 +484,18 @@ fn a_pin_bent_in_x_and_y_reports_the_resultant() {
         "{moment:e}"
     );
     assert_eq!(document["pins"][3]["bending"], *worst);
+    // The resultant deflection: the static F L³/3EI at the tip, along 30° (its x and y
+    // extremes are its cos and sin parts).
+    let pin = &document["pins"][3];
+    let resultant = pin["deflection"]["max_deflection"].as_f64().unwrap();
+    let x = pin["x"]["max_abs_deflection"].as_f64().unwrap();
+    let y = pin["y"]["max_abs_deflection"].as_f64().unwrap();
+    assert_eq!(pin["deflection"]["height"], length);
+    assert!(
+        (resultant - x.hypot(y)).abs() <= 1e-4 * resultant,
+        "{resultant:e} vs ({x:e}, {y:e})"
+    );
+    assert!((x - resultant * angle.to_radians().cos()).abs() <= 1e-4 * resultant);
     let moments = output
         .histories
         .iter()

@@ -127,6 +127,9 @@ pub struct Simulation {
     pub impact_histogram: ImpactHistogram,
     /// Per line (r as in `deflections`).
     pub pin_extremes: Vec<PinExtreme>,
+    /// Per pin in the plane (empty for the row): the largest resultant deflection
+    /// √(wx² + wy²) over the mesh nodes at every output time, where and when.
+    pub resultant_extremes: Vec<PinExtreme>,
     /// `curvatures[h][r]`: bending curvature w'' (1/m) of line r at output height h, per
     /// sample (signed: w'' > 0 bends the line concave toward +x, or +y; the moment is
     /// EI w''), the transport by a moving top support included.

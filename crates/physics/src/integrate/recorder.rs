@@ -67,6 +67,8 @@ pub(super) struct Recorder {
     contact_force_peaks: Vec<Vec<f64>>,
     mechanical_energy: Vec<f64>,
     pin_extremes: Vec<PinExtreme>,
+    /// Per pin in the plane (empty for the row): the largest resultant deflection.
+    resultant_extremes: Vec<PinExtreme>,
     /// Scratch: every line's curvature at every node and output height at the last
     /// sample (laid out as the level deflections).
     node_curvatures: Vec<f64>,
@@ -122,6 +124,10 @@ impl Recorder {
             contact_force_peaks: vec![Vec::new(); contacts],
             mechanical_energy: Vec::new(),
             pin_extremes: vec![PinExtreme::default(); lines],
+            resultant_extremes: match layout.contact_model {
+                ContactModel::Row => Vec::new(),
+                ContactModel::Plane(_) => vec![PinExtreme::default(); layout.model.pins],
+            },
             node_curvatures: vec![0.0; layout.node_curvatures_len()],
             output_curvatures: vec![0.0; layout.output_curvatures_len()],
             curvatures: vec![vec![Vec::new(); lines]; settings.output_heights.len()],
@@ -313,8 +319,9 @@ impl Recorder {
 
     /// The largest |w| of each line over the mesh nodes, if above the one so far.
     fn record_pin_extremes(&mut self, arch: pulp::Arch, layout: &Layout<'_>, state: &State, t: f64) {
-        arch.dispatch(NodeDeflectionsOp {
+        arch.dispatch(LevelsOp {
             layout,
+            shapes: &layout.node_shapes,
             q: &state.q,
             out: &mut self.node_deflections,
         });
@@ -329,12 +336,27 @@ impl Recorder {
         };
         for node in 0..=layout.model.basis.model().elements {
             let (block, lane) = (node / lanes, node % lanes);
+            let w = |line: usize| {
+                self.node_deflections[(block * stride + 1 + line) * lanes + lane] + transport(node, line)
+            };
+            let height = crate::decimal(node as f64 * element_length);
             for (p, extreme) in self.pin_extremes.iter_mut().enumerate() {
-                let w = self.node_deflections[(block * stride + 1 + p) * lanes + lane] + transport(node, p);
+                let w = w(p);
                 if w.abs() > extreme.max_abs_deflection {
                     *extreme = PinExtreme {
                         max_abs_deflection: w.abs(),
-                        height: crate::decimal(node as f64 * element_length),
+                        height,
+                        time: t,
+                    };
+                }
+            }
+            // In the plane, each pin's resultant √(wx² + wy²).
+            for (p, extreme) in self.resultant_extremes.iter_mut().enumerate() {
+                let w = w(p).hypot(w(pins + p));
+                if w > extreme.max_abs_deflection {
+                    *extreme = PinExtreme {
+                        max_abs_deflection: w,
+                        height,
                         time: t,
                     };
                 }
@@ -408,6 +430,7 @@ impl Recorder {
             impact_table,
             impact_histogram,
             pin_extremes: self.pin_extremes,
+            resultant_extremes: self.resultant_extremes,
             curvatures: self.curvatures,
             curvature_envelope: self.curvature_envelope,
             pin_curvatures: self.pin_curvatures,
@@ -474,32 +497,8 @@ fn impacts_by_lane(layout: &Layout<'_>, blocks: usize) -> Vec<ContactImpacts> {
         .collect()
 }
 
-/// The deflection of every pin at every node, as a [`pulp::WithSimd`] operation.
-struct NodeDeflectionsOp<'a> {
-    layout: &'a Layout<'a>,
-    q: &'a [f64],
-    out: &'a mut [f64],
-}
-
-impl pulp::WithSimd for NodeDeflectionsOp<'_> {
-    type Output = ();
-
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
-        let layout = self.layout;
-        level_deflections(
-            simd,
-            &layout.node_shapes,
-            layout.row,
-            self.q,
-            S::as_mut_simd_f64s(self.out).0,
-            layout.stride,
-        );
-    }
-}
-
-/// Every line's value at every level of `shapes` (curvatures at the nodes or at the
-/// output heights), as a [`pulp::WithSimd`] operation.
+/// Every line's value at every level of `shapes` (deflections or curvatures at the nodes,
+/// curvatures at the output heights), as a [`pulp::WithSimd`] operation.
 struct LevelsOp<'a> {
     layout: &'a Layout<'a>,
     shapes: &'a super::kernels::LevelShapes,
