@@ -24,7 +24,7 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 }
 
 /// The top-level module a source file belongs to (`processes` for
-/// `src/processes/inputs.rs`), `None` for the crate root and the binary.
+/// `src/processes/common_inputs.rs`), `None` for the crate root and the binary.
 fn top_level(path: &Path) -> Option<String> {
     let relative = path.strip_prefix(SOURCES).ok()?;
     let first = relative.components().next()?.as_os_str().to_str()?;

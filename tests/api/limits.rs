@@ -91,9 +91,10 @@ async fn histories_above_the_ceiling_point_at_the_output_interval() {
         ..CostLimits::default()
     })
     .await;
-    // row17: 0.2 s sampled every 1e-4 s is 2001 samples of 1 + 180 + 1 + 17 columns,
-    // twice (each history and its peaks), and the per-impact table's default 100 000
-    // rows of 10 values (180 contacts could make more in its ~10⁵ steps).
+    // row17: 0.2 s sampled every 1e-4 s is 2001 samples of 1 + 180 columns twice (the
+    // forces and their peaks) and of 1 + 17 three times (the deflections, their peaks and
+    // the bending moments), and the per-impact table's default 100 000 rows of 10 values
+    // (180 contacts could make more in its ~10⁵ steps).
     let body = example("bundle-row17.json");
     let response = app.post_execution("bundle-dynamics", &body).await;
     let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/too-costly").await;
@@ -107,7 +108,10 @@ async fn histories_above_the_ceiling_point_at_the_output_interval() {
         "{problem}"
     );
     assert_eq!(problem["exceeded"][0]["quantity"], "history_values");
-    assert_eq!(problem["exceeded"][0]["estimate"], 2.0 * 2001.0 * 199.0 + 1e6);
+    assert_eq!(
+        problem["exceeded"][0]["estimate"],
+        2001.0 * (2.0 * 181.0 + 3.0 * 18.0) + 1e6
+    );
 }
 
 #[tokio::test]

@@ -3,7 +3,7 @@
 //! a dozen numbers (`physics::hex`): each wire touches a neighbour's clad or the wrapper
 //! once every H/12, each contact with its normal in the transverse plane. Shaken by the
 //! wrapper in any horizontal direction, pushed by point forces or released from bent
-//! shapes (`hex_loads`). Statistics for every contact, full force histories for a
+//! shapes (`loads`). Statistics for every contact, full force histories for a
 //! selection.
 
 /// The inputs of `hex-bundle-dynamics`.
