@@ -271,6 +271,26 @@ def test_contact_forces_as_xarray_are_time_by_contact_with_the_contacts_as_coord
     assert list(deflections["height"].values) == [inputs["pin"]["length"]], "tips are at the pin length"
 
 
+def test_the_bending_envelope_is_a_frame_by_height_whose_stress_is_the_moment_over_the_section_modulus(
+    bundle: chocmodal.Job,
+) -> None:
+    envelope = bundle.bending()
+    inputs = bundle_inputs()["pin"]
+    outer, inner = inputs["section"]["outer_diameter"], inputs["section"]["inner_diameter"]
+    inertia = math.pi / 64.0 * (outer**4 - inner**4)
+    assert len(envelope) == inputs["elements"] + 1, "one row per mesh node"
+    assert envelope.index[0] == 0.0 and abs(envelope.index[-1] - inputs["length"]) < 1e-12
+    assert envelope.attrs["units"]["moment"] == "N·m" and envelope.attrs["units"]["stress"] == "Pa"
+    # σ = M c / I at the outer fibre, ε = σ / E.
+    stress = envelope["moment"] * (outer / 2.0) / inertia
+    assert ((envelope["stress"] - stress).abs() <= 1e-9 * stress.abs().max()).all()
+    assert ((envelope["strain"] - envelope["stress"] / inputs["young_modulus"]).abs() <= 1e-15).all()
+    worst = bundle.results()["max_bending"]
+    assert envelope["moment"].max() == worst["moment"]
+    assert envelope["moment"].idxmax() == worst["height"]
+    assert set(envelope["pin"]) <= {0, 1}
+
+
 def test_a_dismissed_job_stops_and_waiting_for_it_raises_the_servers_problem(client: chocmodal.Client) -> None:
     inputs = cantilever_inputs()
     inputs["solver"]["duration"] = 60.0  # far longer than this test

@@ -106,8 +106,23 @@ PIN_UNITS: dict[str, str] = {
     "pin": "1",
     "height": "m",
     "max_abs_deflection": "m",
+    "max_deflection": "m",
+    "deflection": "m",
     "time": "s",
+    "moment": "N·m",
+    "stress": "Pa",
+    "strain": "1",
 }
+
+
+def bending_frame(envelope: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
+    """The results' ``bending_envelope`` (per mesh node: the largest bending over every
+    pin and sample, which pin and when) indexed by ``height`` (m)."""
+    columns = ["height", "pin", "time", "moment", "stress", "strain"]
+    frame = pd.DataFrame([dict(e) for e in envelope], columns=columns).set_index("height")
+    frame[["stress", "strain"]] = frame[["stress", "strain"]].astype(float)
+    frame.attrs["units"] = {c: PIN_UNITS[c] for c in columns}
+    return frame
 
 
 def parse_long_header(cells: Sequence[str]) -> tuple[list[str], dict[str, str], dict[str, str]]:

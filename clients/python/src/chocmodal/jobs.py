@@ -273,6 +273,20 @@ class Job:
         frame.attrs["job"] = self.id
         return frame
 
+    def bending(self) -> pd.DataFrame:
+        """The bending envelope along the height (``bending_envelope``: per mesh node the
+        largest bending moment (N·m), outer-fibre stress (Pa) and strain over every pin and
+        output sample, with the ``pin`` and the ``time``), indexed by ``height`` (m); NaN
+        stresses and strains for an explicit section without a diameter. The run's worst
+        is ``results()["max_bending"]`` (``["numerical"]`` for ``cantilever-impact``)."""
+        results = self.results()
+        envelope = results.get("bending_envelope", (results.get("numerical") or {}).get("bending_envelope"))
+        if envelope is None:
+            raise KeyError(f"job {self.id}: its results have no bending envelope")
+        frame = frames.bending_frame(envelope)
+        frame.attrs["job"] = self.id
+        return frame
+
     def to_xarray(self, output: str, **history_options: Any) -> Any:
         """A history as xarray: contact forces as a DataArray over (time, contact), with
         each contact's ``left``, ``right``, ``height``, ``gap`` as coordinates;
