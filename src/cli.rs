@@ -179,7 +179,7 @@ fn record_files(inputs: &serde_json::Value, directory: &Path) -> SignalLibrary {
                 } else {
                     RecordFormat::sniff(&text)
                 };
-                signal_record::parse(&text, format, None, usize::MAX)
+                signal_record::parse(&text, format, None, None, usize::MAX)
                     .map_err(|e| format!("the record file {}: {e}", path.display()))
             });
         match read {

@@ -9,6 +9,18 @@
 //! - JSON: `{"time": [...], "acceleration": [...]}` (the `table` excitation's names) or
 //!   `{"sampling_rate": 200, "acceleration": [...]}`.
 //!
+//! - PEER AT2 (the NGA strong-motion databases' files), recognised by their first line
+//!   (`PEER …`) or a `NPTS` count on their fourth: three title lines (the third naming
+//!   the unit, `… IN UNITS OF G`), a fourth giving the count and the interval
+//!   (`NPTS=  3908, DT= .0100 SEC`, or the older `3908 .0100 NPTS, DT`), then the
+//!   accelerations, several to a line, at k·DT from 0.
+//! - One column after a header line giving the interval: `dt=0.005` (also `dt,0.005`,
+//!   `dt: 0.005 s`), times k·dt from 0.
+//!
+//! Accelerations are in m/s², or in g with `unit` = g (9.80665 m/s², the standard
+//! gravity): a record is stored in m/s² whatever its unit. An AT2 file is in g by its
+//! format; a unit given with it must say so.
+//!
 //! A record has at least two samples, times non-negative and strictly increasing, every
 //! value finite: the rules of a `table` excitation, so that a stored record is a valid
 //! excitation as it is.
@@ -19,6 +31,8 @@ use serde::Deserialize;
 
 use crate::physics::loads::Table;
 use crate::processes::FieldError;
+
+mod at2;
 
 /// At most this many problems are reported for one record (a broken file would
 /// otherwise list every line).
@@ -56,18 +70,86 @@ pub enum RecordError {
     TooLarge { samples: usize, limit: usize },
 }
 
-/// Parses and checks a record of at most `max_samples` samples. `sampling_rate`
-/// (samples per second) comes with a single-column CSV record, from outside its text.
+/// The standard gravity (m/s²): 1 g.
+pub const STANDARD_GRAVITY: f64 = 9.80665;
+
+/// The unit of a record's accelerations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, Deserialize, utoipa::ToSchema)]
+pub enum AccelerationUnit {
+    /// m/s² (the default).
+    #[default]
+    #[serde(rename = "m/s2")]
+    MetresPerSecondSquared,
+    /// The standard gravity, 9.80665 m/s².
+    #[serde(rename = "g")]
+    G,
+}
+
+impl AccelerationUnit {
+    /// From its name in a query: `m/s2` (also `m/s^2`, `m/s²`) or `g`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "m/s2" | "m/s^2" | "m/s²" => Some(Self::MetresPerSecondSquared),
+            "g" => Some(Self::G),
+            _ => None,
+        }
+    }
+
+    /// m/s² per unit.
+    pub fn factor(self) -> f64 {
+        match self {
+            Self::MetresPerSecondSquared => 1.0,
+            Self::G => STANDARD_GRAVITY,
+        }
+    }
+}
+
+/// Parses and checks a record of at most `max_samples` samples, into m/s².
+/// `sampling_rate` (samples per second) comes with a single-column CSV record, and
+/// `unit` (m/s² when absent) with CSV text, from outside its text.
 pub fn parse(
     text: &str,
     format: RecordFormat,
     sampling_rate: Option<f64>,
+    unit: Option<AccelerationUnit>,
     max_samples: usize,
 ) -> Result<Table, RecordError> {
-    let (record, lines) = match format {
-        RecordFormat::Csv => parse_csv(text, sampling_rate)?,
-        RecordFormat::Json => (parse_json(text)?, Vec::new()),
+    let (mut record, lines, unit) = match format {
+        RecordFormat::Csv if at2::recognises(text) => {
+            if sampling_rate.is_some() {
+                return Err(invalid(
+                    "/sampling_rate",
+                    "a PEER AT2 file gives its own interval (DT on its fourth line)",
+                ));
+            }
+            if unit.is_some_and(|u| u != AccelerationUnit::G) {
+                return Err(invalid(
+                    "/unit",
+                    "a PEER AT2 file is in g (its third line says so)",
+                ));
+            }
+            let (record, lines) = at2::parse(text)?;
+            (record, lines, AccelerationUnit::G)
+        }
+        RecordFormat::Csv => {
+            let (record, lines) = parse_csv(text, sampling_rate)?;
+            (record, lines, unit.unwrap_or_default())
+        }
+        RecordFormat::Json => {
+            let (record, json_unit) = parse_json(text)?;
+            if unit.is_some() {
+                return Err(invalid(
+                    "/unit",
+                    "a JSON record gives its unit as its `unit` member, not in the query",
+                ));
+            }
+            (record, Vec::new(), json_unit.unwrap_or_default())
+        }
     };
+    if unit != AccelerationUnit::MetresPerSecondSquared {
+        let factor = unit.factor();
+        record.values.iter_mut().for_each(|a| *a *= factor);
+    }
     if record.time.len() > max_samples {
         return Err(RecordError::TooLarge {
             samples: record.time.len(),
@@ -100,6 +182,7 @@ fn uniform_times(samples: usize, rate: f64) -> Vec<f64> {
 /// The record and, for CSV, the line of each sample.
 fn parse_csv(text: &str, sampling_rate: Option<f64>) -> Result<(Table, Vec<usize>), RecordError> {
     let mut columns: Option<usize> = None;
+    let mut interval: Option<f64> = None;
     let mut first = true;
     let mut time = Vec::new();
     let mut values = Vec::new();
@@ -114,6 +197,11 @@ fn parse_csv(text: &str, sampling_rate: Option<f64>) -> Result<(Table, Vec<usize
         let fields: Vec<&str> = content.split(',').map(str::trim).collect();
         if first {
             first = false;
+            if let Some(dt) = interval_header(content, line)? {
+                interval = Some(dt);
+                columns = Some(1);
+                continue;
+            }
             if fields[0].parse::<f64>().is_err() {
                 columns = Some(header(&fields, line)?);
                 continue;
@@ -170,6 +258,21 @@ fn parse_csv(text: &str, sampling_rate: Option<f64>) -> Result<(Table, Vec<usize
         errors.truncate(MAX_REPORTED);
         return Err(RecordError::Invalid(errors));
     }
+    if let Some(dt) = interval {
+        if sampling_rate.is_some() {
+            return Err(invalid(
+                "/sampling_rate",
+                "this record gives its interval in its header (`dt=`); give one or the other",
+            ));
+        }
+        return Ok((
+            Table {
+                time: (0..values.len()).map(|k| k as f64 * dt).collect(),
+                values,
+            },
+            lines,
+        ));
+    }
     match (columns, sampling_rate) {
         (Some(2), Some(_)) => Err(invalid(
             "/sampling_rate",
@@ -191,6 +294,28 @@ fn parse_csv(text: &str, sampling_rate: Option<f64>) -> Result<(Table, Vec<usize
             ))
         }
         _ => Ok((Table { time, values }, lines)),
+    }
+}
+
+/// The interval of a `dt=0.005` header line (also `dt,0.005`, `dt: 0.005 s`), `None`
+/// for any other line.
+fn interval_header(content: &str, line: usize) -> Result<Option<f64>, RecordError> {
+    let lower = content.to_ascii_lowercase();
+    let Some(rest) = lower.strip_prefix("dt") else {
+        return Ok(None);
+    };
+    let rest = rest.trim_start();
+    let Some(value) = rest.strip_prefix(['=', ',', ':']) else {
+        return Ok(None);
+    };
+    let value = value.trim();
+    let value = value.strip_suffix('s').unwrap_or(value).trim();
+    match value.parse::<f64>() {
+        Ok(dt) if dt.is_finite() && dt > 0.0 => Ok(Some(dt)),
+        _ => Err(invalid(
+            "/dt",
+            format!("line {line}: the interval `{value}` is not a positive number of seconds"),
+        )),
     }
 }
 
@@ -217,16 +342,18 @@ struct JsonRecord {
     time: Option<Vec<f64>>,
     sampling_rate: Option<f64>,
     acceleration: Vec<f64>,
+    unit: Option<AccelerationUnit>,
 }
 
-fn parse_json(text: &str) -> Result<Table, RecordError> {
+fn parse_json(text: &str) -> Result<(Table, Option<AccelerationUnit>), RecordError> {
     let value: serde_json::Value = serde_json::from_str(text)
         .map_err(|e| RecordError::Malformed(format!("the body is not JSON: {e}")))?;
     let record: JsonRecord = serde_path_to_error::deserialize(&value).map_err(|error| {
         let pointer = crate::pointer::pointer_of(error.path());
         invalid(pointer, error.into_inner().to_string())
     })?;
-    match (record.time, record.sampling_rate) {
+    let unit = record.unit;
+    let table = match (record.time, record.sampling_rate) {
         (Some(_), Some(_)) => Err(invalid(
             "/sampling_rate",
             "give `time` or `sampling_rate`, not both",
@@ -258,7 +385,8 @@ fn parse_json(text: &str) -> Result<Table, RecordError> {
                 values: record.acceleration,
             })
         }
-    }
+    }?;
+    Ok((table, unit))
 }
 
 /// At least two samples; times non-negative and strictly increasing; an Arias intensity
@@ -379,7 +507,7 @@ mod tests {
     use super::*;
 
     fn csv(text: &str, rate: Option<f64>) -> Result<Table, RecordError> {
-        parse(text, RecordFormat::Csv, rate, 1000)
+        parse(text, RecordFormat::Csv, rate, None, 1000)
     }
 
     fn errors(result: Result<Table, RecordError>) -> Vec<FieldError> {
@@ -408,9 +536,12 @@ mod tests {
             Ok(expected.clone())
         );
         let json = r#"{"time": [0, 0.5, 1], "acceleration": [1, -2, 0.25]}"#;
-        assert_eq!(parse(json, RecordFormat::Json, None, 10), Ok(expected.clone()));
+        assert_eq!(
+            parse(json, RecordFormat::Json, None, None, 10),
+            Ok(expected.clone())
+        );
         let json = r#"{"sampling_rate": 2, "acceleration": [1, -2, 0.25]}"#;
-        assert_eq!(parse(json, RecordFormat::Json, None, 10), Ok(expected));
+        assert_eq!(parse(json, RecordFormat::Json, None, None, 10), Ok(expected));
     }
 
     #[test]
@@ -439,6 +570,7 @@ mod tests {
             r#"{"sampling_rate": -5, "acceleration": [1, 2]}"#,
             RecordFormat::Json,
             None,
+            None,
             10,
         ));
         assert_eq!(found[0].pointer, "/sampling_rate");
@@ -447,7 +579,7 @@ mod tests {
     #[test]
     fn too_many_samples_name_the_limit() {
         assert_eq!(
-            parse("0,1\n1,2\n2,3\n", RecordFormat::Csv, None, 2),
+            parse("0,1\n1,2\n2,3\n", RecordFormat::Csv, None, None, 2),
             Err(RecordError::TooLarge { samples: 3, limit: 2 })
         );
     }
@@ -461,6 +593,80 @@ mod tests {
         let text: String = csv_chunks(Arc::new(record.clone()), 3).collect();
         assert_eq!(csv(&text, None), Ok(record.clone()));
         let text: String = json_chunks(Arc::new(record.clone()), 3).collect();
-        assert_eq!(parse(&text, RecordFormat::Json, None, 10), Ok(record));
+        assert_eq!(parse(&text, RecordFormat::Json, None, None, 10), Ok(record));
+    }
+
+    /// A record in g, as an NGA-West2 AT2 file (4 samples on two lines, the values of a
+    /// half cycle), as a one-column text with a `dt=` header and `unit` g, and as JSON
+    /// with `"unit": "g"`: all three are the same record in m/s², 9.80665 × each value.
+    #[test]
+    fn a_record_in_g_is_stored_in_metres_per_second_squared_whatever_its_format() {
+        let g = [0.0, 0.5e-1, -0.25, 0.125e-2];
+        let expected = Table {
+            time: vec![0.0, 0.01, 0.02, 0.03],
+            values: g.iter().map(|a| a * STANDARD_GRAVITY).collect(),
+        };
+        let at2 = "PEER NGA STRONG MOTION DATABASE RECORD\n\
+                   Somewhere, 1/1/2000, Station, 090\n\
+                   ACCELERATION TIME SERIES IN UNITS OF G\n\
+                   NPTS=     4, DT=   .0100 SEC\n\
+                   \x20 .0000000E+00  .5000000E-01 -.2500000E+00\n\
+                   \x20 .1250000E-02\n";
+        let read = parse(at2, RecordFormat::Csv, None, None, 100).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(read.time.len(), 4);
+        for (got, want) in read.values.iter().zip(&expected.values) {
+            assert!((got - want).abs() <= 1e-15 * want.abs(), "{read:?}");
+        }
+        for (got, want) in read.time.iter().zip(&expected.time) {
+            assert!((got - want).abs() < 1e-15, "{read:?}");
+        }
+        // The layout of the older files: count and interval first.
+        let older = at2.replace("NPTS=     4, DT=   .0100 SEC", "    4    0.0100    NPTS, DT");
+        assert_eq!(
+            parse(&older, RecordFormat::Csv, None, None, 100),
+            Ok(read.clone())
+        );
+        let column = "dt=0.01\n0\n0.05\n-0.25\n0.00125\n";
+        let in_g = Some(AccelerationUnit::G);
+        assert_eq!(
+            parse(column, RecordFormat::Csv, None, in_g, 100),
+            Ok(read.clone())
+        );
+        let json = r#"{"sampling_rate": 100, "acceleration": [0, 0.05, -0.25, 0.00125], "unit": "g"}"#;
+        let from_json = parse(json, RecordFormat::Json, None, None, 100).unwrap_or_else(|e| panic!("{e}"));
+        for (got, want) in from_json.values.iter().zip(&read.values) {
+            assert!((got - want).abs() <= 1e-15 * want.abs(), "{from_json:?}");
+        }
+    }
+
+    #[test]
+    fn an_at2_file_that_contradicts_itself_is_refused_at_its_pointer() {
+        let at2 = |count: &str, third: &str, unit: Option<AccelerationUnit>| {
+            let text = format!("PEER\ntitle\n{third}\nNPTS= {count}, DT= .005 SEC\n1.0 2.0\n3.0\n");
+            errors(parse(&text, RecordFormat::Csv, None, unit, 100))
+        };
+        let found = at2("4", "ACCELERATION IN UNITS OF G", None);
+        assert_eq!(found[0].pointer, "/acceleration");
+        assert!(
+            found[0].detail.contains("3 samples") && found[0].detail.contains("NPTS = 4"),
+            "{found:?}"
+        );
+        let found = at2("3", "VELOCITY IN UNITS OF CM/S", None);
+        assert!(
+            found[0].detail.contains("not an acceleration record"),
+            "{found:?}"
+        );
+        let found = at2(
+            "3",
+            "ACCELERATION IN UNITS OF G",
+            Some(AccelerationUnit::MetresPerSecondSquared),
+        );
+        assert_eq!(found[0].pointer, "/unit");
+        let found = at2("x", "ACCELERATION IN UNITS OF G", None);
+        assert_eq!(found[0].pointer, "/dt");
+        let found = errors(parse("dt=-1\n1\n2\n", RecordFormat::Csv, None, None, 100));
+        assert_eq!(found[0].pointer, "/dt");
+        let found = errors(parse("dt=0.1\n1\n2\n", RecordFormat::Csv, Some(10.0), None, 100));
+        assert_eq!(found[0].pointer, "/sampling_rate");
     }
 }

@@ -8,6 +8,7 @@ use crate::physics::loads::{BaseAcceleration, Pulse, Table};
 use crate::processes::FieldError;
 use crate::processes::common_inputs::at;
 use crate::processes::input_schema::NonNegativeNumber;
+use crate::signal_record::AccelerationUnit;
 
 /// Base acceleration a(t) (m/s²), positive toward the right wall (the +x axis of a
 /// hexagonal bundle's direction), starting at t = 0.
@@ -38,8 +39,11 @@ pub enum BaseAccelerationInput {
         /// Sample times (s), at least two, ≥ 0 and strictly increasing.
         #[schema(value_type = Vec<NonNegativeNumber>)]
         time: Vec<f64>,
-        /// Acceleration at each time (m/s²).
+        /// Acceleration at each time, in `unit`.
         acceleration: Vec<f64>,
+        /// The unit of `acceleration`: `m/s2` (the default) or `g` (9.80665 m/s²).
+        #[serde(default)]
+        unit: AccelerationUnit,
     },
     /// amplitude · sin²(π t / duration) during `duration`, then 0 (velocity change
     /// amplitude · duration / 2).
@@ -126,9 +130,13 @@ impl BaseAccelerationInput {
                 frequency: *frequency,
                 cycles: *cycles,
             },
-            Self::Table { time, acceleration } => BaseAcceleration::Table(Table {
+            Self::Table {
+                time,
+                acceleration,
+                unit,
+            } => BaseAcceleration::Table(Table {
                 time: time.clone(),
-                values: acceleration.clone(),
+                values: acceleration.iter().map(|a| a * unit.factor()).collect(),
             }),
             Self::Haversine { amplitude, duration } => BaseAcceleration::Pulse(Pulse::Haversine {
                 amplitude: *amplitude,

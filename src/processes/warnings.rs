@@ -77,6 +77,9 @@ pub enum WarningCode {
     /// The static correction's pseudo-modes make the critical step over 4 times smaller
     /// than the eigenmodes' alone (contacts at many heights).
     CostlyStaticCorrection,
+    /// The run ends before its base (or wall) acceleration does: the rest of the record
+    /// is never applied, and its peaks may come later.
+    ExcitationOutlastsRun,
 }
 
 /// A plausibility note about valid inputs: where (JSON pointer into the request body)
@@ -301,6 +304,10 @@ pub fn assess(subject: &Subject<'_>, steps: f64) -> Vec<Warning> {
         warnings.push(warning);
     }
 
+    if let Some(warning) = excitation_outlasts_run(subject) {
+        warnings.push(warning);
+    }
+
     if steps > MAX_STEPS {
         warnings.push(Warning::new(
             WarningCode::ManySteps,
@@ -313,6 +320,53 @@ pub fn assess(subject: &Subject<'_>, steps: f64) -> Vec<Warning> {
         ));
     }
     warnings
+}
+
+/// A warning when a base or wall acceleration goes on after the run's end (by more than
+/// rounding): the latest of them, with its end. Point forces are left alone: a table
+/// that runs past the end is how a held load is written.
+fn excitation_outlasts_run(subject: &Subject<'_>) -> Option<Warning> {
+    let model = &subject.model;
+    let walls = model.walls.as_ref();
+    let (name, end) = [
+        ("the base acceleration", model.base_acceleration.as_ref()),
+        (
+            "the base acceleration along y",
+            model
+                .plane
+                .as_ref()
+                .and_then(|plane| plane.base_acceleration_y.as_ref()),
+        ),
+        (
+            "the left wall's acceleration",
+            walls.and_then(|w| w.left_x.as_ref()),
+        ),
+        (
+            "the right wall's acceleration",
+            walls.and_then(|w| w.right_x.as_ref()),
+        ),
+        (
+            "the walls' acceleration along y",
+            walls.and_then(|w| w.y.as_ref()),
+        ),
+    ]
+    .into_iter()
+    .filter_map(|(name, signal)| signal.map(|s| (name, s.end())))
+    .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    (end > subject.duration * (1.0 + 1e-9)).then(|| {
+        Warning::new(
+            WarningCode::ExcitationOutlastsRun,
+            "/inputs/solver/duration",
+            format!(
+                "the run ends at {} s, before {name} does ({} s): the last {} of it is never applied, and \
+                 the largest response may come in it; run for {} s",
+                number(subject.duration),
+                number(end),
+                percent(1.0 - subject.duration / end),
+                number(end)
+            ),
+        )
+    })
 }
 
 /// The critical step of the model with its pseudo-modes against its eigenmodes alone:

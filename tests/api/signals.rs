@@ -687,3 +687,49 @@ async fn huge_accelerations_get_their_exact_arias_intensity_or_a_422_stating_the
         "{detail}"
     );
 }
+
+/// A record in g, uploaded as a PEER AT2 file (as `text/plain`, NPTS and DT read from
+/// it) and as one CSV column with `?unit=g` and a `dt=` header: both are stored in
+/// m/s², with the PGA of the sine's amplitude × 9.80665 and its duration (NPTS − 1)·DT;
+/// a unit that contradicts the file is a 422 at `/unit`, an unknown unit a 400.
+#[tokio::test]
+async fn a_record_in_g_as_an_at2_file_or_a_column_is_stored_in_metres_per_second_squared() {
+    let app = spawn_with_bundle().await;
+    let (amplitude_g, frequency, dt, samples) = (0.3, 2.0, 0.01, 401);
+    let values: Vec<f64> = (0..samples)
+        .map(|k| amplitude_g * (TAU * frequency * k as f64 * dt).sin())
+        .collect();
+    let mut at2 = format!(
+        "PEER NGA STRONG MOTION DATABASE RECORD\nTest sine, 1/1/2000, Station, 000\n\
+         ACCELERATION TIME SERIES IN UNITS OF G\nNPTS= {samples:5}, DT=   .0100 SEC\n"
+    );
+    for chunk in values.chunks(5) {
+        let line: Vec<String> = chunk.iter().map(|a| format!("{a:15.7E}")).collect();
+        at2.push_str(&line.join(""));
+        at2.push('\n');
+    }
+    let mut column = String::from("dt=0.01\n");
+    for a in &values {
+        column.push_str(&format!("{a:e}\n"));
+    }
+    for (body, query) in [(at2.clone(), ""), (column, "?unit=g")] {
+        let metadata = app.upload_signal(body, "text/plain", query).await;
+        let number = |name: &str| metadata[name].as_f64().unwrap_or(f64::NAN);
+        assert_eq!(metadata["samples"], samples, "{metadata}");
+        assert!((number("duration") - 4.0).abs() < 1e-12, "{metadata}");
+        // The largest sample, in m/s²; the file's 8 significant digits bound the agreement.
+        let pga = values.iter().fold(0.0_f64, |m, a| m.max(a.abs())) * G;
+        assert!(
+            (number("pga") - pga).abs() < 1e-6 * pga,
+            "{query}: PGA {} m/s², expected {pga}",
+            number("pga")
+        );
+    }
+    let response = app.post_signal(at2, "text/plain", "?unit=m/s2").await;
+    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-signal").await;
+    assert_eq!(problem["errors"][0]["pointer"], "/unit", "{problem}");
+    let response = app
+        .post_signal("acceleration\n1\n2\n", "text/csv", "?sampling_rate=10&unit=ft/s2")
+        .await;
+    assert_eq!(response.status(), StatusCode::BAD_REQUEST);
+}

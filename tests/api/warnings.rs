@@ -491,3 +491,52 @@ async fn a_static_correction_that_shrinks_the_step_is_flagged_with_its_cost() {
         "/inputs/pin/static_correction"
     ));
 }
+
+/// A run shorter than its earthquake record: a warning at `solver/duration` giving the
+/// record's end (the spectrum-compatible record of 12 s, run for 2 s); none once the run
+/// covers it, and none for a point force held past the end (sdnl104c's table).
+#[tokio::test]
+async fn a_run_that_ends_before_its_record_is_flagged_with_the_record_end() {
+    let app = spawn_idle().await;
+    let mut inputs = example("bundle-earthquake.json")["inputs"].clone();
+    let record_end = inputs["excitation"]["base_acceleration"]["duration"]
+        .as_f64()
+        .unwrap();
+    inputs["solver"]["duration"] = json!(record_end / 6.0);
+    let body = accepted(&app, "bundle-dynamics", &inputs).await;
+    let found = warnings(&body);
+    assert!(
+        has(&found, "excitation_outlasts_run", "/inputs/solver/duration"),
+        "{body}"
+    );
+    let message = body["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|w| w["code"] == "excitation_outlasts_run")
+        .unwrap()["message"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    assert!(message.contains(&format!("({record_end} s)")), "{message}");
+    inputs["solver"]["duration"] = json!(record_end);
+    let body = accepted(&app, "bundle-dynamics", &inputs).await;
+    assert!(
+        !has(
+            &warnings(&body),
+            "excitation_outlasts_run",
+            "/inputs/solver/duration"
+        ),
+        "{body}"
+    );
+    let held = example("sdnl104c.json")["inputs"].clone();
+    let body = accepted(&app, &process_of("sdnl104c.json"), &held).await;
+    assert!(
+        !has(
+            &warnings(&body),
+            "excitation_outlasts_run",
+            "/inputs/solver/duration"
+        ),
+        "{body}"
+    );
+}

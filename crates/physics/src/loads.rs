@@ -52,6 +52,19 @@ impl BaseAcceleration {
         }
     }
 
+    /// The time (s) after which the signal is 0 for good: the pulse's duration, the
+    /// sine's last cycle, the table's last sample.
+    pub fn end(&self) -> f64 {
+        match self {
+            BaseAcceleration::HalfSine { duration, .. } => *duration,
+            BaseAcceleration::Sine {
+                frequency, cycles, ..
+            } => cycles / frequency,
+            BaseAcceleration::Table(table) => table.time.last().copied().unwrap_or(0.0),
+            BaseAcceleration::Pulse(pulse) => pulse.duration(),
+        }
+    }
+
     /// The same signal multiplied by `factor` (a component of a signal along a
     /// direction: `factor` = cos θ or sin θ).
     pub fn scaled(&self, factor: f64) -> BaseAcceleration {
@@ -256,6 +269,40 @@ mod tests {
             .map(|i| i.field)
             .collect();
         assert_eq!(fields, ["time/1", "acceleration/1"]);
+    }
+
+    // The end is where each signal is 0 for good: just after it, every kind is 0, and
+    // (but for a sine ending on a zero crossing) not just before.
+    #[test]
+    fn every_signal_is_zero_after_its_end() {
+        let signals = [
+            BaseAcceleration::HalfSine {
+                amplitude: 5.0,
+                duration: 0.01,
+            },
+            BaseAcceleration::Sine {
+                amplitude: 2.0,
+                frequency: 10.0,
+                cycles: 2.25,
+            },
+            BaseAcceleration::Table(Table {
+                time: vec![0.0, 0.5, 1.5],
+                values: vec![0.0, 1.0, 3.0],
+            }),
+            BaseAcceleration::Pulse(Pulse::Trapezoid {
+                amplitude: 1.0,
+                rise: 0.1,
+                plateau: 0.2,
+                fall: 0.1,
+            }),
+        ];
+        let ends = [0.01, 0.225, 1.5, 0.4];
+        for (signal, want) in signals.iter().zip(ends) {
+            let end = signal.end();
+            assert!((end - want).abs() < 1e-15, "{signal:?}: end {end}, want {want}");
+            assert_eq!(signal.at(end * (1.0 + 1e-9)), 0.0, "{signal:?}");
+            assert!(signal.at(end * (1.0 - 1e-3)) != 0.0, "{signal:?}");
+        }
     }
 
     #[test]

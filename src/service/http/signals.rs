@@ -31,7 +31,7 @@ use crate::service::queue::idempotency::{Keyed, KeyedRequest, Kind, RequestHash}
 use crate::service::signals::SignalReadError;
 use crate::service::signals::create::CreateError;
 use crate::service::signals::delete::Deletion;
-use crate::signal_record::{self, RecordError, RecordFormat};
+use crate::signal_record::{self, AccelerationUnit, RecordError, RecordFormat};
 
 /// Rows per chunk of a streamed record.
 const STREAM_ROWS: usize = 4096;
@@ -44,6 +44,10 @@ pub struct UploadQuery {
     /// Samples per second (Hz, positive) of a CSV record of accelerations alone (one
     /// column); times are then k / sampling_rate from 0.
     pub sampling_rate: Option<f64>,
+    /// The unit of a CSV record's accelerations: `m/s2` (default) or `g` (9.80665 m/s²);
+    /// the record is stored in m/s². A PEER AT2 file is in g by its format; a JSON record
+    /// gives its unit as its `unit` member.
+    pub unit: Option<String>,
     /// A label of the signal (repeatable; at most 20, each 1 to 64 characters without
     /// control characters or surrounding spaces): `GET /signals?label=` filters on them.
     #[param(explode = true)]
@@ -56,14 +60,18 @@ pub struct UploadQuery {
 #[derive(Debug, Default)]
 struct Upload {
     sampling_rate: Option<f64>,
+    unit: Option<AccelerationUnit>,
     labels: Vec<String>,
     note: Option<String>,
 }
 
-/// What an idempotency key's request hash covers besides the body (labels and a note
-/// only when given, so that keys stored before them still match).
-fn upload_description(format: RecordFormat, sampling_rate: Option<f64>, annotations: &Annotations) -> String {
-    let mut text = format!("{format:?} sampling_rate={sampling_rate:?}");
+/// What an idempotency key's request hash covers besides the body (a unit, labels and a
+/// note only when given, so that keys stored before them still match).
+fn upload_description(upload: &Upload, format: RecordFormat, annotations: &Annotations) -> String {
+    let mut text = format!("{format:?} sampling_rate={:?}", upload.sampling_rate);
+    if let Some(unit) = upload.unit {
+        text.push_str(&format!(" unit={unit:?}"));
+    }
     if !annotations.labels.is_empty() || annotations.note.is_some() {
         text.push_str(&format!(
             " labels={:?} note={:?}",
@@ -73,7 +81,7 @@ fn upload_description(format: RecordFormat, sampling_rate: Option<f64>, annotati
     text
 }
 
-/// `sampling_rate`, `label` (repeatable) and `note`; anything else is refused.
+/// `sampling_rate`, `unit`, `label` (repeatable) and `note`; anything else is refused.
 fn parse_upload_query(pairs: &[(String, String)]) -> Result<Upload, Problem> {
     let mut upload = Upload::default();
     for (key, value) in pairs {
@@ -83,11 +91,16 @@ fn parse_upload_query(pairs: &[(String, String)]) -> Result<Upload, Problem> {
                     Problem::invalid_query(format!("`sampling_rate`: `{value}` is not a number"))
                 })?)
             }
+            "unit" => {
+                upload.unit = Some(AccelerationUnit::from_name(value).ok_or_else(|| {
+                    Problem::invalid_query(format!("`unit`: `{value}` is not `m/s2` or `g`"))
+                })?)
+            }
             "label" => upload.labels.push(value.clone()),
             "note" => upload.note = Some(value.clone()),
             other => {
                 return Err(Problem::invalid_query(format!(
-                    "unknown query parameter `{other}` (expected sampling_rate, label, note)"
+                    "unknown query parameter `{other}` (expected sampling_rate, unit, label, note)"
                 )));
             }
         }
@@ -125,8 +138,11 @@ fn upload_format(headers: &HeaderMap, text: &str) -> Result<RecordFormat, ApiErr
 /// Upload a signal
 ///
 /// An accelerogram (m/s²) as CSV, `time,acceleration` (s, m/s²; header optional), or the
-/// acceleration alone with `?sampling_rate=`; or as JSON, `{"time": [...],
-/// "acceleration": [...]}` or `{"sampling_rate": 200, "acceleration": [...]}`. Times
+/// acceleration alone with `?sampling_rate=` or after a `dt=0.005` header line; a PEER
+/// AT2 file (NGA databases, in g, its NPTS and DT read from it); or as JSON,
+/// `{"time": [...], "acceleration": [...]}` or `{"sampling_rate": 200, "acceleration":
+/// [...]}`, with an optional `"unit": "g"`. `?unit=g` reads a CSV record in g; every
+/// record is stored in m/s². Times
 /// non-negative and strictly increasing, every value finite, at least 2 samples. Stored
 /// once: `201 Created`, `Location: /signals/{id}` and its metadata; jobs refer to it as
 /// `{"type": "signal", "id": "<id>", "scale": 1.0}`. A bad record is a 422
@@ -195,7 +211,7 @@ pub async fn create(
         kind: Kind::Signal,
         hash: RequestHash::of_bytes(
             Kind::Signal,
-            &upload_description(format, query.sampling_rate, &annotations),
+            &upload_description(&query, format, &annotations),
             &bytes,
         ),
     });
@@ -208,7 +224,7 @@ pub async fn create(
     }
     let max_samples = state.max_signal_samples;
     let parsed = tokio::task::spawn_blocking(move || {
-        signal_record::parse(&text, format, query.sampling_rate, max_samples)
+        signal_record::parse(&text, format, query.sampling_rate, query.unit, max_samples)
     })
     .await
     .map_err(|e| ApiError::Internal(format!("parsing a signal panicked: {e}")))?;

@@ -76,6 +76,9 @@ pub(super) struct Recorder {
     curvatures: Vec<Vec<Vec<f64>>>,
     curvature_envelope: Vec<CurvaturePeak>,
     pin_curvatures: Vec<CurvaturePeak>,
+    /// The height of every mesh node (m), as the decimal it stands for: computed once,
+    /// not at every sample.
+    node_heights: Vec<f64>,
 }
 
 impl Recorder {
@@ -92,6 +95,10 @@ impl Recorder {
         let contacts = recorded.len();
         let counting = &settings.impacts;
         let steps = layout.step.steps(settings.duration);
+        let mesh = layout.model.basis.model();
+        let node_heights: Vec<f64> = (0..=mesh.elements)
+            .map(|node| crate::decimal(node as f64 * mesh.element_length))
+            .collect();
         Self {
             statistics: vec![ContactStatistics::default(); lanes],
             impacts: impacts_by_lane(layout, counting.blocks),
@@ -131,12 +138,14 @@ impl Recorder {
             node_curvatures: vec![0.0; layout.node_curvatures_len()],
             output_curvatures: vec![0.0; layout.output_curvatures_len()],
             curvatures: vec![vec![Vec::new(); lines]; settings.output_heights.len()],
-            curvature_envelope: (0..=layout.model.basis.model().elements)
-                .map(|node| CurvaturePeak {
-                    height: crate::decimal(node as f64 * layout.model.basis.model().element_length),
+            curvature_envelope: node_heights
+                .iter()
+                .map(|&height| CurvaturePeak {
+                    height,
                     ..CurvaturePeak::default()
                 })
                 .collect(),
+            node_heights,
             pin_curvatures: (0..layout.model.pins)
                 .map(|pin| CurvaturePeak {
                     pin,
@@ -293,10 +302,15 @@ impl Recorder {
                 let along = |line: usize| {
                     value(&self.node_curvatures, node, line) + transport(node_transport, node, line)
                 };
-                let curvature = match lines > pins {
-                    true => along(pin).hypot(along(pins + pin)),
-                    false => along(pin).abs(),
+                // Squares compared, one root for a new extreme: no hypot per node and pin.
+                let squared = match lines > pins {
+                    true => along(pin).powi(2) + along(pins + pin).powi(2),
+                    false => along(pin).powi(2),
                 };
+                if squared <= envelope.curvature.powi(2) && squared <= extreme.curvature.powi(2) {
+                    continue;
+                }
+                let curvature = squared.sqrt();
                 if curvature > envelope.curvature {
                     *envelope = CurvaturePeak {
                         curvature,
@@ -325,7 +339,6 @@ impl Recorder {
             q: &state.q,
             out: &mut self.node_deflections,
         });
-        let element_length = layout.model.basis.model().element_length;
         let (lanes, stride, pins) = (layout.lanes, layout.stride, layout.model.pins);
         // The transport by the top support, with walls that move (0 without).
         let transport = |node: usize, line: usize| match (&layout.walls, &state.wall) {
@@ -339,7 +352,7 @@ impl Recorder {
             let w = |line: usize| {
                 self.node_deflections[(block * stride + 1 + line) * lanes + lane] + transport(node, line)
             };
-            let height = crate::decimal(node as f64 * element_length);
+            let height = self.node_heights[node];
             for (p, extreme) in self.pin_extremes.iter_mut().enumerate() {
                 let w = w(p);
                 if w.abs() > extreme.max_abs_deflection {
@@ -352,10 +365,10 @@ impl Recorder {
             }
             // In the plane, each pin's resultant √(wx² + wy²).
             for (p, extreme) in self.resultant_extremes.iter_mut().enumerate() {
-                let w = w(p).hypot(w(pins + p));
-                if w > extreme.max_abs_deflection {
+                let squared = w(p).powi(2) + w(pins + p).powi(2);
+                if squared > extreme.max_abs_deflection.powi(2) {
                     *extreme = PinExtreme {
-                        max_abs_deflection: w,
+                        max_abs_deflection: squared.sqrt(),
                         height,
                         time: t,
                     };
