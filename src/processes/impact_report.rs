@@ -21,8 +21,8 @@ use super::simulation::{HistoryKind, HistoryOutput};
 use crate::physics::impacts::{
     DEFAULT_CLASSES, DEFAULT_MAX_ROWS, Impact, ImpactCounting, ImpactStatistics, ImpactTable, TABLE_COLUMNS,
 };
-use std::collections::HashMap;
 use crate::physics::integrate::Simulation;
+use std::collections::HashMap;
 
 /// Name of the per-impact table output.
 pub const TABLE: &str = "impacts";
@@ -153,7 +153,12 @@ pub fn contact_reports(simulation: &Simulation) -> Vec<ContactImpacts> {
         .map(|(c, (statistics, histogram))| ContactImpacts {
             statistics: statistics.clone(),
             histogram: histogram.clone(),
-            tabulated: simulation.impact_table.contact_tabulated.get(c).copied().unwrap_or(0),
+            tabulated: simulation
+                .impact_table
+                .contact_tabulated
+                .get(c)
+                .copied()
+                .unwrap_or(0),
         })
         .collect()
 }
@@ -433,7 +438,11 @@ pub const HEADER: &str = "impact-table";
 /// `complete, impacts=6, tabulated=6`, or `truncated, impacts=2034117, tabulated=100000`
 /// (counts of the whole table, whatever the filter and the page).
 pub fn header_value(table: &StoredTable) -> String {
-    let state = if table.truncation.is_some() { "truncated" } else { "complete" };
+    let state = if table.truncation.is_some() {
+        "truncated"
+    } else {
+        "complete"
+    };
     format!(
         "{state}, impacts={}, tabulated={}",
         table.impacts(),
@@ -518,7 +527,10 @@ mod tests {
         let stored = read_table(&table_history(&truncated)).expect("a table");
         assert_eq!(stored.rows, truncated.rows);
         let truncation = stored.truncation.as_ref().expect("truncated");
-        assert_eq!((truncation.impacts, truncation.contact(0), truncation.contact(5)), (12, Some((10, 2)), Some((2, 1))));
+        assert_eq!(
+            (truncation.impacts, truncation.contact(0), truncation.contact(5)),
+            (12, Some((10, 2)), Some((2, 1)))
+        );
         assert_eq!(header_value(&stored), "truncated, impacts=12, tabulated=3");
         // A page of contact 5 alone still gives the whole table's counts.
         let csv = table_csv(&stored, stored.rows.iter().filter(|r| r.contact == 5));

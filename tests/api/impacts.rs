@@ -197,7 +197,7 @@ async fn bad_counting_settings_are_refused_at_their_pointers() {
             "{process}: {problem}"
         );
         assert!(
-            problem["errors"][0]["reason"]
+            problem["errors"][0]["detail"]
                 .as_str()
                 .is_some_and(|r| r.contains("at least 1")),
             "{problem}"
@@ -288,13 +288,23 @@ async fn a_capped_table_keeps_each_contacts_largest_impacts_and_says_truncated()
     assert_eq!(summary["truncated"], false, "{summary}");
     assert_eq!(summary["untabulated_max_peak"], Value::Null);
     let (header, every) = get_text(&app, &format!("/jobs/{complete_id}/results/impacts?format=csv")).await;
-    assert_eq!(header, format!("complete, impacts={impacts}, tabulated={impacts}"));
+    assert_eq!(
+        header,
+        format!("complete, impacts={impacts}, tabulated={impacts}")
+    );
     let (columns, every) = records(&every);
-    assert_eq!(columns.len(), 10, "a complete table has its ten columns: {columns:?}");
+    assert_eq!(
+        columns.len(),
+        10,
+        "a complete table has its ten columns: {columns:?}"
+    );
     assert_eq!(every.len() as u64, impacts);
 
     let max_rows = impacts / 3;
-    assert!(max_rows >= 2 * contacts, "the case must impact often: {impacts} impacts");
+    assert!(
+        max_rows >= 2 * contacts,
+        "the case must impact often: {impacts} impacts"
+    );
     body["inputs"]["output"] = json!({"impacts": {"max_rows": max_rows}});
     let (id, capped) = run(&app, "bundle-dynamics", &body).await;
     let summary = &capped["impact_summary"];
@@ -306,11 +316,20 @@ async fn a_capped_table_keeps_each_contacts_largest_impacts_and_says_truncated()
     assert_eq!(summary["fair_share"].as_u64(), Some(max_rows / contacts));
 
     let (header, csv) = get_text(&app, &format!("/jobs/{id}/results/impacts?format=csv")).await;
-    assert_eq!(header, format!("truncated, impacts={impacts}, tabulated={max_rows}"));
+    assert_eq!(
+        header,
+        format!("truncated, impacts={impacts}, tabulated={max_rows}")
+    );
     let (columns, kept) = records(&csv);
     assert_eq!(
         columns[10..],
-        ["truncated", "impacts", "tabulated", "contact_impacts", "contact_tabulated"]
+        [
+            "truncated",
+            "impacts",
+            "tabulated",
+            "contact_impacts",
+            "contact_tabulated"
+        ]
     );
     assert_eq!(kept.len() as u64, max_rows);
     let cell = |row: &Vec<String>, name: &str| row[columns.iter().position(|c| c == name).unwrap()].clone();
@@ -319,7 +338,10 @@ async fn a_capped_table_keeps_each_contacts_largest_impacts_and_says_truncated()
     let starts: Vec<f64> = kept.iter().map(|r| cell(r, "start").parse().unwrap()).collect();
     assert!(starts.windows(2).all(|w| w[0] <= w[1]));
     for row in &kept {
-        assert!(every.contains(&row[..10].to_vec()), "{row:?} is not a row of the complete table");
+        assert!(
+            every.contains(&row[..10].to_vec()),
+            "{row:?} is not a row of the complete table"
+        );
     }
     let mut left_out_peak = f64::NEG_INFINITY;
     let stated: u64 = capped["contacts"]
@@ -330,12 +352,21 @@ async fn a_capped_table_keeps_each_contacts_largest_impacts_and_says_truncated()
         .sum();
     assert_eq!(stated, max_rows);
     for (k, contact) in capped["contacts"].as_array().unwrap().iter().enumerate() {
-        let mine: Vec<&Vec<String>> = kept.iter().filter(|r| cell(r, "contact") == k.to_string()).collect();
+        let mine: Vec<&Vec<String>> = kept
+            .iter()
+            .filter(|r| cell(r, "contact") == k.to_string())
+            .collect();
         let all: Vec<&Vec<String>> = every.iter().filter(|r| r[0] == k.to_string()).collect();
         let counted = contact["impacts"].as_u64().unwrap();
         assert_eq!(all.len() as u64, counted, "contact {k}");
-        assert_eq!(contact["impact_statistics"]["tabulated"].as_u64(), Some(mine.len() as u64));
-        assert!(mine.len() as u64 >= counted.min(max_rows / contacts), "contact {k}: its fair share");
+        assert_eq!(
+            contact["impact_statistics"]["tabulated"].as_u64(),
+            Some(mine.len() as u64)
+        );
+        assert!(
+            mine.len() as u64 >= counted.min(max_rows / contacts),
+            "contact {k}: its fair share"
+        );
         for row in &mine {
             assert_eq!(cell(row, "truncated"), "true");
             assert_eq!(cell(row, "impacts"), impacts.to_string());
@@ -351,11 +382,17 @@ async fn a_capped_table_keeps_each_contacts_largest_impacts_and_says_truncated()
             .map(|r| force(r))
             .collect();
         let largest_dropped = dropped.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        assert!(largest_dropped <= smallest_kept, "contact {k}: dropped {largest_dropped} N, kept {smallest_kept} N");
+        assert!(
+            largest_dropped <= smallest_kept,
+            "contact {k}: dropped {largest_dropped} N, kept {smallest_kept} N"
+        );
         left_out_peak = left_out_peak.max(largest_dropped);
         if counted > 0 {
             let max_force = contact["max_force"].as_f64().unwrap();
-            assert!(mine.iter().any(|r| force(r) == max_force), "contact {k}: {max_force} N not kept");
+            assert!(
+                mine.iter().any(|r| force(r) == max_force),
+                "contact {k}: {max_force} N not kept"
+            );
         }
     }
     assert_eq!(summary["untabulated_max_peak"].as_f64(), Some(left_out_peak));
@@ -366,7 +403,9 @@ async fn a_capped_table_keeps_each_contacts_largest_impacts_and_says_truncated()
     assert_eq!(kept.iter().map(force).fold(0.0, f64::max), run_peak);
 
     // JSON pages and a filter give the whole table's counts, in the header too.
-    let page = app.get(&format!("/jobs/{id}/results/impacts?contact=0&limit=2")).await;
+    let page = app
+        .get(&format!("/jobs/{id}/results/impacts?contact=0&limit=2"))
+        .await;
     assert_eq!(
         page.headers()["impact-table"],
         format!("truncated, impacts={impacts}, tabulated={max_rows}").as_str()
@@ -375,7 +414,9 @@ async fn a_capped_table_keeps_each_contacts_largest_impacts_and_says_truncated()
     assert_eq!(page["truncated"], true);
     assert_eq!(page["impacts"].as_u64(), Some(impacts));
     assert_eq!(page["tabulated"].as_u64(), Some(max_rows));
-    let complete_page = app.get_json(&format!("/jobs/{complete_id}/results/impacts?limit=1")).await;
+    let complete_page = app
+        .get_json(&format!("/jobs/{complete_id}/results/impacts?limit=1"))
+        .await;
     assert_eq!(complete_page["truncated"], false);
     assert_eq!(complete_page["impacts"].as_u64(), Some(impacts));
 }

@@ -89,7 +89,8 @@ where
                 .ok_or_else(|| Problem::no_such_output(job_id, output))?;
             let permit = state.response_memory.admit(working_bytes(&stored))?;
             let (rendered, extra) = tokio::task::spawn_blocking(move || {
-                render(&stored, &outcome).map(|(body, extra)| -> (Rendered, HeaderMap) { (body.into(), extra) })
+                render(&stored, &outcome)
+                    .map(|(body, extra)| -> (Rendered, HeaderMap) { (body.into(), extra) })
             })
             .await
             .map_err(|e| ApiError::Internal(format!("{work} panicked: {e}")))??;
