@@ -207,8 +207,8 @@ fn write_histories(dir: &Path, output: &RunOutput) -> Result<(), String> {
     for history in &output.histories {
         let path = dir.join(format!("{}.csv", history.name));
         // The per-impact table in its own columns; every other output is a time history.
-        let text = match impact_report::rows_of(history).filter(|_| history.name == impact_report::TABLE) {
-            Some(rows) => impact_report::table_csv(&rows),
+        let text = match impact_report::read_table(history).filter(|_| history.name == impact_report::TABLE) {
+            Some(table) => impact_report::table_csv(&table, &table.rows),
             None => history.to_csv(),
         };
         std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;

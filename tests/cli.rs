@@ -438,3 +438,69 @@ fn the_shipped_record_example_runs() {
         .fold(0.0, f64::max);
     assert!((peak - 3.0).abs() < 1e-5, "PGA {peak}");
 }
+
+/// Issue 33: the cantilever bounces a few times in 0.3 s; with fewer rows than impacts,
+/// `impacts.csv` holds the largest ones and says `truncated` with the counts on every
+/// row, as the results do.
+#[test]
+fn a_capped_impacts_csv_keeps_the_largest_and_says_truncated() {
+    let out = std::env::temp_dir().join(format!("chocmodal-cli-capped-{}", std::process::id()));
+    let mut body: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(example()).unwrap()).unwrap();
+    body["inputs"]["solver"]["duration"] = serde_json::json!(0.3);
+    body["inputs"]["output"] = serde_json::json!({"impacts": {"max_rows": 2}});
+    let mut child = chocmodal()
+        .args(["run", "cantilever-impact", "-", "--out"])
+        .arg(&out)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(body.to_string().as_bytes())
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    assert!(
+        output.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let document: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let summary = &document["numerical"]["impact_summary"];
+    let impacts = summary["impacts"].as_u64().unwrap();
+    assert!(impacts > 2, "the case must bounce more than twice: {summary}");
+    assert_eq!(
+        (summary["truncated"].as_bool(), summary["tabulated"].as_u64()),
+        (Some(true), Some(2))
+    );
+    let csv = std::fs::read_to_string(out.join("impacts.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .ends_with(",energy,truncated,impacts,tabulated,contact_impacts,contact_tabulated")
+    );
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 2);
+    for row in &rows {
+        assert!(row.ends_with(&format!(",true,{impacts},2,{impacts},2")), "{row}");
+    }
+    // The run's largest force is in the table.
+    let peak = document["numerical"]["max_contact_force"].as_f64().unwrap();
+    let forces: Vec<f64> = rows
+        .iter()
+        .map(|r| r.split(',').nth(3).unwrap().parse().unwrap())
+        .collect();
+    assert!(forces.contains(&peak), "{peak} N not in {forces:?}");
+    assert!(
+        forces
+            .iter()
+            .all(|&f| f >= summary["untabulated_max_peak"].as_f64().unwrap())
+    );
+    std::fs::remove_dir_all(&out).ok();
+}

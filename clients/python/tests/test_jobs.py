@@ -252,6 +252,37 @@ def test_the_impact_table_holds_every_impact_of_every_contact(bundle: chocmodal.
     assert len(only) == contacts.loc[1, "impacts"]
 
 
+def test_a_truncated_impact_table_warns_and_holds_each_contacts_largest(client: chocmodal.Client, bundle: chocmodal.Job) -> None:
+    """The same bundle with fewer rows than impacts: the client warns with the counts,
+    and each contact's rows are its largest impacts of the complete table."""
+    complete = bundle.impacts()
+    assert complete.attrs["truncated"] is False
+    assert complete.attrs["impacts"] == complete.attrs["tabulated"] == len(complete)
+    inputs = bundle_inputs()
+    contacts = len(inputs["contacts"])
+    max_rows = len(complete) // 2
+    assert max_rows > contacts, "the bundle must impact often enough"
+    inputs["output"] = {**inputs.get("output", {}), "impacts": {"max_rows": max_rows}}
+    job = client.submit("bundle-dynamics", inputs)
+    with pytest.warns(chocmodal.QualityWarning):
+        job.wait(progress=False, timeout=120)
+    summary = job.results()["impact_summary"]
+    assert summary["truncated"] is True
+    assert (summary["tabulated"], summary["untabulated"]) == (max_rows, len(complete) - max_rows)
+    with pytest.warns(chocmodal.TruncatedTableWarning) as caught:
+        capped = job.impacts()
+    assert (caught[0].message.impacts, caught[0].message.tabulated) == (len(complete), max_rows)
+    assert capped.attrs["truncated"] is True and len(capped) == max_rows
+    for k, rows in capped.groupby("contact"):
+        largest = complete[complete["contact"] == k]["peak_force"].nlargest(len(rows))
+        assert sorted(rows["peak_force"]) == sorted(largest), f"contact {k}"
+    assert capped["peak_force"].max() == complete["peak_force"].max()
+    # The CSV says it too, with pandas' defaults.
+    csv = pd.read_csv(job.url("/results/impacts?format=csv"))
+    assert csv["truncated"].all() and (csv["impacts"] == len(complete)).all()
+    assert (csv["tabulated"] == max_rows).all()
+
+
 def test_reading_the_impact_table_in_small_pages_gives_the_same_rows(bundle: chocmodal.Job) -> None:
     whole = bundle.impacts()
     paged = bundle.impacts(page_size=7)

@@ -17,8 +17,15 @@
 //! and `rebounds` counts the returns above the threshold after the first within one
 //! impact (code_aster's `NB_REBON_CHOC` counts every return below it, first included,
 //! so it is our rebounds + 1 per impact).
+//!
+//! The per-impact table holds every impact up to `max_rows`; past that it keeps the
+//! largest by peak force with a fair share per contact, and counts what it left out
+//! (`table.rs`, where the rule is stated).
 
 use crate::InputIssue;
+
+pub(crate) mod table;
+pub use table::{ImpactTable, TableKeeper, fair_share};
 
 /// Default [`ImpactCounting::classes`].
 pub const DEFAULT_CLASSES: usize = 10;
@@ -48,8 +55,9 @@ pub struct ImpactCounting {
     pub blocks: usize,
     /// Classes of the peak-force histograms (1…[`MAX_CLASSES`]).
     pub classes: usize,
-    /// Rows of the per-impact table kept (the first impacts to end); the statistics
-    /// cover every impact regardless.
+    /// Rows of the per-impact table (≥ 1): every impact while they number at most this,
+    /// else the largest by peak force with a fair share per contact ([`TableKeeper`]);
+    /// the statistics cover every impact regardless.
     pub max_rows: usize,
 }
 
@@ -81,6 +89,12 @@ impl ImpactCounting {
             issues.push(InputIssue::new(
                 "classes",
                 format!("must be between 1 and {MAX_CLASSES} (got {})", self.classes),
+            ));
+        }
+        if self.max_rows == 0 {
+            issues.push(InputIssue::new(
+                "max_rows",
+                "must be at least 1: the table always holds the run's largest impact".to_owned(),
             ));
         }
         issues
@@ -255,12 +269,8 @@ struct Running {
 /// The per-impact table and the peak forces of a run, shared by its contacts.
 #[derive(Debug, Clone, Default)]
 pub struct ImpactLog {
-    max_rows: usize,
     classes: usize,
-    /// Rows in the order the impacts ended.
-    rows: Vec<Impact>,
-    /// Impacts that ended and were not tabulated.
-    untabulated: u64,
+    table: TableKeeper,
     /// Per contact, the peak force of each impact (for the histograms).
     peaks: Vec<Vec<f64>>,
     kept_peaks: usize,
@@ -281,11 +291,7 @@ impl ImpactSink for Vec<Impact> {
 
 impl ImpactSink for ImpactLog {
     fn push(&mut self, impact: Impact) {
-        if self.rows.len() < self.max_rows {
-            self.rows.push(impact);
-        } else {
-            self.untabulated += 1;
-        }
+        self.table.push(impact);
         if self.kept_peaks < MAX_HISTOGRAM_IMPACTS {
             self.peaks[impact.contact].push(impact.peak_force);
             self.kept_peaks += 1;
@@ -297,21 +303,17 @@ impl ImpactLog {
     /// For `contacts` contacts, as `counting` says (rows kept, histogram classes).
     pub fn new(contacts: usize, counting: &ImpactCounting) -> Self {
         Self {
-            max_rows: counting.max_rows,
             classes: counting.classes.max(1),
-            rows: Vec::new(),
-            untabulated: 0,
+            table: TableKeeper::new(contacts, counting.max_rows),
             peaks: vec![Vec::new(); contacts],
             kept_peaks: 0,
         }
     }
 
-    /// The table sorted by start time (then contact), the number of impacts left out,
-    /// and the peak-force histograms in `classes` equal classes from 0 to the largest
-    /// peak of the run.
-    pub fn finish(mut self) -> (ImpactTable, ImpactHistogram) {
-        self.rows
-            .sort_by(|a, b| a.start.total_cmp(&b.start).then(a.contact.cmp(&b.contact)));
+    /// The table sorted by start time (then contact) with what it left out, and the
+    /// peak-force histograms in `classes` equal classes from 0 to the largest peak of
+    /// the run.
+    pub fn finish(self) -> (ImpactTable, ImpactHistogram) {
         let classes = self.classes;
         let top = self.peaks.iter().flatten().fold(0.0_f64, |m, &f| m.max(f));
         let edges: Vec<f64> = (0..=classes)
@@ -342,10 +344,7 @@ impl ImpactLog {
             }
         }
         (
-            ImpactTable {
-                rows: self.rows,
-                untabulated: self.untabulated,
-            },
+            self.table.finish(),
             ImpactHistogram {
                 edges,
                 counts: total,
@@ -354,15 +353,6 @@ impl ImpactLog {
             },
         )
     }
-}
-
-/// The per-impact table of a run.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct ImpactTable {
-    /// Sorted by start time, then contact.
-    pub rows: Vec<Impact>,
-    /// Impacts beyond `max_rows`, not tabulated (the statistics count them).
-    pub untabulated: u64,
 }
 
 /// Histograms of the impacts' peak forces, with the same classes for every contact.

@@ -228,16 +228,28 @@ fn histograms_share_their_classes_and_count_every_impact() {
     assert_eq!(histogram.impacts, 10);
 }
 
+/// Seven pulses of rising force on one contact and three rows: the three largest are
+/// kept (the last three, sorted by start), the four others counted as left out.
 #[test]
-fn rows_beyond_the_limit_are_counted_not_tabulated() {
-    let forces = pulses(5.0, 2, 2, 7, 0);
+fn rows_beyond_the_limit_keep_the_largest_and_count_the_rest() {
+    let mut forces = Vec::new();
+    for k in 1..=7 {
+        forces.extend([k as f64, k as f64, 0.0, 0.0]);
+    }
     let counting = ImpactCounting {
         max_rows: 3,
         ..ImpactCounting::default()
     };
     let (statistics, table, histogram) = feed(&counting, &forces);
     assert_eq!(statistics.summary.impacts, 7);
-    assert_eq!((table.rows.len(), table.untabulated), (3, 4));
+    assert_eq!((table.rows.len(), table.untabulated, table.impacts), (3, 4, 7));
+    let kept: Vec<f64> = table.rows.iter().map(|r| r.peak_force).collect();
+    assert_eq!(kept, [5.0, 6.0, 7.0]);
+    assert_eq!(table.untabulated_max_peak, Some(4.0));
+    assert_eq!(
+        (table.contact_impacts.clone(), table.contact_tabulated.clone()),
+        (vec![7], vec![3])
+    );
     assert_eq!(histogram.impacts, 7);
 }
 
@@ -272,7 +284,10 @@ fn bad_settings_are_named() {
         max_rows: 0,
     };
     let fields: Vec<String> = counting.validate().into_iter().map(|i| i.field).collect();
-    assert_eq!(fields, ["force_threshold", "rest_time", "blocks", "classes"]);
+    assert_eq!(
+        fields,
+        ["force_threshold", "rest_time", "blocks", "classes", "max_rows"]
+    );
     let too_many = ImpactCounting {
         classes: MAX_CLASSES + 1,
         ..ImpactCounting::default()

@@ -320,7 +320,9 @@ fn the_impact_table_adds_up_to_every_contacts_impulse() {
     let output = run(&inputs());
     let doc = &output.document;
     let table = output.histories.last().expect("the impacts table");
-    let rows = crate::processes::impact_report::rows_of(table).expect("a table");
+    let rows = crate::processes::impact_report::read_table(table)
+        .expect("a table")
+        .rows;
     let contacts = contacts(doc);
     let mut total = 0;
     for (k, contact) in contacts.iter().enumerate() {

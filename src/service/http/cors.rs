@@ -83,11 +83,13 @@ const REQUEST_HEADERS: [HeaderName; 4] = [
 
 /// Response headers the API sets that a client reads: the new job's address, the
 /// validator of cacheable results, the back-off of a 429/503, the auth challenge.
-const EXPOSED_HEADERS: [HeaderName; 4] = [
+const EXPOSED_HEADERS: [HeaderName; 5] = [
     header::LOCATION,
     header::ETAG,
     header::RETRY_AFTER,
     header::WWW_AUTHENTICATE,
+    // Whether the per-impact table served is complete or truncated.
+    HeaderName::from_static(crate::processes::impact_report::HEADER),
 ];
 
 /// How long a browser may cache a preflight's answer.

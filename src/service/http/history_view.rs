@@ -57,6 +57,28 @@ where
     F: FnOnce(&StoredHistory, &JobOutcome) -> Result<R, ApiError> + Send + 'static,
     R: Into<Rendered>,
 {
+    let render = move |stored: &StoredHistory, outcome: &JobOutcome| {
+        render(stored, outcome).map(|body| (body, HeaderMap::new()))
+    };
+    respond_with_headers(state, tenant, job_id, output, headers, format, work, render).await
+}
+
+/// [`respond`], with headers that `render` adds to the response (on a 304 too: they
+/// describe the representation, as its tag does).
+pub(super) async fn respond_with_headers<F, R>(
+    state: &AppState,
+    tenant: &Tenant,
+    job_id: &str,
+    output: &str,
+    headers: &HeaderMap,
+    format: Format,
+    work: &'static str,
+    render: F,
+) -> Result<Response, ApiError>
+where
+    F: FnOnce(&StoredHistory, &JobOutcome) -> Result<(R, HeaderMap), ApiError> + Send + 'static,
+    R: Into<Rendered>,
+{
     with_retry_after(
         async {
             let outcome = successful(job_id, state.queue.outcome(tenant.as_str(), job_id).await?)?;
@@ -66,8 +88,9 @@ where
                 .await?
                 .ok_or_else(|| Problem::no_such_output(job_id, output))?;
             let permit = state.response_memory.admit(working_bytes(&stored))?;
-            let rendered = tokio::task::spawn_blocking(move || {
-                render(&stored, &outcome).map(|body| -> Rendered { body.into() })
+            let (rendered, extra) = tokio::task::spawn_blocking(move || {
+                render(&stored, &outcome)
+                    .map(|(body, extra)| -> (Rendered, HeaderMap) { (body.into(), extra) })
             })
             .await
             .map_err(|e| ApiError::Internal(format!("{work} panicked: {e}")))??;
@@ -75,7 +98,7 @@ where
                 Rendered::Bytes(bytes) => (entity_tag(&bytes), Either::Bytes(bytes)),
                 Rendered::Stream { etag, write } => (etag, Either::Stream(write)),
             };
-            let mut response_headers = HeaderMap::new();
+            let mut response_headers = extra;
             response_headers.insert(header::ETAG, etag.clone());
             response_headers.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
             if if_none_match(headers, &etag) {

@@ -16,7 +16,14 @@ from ._version import __version__
 from ._xarray import history_to_xarray
 from .callbacks import SIGNATURE_HEADER, verify_signature
 from .client import Client
-from .errors import ChocmodalConnectionError, ChocmodalError, FieldError, ProblemDocument, QualityWarning
+from .errors import (
+    ChocmodalConnectionError,
+    ChocmodalError,
+    FieldError,
+    ProblemDocument,
+    QualityWarning,
+    TruncatedTableWarning,
+)
 from .jobs import Job
 from .signals import Signal
 from .sweeps import Sweep
@@ -33,6 +40,7 @@ __all__ = [
     "ProblemDocument",
     "FieldError",
     "QualityWarning",
+    "TruncatedTableWarning",
     "axes",
     "history_to_xarray",
     "verify_signature",

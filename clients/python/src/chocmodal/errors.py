@@ -156,3 +156,19 @@ class QualityWarning(UserWarning):
     def of(cls, job_id: str, verdict: str, reasons: "list[str]") -> "QualityWarning":
         why = "; ".join(reasons) if reasons else "no reason given"
         return cls(f"job {job_id}: quality {verdict}: {why}", job_id=job_id, verdict=verdict, reasons=tuple(reasons))
+
+
+class TruncatedTableWarning(UserWarning):
+    """A per-impact table read whole holds fewer rows than the run had impacts.
+
+    Past ``output.impacts.max_rows`` the service keeps the largest impacts by peak force,
+    each contact's fair share first (docs/impacts.md); raised with :func:`warnings.warn`
+    by :meth:`chocmodal.Job.impacts` with the run's ``impacts`` and the table's
+    ``tabulated`` rows.
+    """
+
+    def __init__(self, message: str, *, job_id: str = "", impacts: int = 0, tabulated: int = 0):
+        super().__init__(message)
+        self.job_id = job_id
+        self.impacts = impacts
+        self.tabulated = tabulated

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any, Optional, Union
 import pandas as pd
 
 from . import frames
-from .errors import ChocmodalError, QualityWarning
+from .errors import ChocmodalError, QualityWarning, TruncatedTableWarning
 from .progress import Poller, progress_bar
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -207,11 +207,18 @@ class Job:
         """The per-impact table (``/jobs/{jobId}/results/impacts``), one row per impact
         sorted by start time: ``contact, start, peak_time, peak_force, impulse,
         duration, approach_velocity, rebounds, dissipated, energy``. Every page is
-        read (``total_rows``, ``next``); ``contact`` filters."""
+        read (``total_rows``, ``next``); ``contact`` filters.
+
+        ``attrs`` holds ``truncated``, the run's ``impacts`` and the whole table's
+        ``tabulated`` rows. A truncated table (past ``output.impacts.max_rows``) holds
+        the largest impacts by peak force, each contact's fair share first: reading one
+        issues a :class:`TruncatedTableWarning`."""
         rows: list[dict[str, Any]] = []
         params: dict[str, Any] = {"format": "json", "limit": page_size, "offset": 0, "contact": contact}
         if isinstance(contact, int):
             params["contact"] = str(contact)
+        elif isinstance(contact, list):
+            params["contact"] = ",".join(str(c) for c in contact)
         while True:
             page = self._client._transport.get_json(f"/jobs/{self.id}/results/impacts", params=params)
             rows.extend(page.get("rows") or [])
@@ -220,6 +227,22 @@ class Job:
             params["offset"] = int(page.get("offset", 0)) + len(page["rows"])
         frame = frames.impacts_frame(rows)
         frame.attrs["job"] = self.id
+        truncated = bool(page.get("truncated", False))
+        frame.attrs["truncated"] = truncated
+        frame.attrs["impacts"] = int(page.get("impacts", len(rows)))
+        frame.attrs["tabulated"] = int(page.get("tabulated", len(rows)))
+        if truncated:
+            impacts, tabulated = frame.attrs["impacts"], frame.attrs["tabulated"]
+            warnings.warn(
+                TruncatedTableWarning(
+                    f"job {self.id}: the impact table holds {tabulated} of {impacts} impacts, "
+                    "the largest by peak force (each contact's fair share first)",
+                    job_id=self.id,
+                    impacts=impacts,
+                    tabulated=tabulated,
+                ),
+                stacklevel=2,
+            )
         return frame
 
     def contacts(self) -> pd.DataFrame:

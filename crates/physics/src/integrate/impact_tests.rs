@@ -1,7 +1,8 @@
 //! Impacts counted in full runs: the single-mode wall impact against its closed form
 //! (duration, peak force, impulse, approach velocity and energy), rebounds merged by a
 //! rest time, and on a damped shaken row the per-impact table against the per-contact
-//! totals and the energy balance.
+//! totals and the energy balance, and capped to fewer rows than impacts, the largest of
+//! them by the table's rule.
 
 use std::f64::consts::PI;
 
@@ -244,4 +245,67 @@ fn the_contact_statistics_are_the_step_forces_with_or_without_a_threshold() {
             "the case must exercise contacts: {closed} closed steps"
         );
     }
+}
+
+/// The damped shaken row run twice, its table complete and capped at a third of its
+/// impacts: the statistics are the same, the capped table holds exactly the rows the
+/// rule picks from the complete one (each contact's fair share of its largest, then the
+/// largest of the rest), the run's peak among them, and its counts add up to the
+/// statistics' impact count.
+#[test]
+fn a_capped_table_keeps_the_largest_impacts_of_the_complete_one() {
+    let basis = basis(20, 8);
+    let model = shaken_two_pin_row(&basis);
+    let with_rows = |max_rows| {
+        run(
+            &model,
+            &Settings {
+                output_interval: Some(1e-4),
+                impacts: ImpactCounting {
+                    max_rows,
+                    ..ImpactCounting::default()
+                },
+                ..settings(Scheme::CentralDifference, 2e-6, 0.1)
+            },
+        )
+    };
+    let complete = with_rows(crate::impacts::DEFAULT_MAX_ROWS);
+    let every = &complete.impact_table.rows;
+    assert!(!complete.impact_table.truncated());
+    let contacts = model.contacts.len();
+    let cap = every.len() / 3;
+    assert!(
+        cap > contacts,
+        "the case must leave rows beyond the fair shares: {cap} rows"
+    );
+    let capped = with_rows(cap);
+    assert_eq!(capped.impact_statistics, complete.impact_statistics);
+    let table = &capped.impact_table;
+    assert!(table.truncated());
+    assert_eq!(
+        table.rows,
+        crate::impacts::table::tests::plain_rule(every, contacts, cap),
+        "the capped table is not the rule applied to the complete one"
+    );
+    let counted: u64 = capped.contact_statistics.iter().map(|s| s.impacts).sum();
+    assert_eq!(table.impacts, counted);
+    assert_eq!(table.rows.len() as u64 + table.untabulated, counted);
+    for (c, stats) in capped.contact_statistics.iter().enumerate() {
+        assert_eq!(table.contact_impacts[c], stats.impacts, "contact {c}");
+        assert!(
+            table
+                .rows
+                .iter()
+                .any(|r| r.contact == c && r.peak_force == stats.max_force),
+            "contact {c}: its largest force {} N is not in the table",
+            stats.max_force
+        );
+    }
+    let run_peak = capped
+        .contact_statistics
+        .iter()
+        .map(|s| s.max_force)
+        .fold(0.0, f64::max);
+    let table_peak = table.rows.iter().map(|r| r.peak_force).fold(0.0, f64::max);
+    assert_eq!(table_peak, run_peak);
 }

@@ -122,7 +122,8 @@ pub struct Simulation {
     /// Per contact: its impacts as `Settings::impacts` counts them, over the run and its
     /// blocks (`contact_statistics[c].impacts` is the same count).
     pub impact_statistics: Vec<ImpactStatistics>,
-    /// The per-impact table (its first `max_rows` rows) and the peak-force histograms.
+    /// The per-impact table (every impact, or past `max_rows` the largest with a fair share
+    /// per contact: [`crate::impacts::TableKeeper`]) and the peak-force histograms.
     pub impact_table: ImpactTable,
     pub impact_histogram: ImpactHistogram,
     /// Per line (r as in `deflections`).

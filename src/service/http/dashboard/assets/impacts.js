@@ -43,7 +43,9 @@ export function impactsCard(results, summary, describe) {
       ['counting', `force threshold ${withUnit(summary.force_threshold, 'N')}, rest time ` +
         `${withUnit(summary.rest_time, 's')}, ${summary.blocks} block${summary.blocks === 1 ? '' : 's'}`],
       ['impacts', `${fmt(summary.impacts)} (${fmt(summary.tabulated)} in the table` +
-        (summary.untabulated ? `, ${fmt(summary.untabulated)} left out by max_rows)` : ')')],
+        (summary.truncated ? `, truncated at max_rows ${fmt(summary.max_rows)}: the largest by peak force, ` +
+          `${fmt(summary.fair_share)} per contact first; ${fmt(summary.untabulated)} left out, none above ` +
+          `${withUnit(summary.untabulated_max_peak, 'N')})` : ', complete)')],
       ['largest impact energy, duration', `${withUnit(summary.max_impact_energy, 'J')}, ` +
         `${withUnit(summary.max_duration, 's')}`],
     ]),
@@ -85,7 +87,9 @@ export function contactImpacts(id, k, contact) {
         h('tbody', {}, page.rows.map((r) => h('tr', {'data-impact': ''},
           [r.start, r.peak_force, r.peak_time, r.impulse, r.duration, r.approach_velocity, r.rebounds, r.dissipated,
             r.energy].map((v) => h('td', {}, fmt(v, 4))))))) : h('p', {class: 'muted'}, 'No impact in the table.'),
-      h('p', {class: 'muted'}, `rows ${offset + 1}–${offset + page.rows.length} of ${page.total_rows} `,
+      h('p', {class: 'muted'}, `rows ${offset + 1}–${offset + page.rows.length} of ${page.total_rows}` +
+        (page.truncated ? ` (the table is truncated: these are the contact's ${fmt(s.tabulated)} largest of ` +
+          `${fmt(s.impacts)} impacts) ` : ' '),
         h('a', {href: `/jobs/${id}/results/impacts?format=csv&contact=${k}`, download: `impacts-c${k}.csv`},
           'CSV'), ' ', more));
     } catch (error) {
