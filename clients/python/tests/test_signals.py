@@ -161,3 +161,25 @@ def test_a_signal_a_queued_or_running_job_refers_to_cannot_be_deleted(client: ch
     finally:
         job.dismiss()
     signal.delete()
+
+
+def test_a_record_in_g_from_an_at2_file_or_an_array_is_stored_in_metres_per_second_squared(
+    client: chocmodal.Client, tmp_path: Path
+) -> None:
+    # The sine in g, as a PEER AT2 file (NGA-West2 layout, 5 values to a line) and as an
+    # array with unit="g": both come back in m/s², the PGA the amplitude.
+    _, acceleration = sine()
+    in_g = acceleration / G
+    lines = ["PEER NGA STRONG MOTION DATABASE RECORD", "Test sine, 1/1/2000, Station, 000",
+             "ACCELERATION TIME SERIES IN UNITS OF G", f"NPTS= {len(in_g):5d}, DT=   {1 / RATE:.4f} SEC"]
+    lines += ["".join(f"{a:16.8E}" for a in in_g[k:k + 5]) for k in range(0, len(in_g), 5)]
+    path = tmp_path / "sine.AT2"
+    path.write_text("\n".join(lines) + "\n")
+    for signal in (client.upload_signal(path), client.upload_signal(in_g, time_step=1 / RATE, unit="g")):
+        m = signal.metadata
+        assert m["samples"] == len(in_g)
+        assert m["duration"] == pytest.approx(DURATION, rel=1e-9)
+        assert m["pga"] == pytest.approx(AMPLITUDE, rel=1e-7)
+    with pytest.raises(chocmodal.ChocmodalError) as refused:
+        client.upload_signal(path, unit="m/s2")
+    assert "/unit" in str(refused.value)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import uuid
 from typing import Any, Iterator, Mapping, Optional, Sequence, Union
 
@@ -225,16 +226,28 @@ class Client:
         time_step: Optional[float] = None,
         time: Optional[Sequence[float]] = None,
         sampling_rate: Optional[float] = None,
+        unit: Optional[str] = None,
         idempotency_key: Optional[str] = None,
         labels: Optional[Sequence[str]] = None,
         note: Optional[str] = None,
     ) -> Signal:
-        """Stores an accelerogram (m/s²) and returns it: a NumPy array with ``time_step``
+        """Stores an accelerogram and returns it: a NumPy array with ``time_step``
         (s), ``sampling_rate`` (Hz) or ``time`` (s); a pandas Series indexed by time;
-        or a file (path or open file) of CSV ``time,acceleration`` (or JSON).
-        ``labels`` and ``note`` are stored with it (``client.signals(label=...)``)."""
+        or a file (path or open file) of CSV ``time,acceleration`` (or JSON), of one
+        column after a ``dt=0.005`` line, or a PEER AT2 file (in g, read as it is).
+        ``unit`` is ``"m/s2"`` (the default) or ``"g"`` for a CSV file or an array in g;
+        the server stores every record in m/s². ``labels`` and ``note`` are stored with
+        it (``client.signals(label=...)``)."""
         body, content_type, params = upload_body(source, time_step=time_step, time=time, sampling_rate=sampling_rate)
         params = dict(params)
+        if unit is not None:
+            if content_type == "application/json":
+                # A JSON body carries its unit as a member (the query's is for CSV).
+                record = json.loads(body)
+                record["unit"] = unit
+                body = json.dumps(record).encode()
+            else:
+                params["unit"] = unit
         if labels:
             params["label"] = Repeated(labels)
         if note is not None:
