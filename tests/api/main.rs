@@ -28,6 +28,7 @@ mod hex_loads;
 mod idempotency;
 mod impacts;
 mod limits;
+mod margins;
 mod listing;
 mod load;
 mod negotiation;
