@@ -175,7 +175,10 @@ impl AllowablesInput {
                 check_positive(Some(force), force_pointer.clone(), "N", errors)
             }
             Some(ContactForceAllowable::Families(families)) => {
-                for (family, force) in [(Family::PinPin, families.pin_pin), (Family::PinWall, families.pin_wall)] {
+                for (family, force) in [
+                    (Family::PinPin, families.pin_pin),
+                    (Family::PinWall, families.pin_wall),
+                ] {
                     check_positive(force, format!("{force_pointer}/{}", family.member()), "N", errors);
                 }
             }
@@ -195,7 +198,9 @@ impl AllowablesInput {
             }
             if let Some(law) = laws.iter().find(|law| law.family == family) {
                 let at = match self.contact_force {
-                    Some(ContactForceAllowable::Families(_)) => format!("{force_pointer}/{}", family.member()),
+                    Some(ContactForceAllowable::Families(_)) => {
+                        format!("{force_pointer}/{}", family.member())
+                    }
                     _ => force_pointer.clone(),
                 };
                 errors.push(FieldError::new(
@@ -284,7 +289,11 @@ pub struct PinUtilisation {
 impl PinUtilisation {
     /// Of a pin whose bending is `bending`, against the allowable stress `stress` (Pa),
     /// with the utilisations of its contacts.
-    pub fn of(bending: &Bending, stress: Option<f64>, contacts: impl IntoIterator<Item = Option<f64>>) -> Self {
+    pub fn of(
+        bending: &Bending,
+        stress: Option<f64>,
+        contacts: impl IntoIterator<Item = Option<f64>>,
+    ) -> Self {
         let stress_utilisation = bending.stress.and_then(|s| ratio(s, stress));
         let contact_utilisation = largest(contacts);
         Self {
@@ -354,7 +363,10 @@ mod tests {
         let bare = PinUtilisation::of(&bending(Some(150e6)), None, [None, None]);
         assert_eq!(bare, PinUtilisation::default());
         let no_fibre = PinUtilisation::of(&bending(None), Some(300e6), [Some(1.5)]);
-        assert_eq!((no_fibre.stress_utilisation, no_fibre.utilisation), (None, Some(1.5)));
+        assert_eq!(
+            (no_fibre.stress_utilisation, no_fibre.utilisation),
+            (None, Some(1.5))
+        );
     }
 
     #[test]
@@ -369,7 +381,10 @@ mod tests {
         let stress = run.max_stress_utilisation.unwrap();
         assert_eq!((stress.pin, stress.utilisation), (3, 1.2));
         assert_eq!(run.worst_utilisation, Some(1.2));
-        assert_eq!(RunMargins::of(None, &bending(Some(1.0)), None), RunMargins::default());
+        assert_eq!(
+            RunMargins::of(None, &bending(Some(1.0)), None),
+            RunMargins::default()
+        );
     }
 
     #[test]
@@ -398,7 +413,12 @@ mod tests {
             ],
             "{errors:?}"
         );
-        assert!(errors[3].detail.contains("/inputs/bundle/wall_law/allowable_force"), "{errors:?}");
+        assert!(
+            errors[3]
+                .detail
+                .contains("/inputs/bundle/wall_law/allowable_force"),
+            "{errors:?}"
+        );
         let mut none = Vec::new();
         AllowablesInput::default().check("/inputs/output/allowables", false, &laws, &mut none);
         assert!(none.is_empty(), "{none:?}");

@@ -86,14 +86,21 @@ async fn refused(app: &TestApp, process: &str, inputs: Value) -> Vec<(String, St
     let response = app.post_execution(process, &json!({"inputs": inputs})).await;
     let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
     let mut errors: Vec<(String, String)> = (problem["errors"].as_array().unwrap().iter())
-        .map(|e| (e["pointer"].as_str().unwrap().to_owned(), e["detail"].as_str().unwrap().to_owned()))
+        .map(|e| {
+            (
+                e["pointer"].as_str().unwrap().to_owned(),
+                e["detail"].as_str().unwrap().to_owned(),
+            )
+        })
         .collect();
     errors.sort();
     errors
 }
 
 fn number(value: &Value, what: &str) -> f64 {
-    value.as_f64().unwrap_or_else(|| panic!("{what} is not a number: {value}"))
+    value
+        .as_f64()
+        .unwrap_or_else(|| panic!("{what} is not a number: {value}"))
 }
 
 /// `measured` is `expected` to 1e-12 relative.
@@ -136,9 +143,17 @@ fn check_bundle_margins(
     let mut worst_contact = (f64::NEG_INFINITY, 0);
     for (k, contact) in contacts.iter().enumerate() {
         let expected = allowable(contact);
-        assert_eq!(number(&contact["allowable_force"], "allowable_force"), expected, "{contact}");
+        assert_eq!(
+            number(&contact["allowable_force"], "allowable_force"),
+            expected,
+            "{contact}"
+        );
         let utilisation = number(&contact["utilisation"], "utilisation");
-        close(utilisation * expected, number(&contact["max_force"], "max_force"), &format!("c{k}: utilisation × allowable"));
+        close(
+            utilisation * expected,
+            number(&contact["max_force"], "max_force"),
+            &format!("c{k}: utilisation × allowable"),
+        );
         if utilisation > worst_contact.0 {
             worst_contact = (utilisation, k);
         }
@@ -160,8 +175,16 @@ fn check_bundle_margins(
             .map(|c| number(&c["utilisation"], "utilisation"))
             .fold(f64::NEG_INFINITY, f64::max);
         assert!(of_contacts.is_finite(), "pin {p} takes part in contacts");
-        assert_eq!(number(&pin["contact_utilisation"], "contact_utilisation"), of_contacts, "{pin}");
-        assert_eq!(number(&pin["utilisation"], "utilisation"), of_contacts.max(stress_utilisation), "{pin}");
+        assert_eq!(
+            number(&pin["contact_utilisation"], "contact_utilisation"),
+            of_contacts,
+            "{pin}"
+        );
+        assert_eq!(
+            number(&pin["utilisation"], "utilisation"),
+            of_contacts.max(stress_utilisation),
+            "{pin}"
+        );
     }
     let run = &document["max_utilisation"];
     assert_eq!(run["contact"], worst_contact.1, "{run}");
@@ -169,10 +192,20 @@ fn check_bundle_margins(
     let run_stress = &document["max_stress_utilisation"];
     let max_bending = &document["max_bending"];
     for member in ["pin", "height", "time", "stress"] {
-        assert_eq!(run_stress[member], max_bending[member], "{run_stress} is at {max_bending}");
+        assert_eq!(
+            run_stress[member], max_bending[member],
+            "{run_stress} is at {max_bending}"
+        );
     }
-    assert_eq!(number(&run_stress["allowable_stress"], "allowable_stress"), stress);
-    assert_eq!(number(&run_stress["utilisation"], "stress utilisation"), worst_stress.0, "{run_stress}");
+    assert_eq!(
+        number(&run_stress["allowable_stress"], "allowable_stress"),
+        stress
+    );
+    assert_eq!(
+        number(&run_stress["utilisation"], "stress utilisation"),
+        worst_stress.0,
+        "{run_stress}"
+    );
     assert_eq!(
         number(&document["worst_utilisation"], "worst_utilisation"),
         worst_contact.0.max(worst_stress.0)
@@ -193,19 +226,33 @@ async fn a_rows_utilisations_times_their_allowables_give_its_peaks_and_nothing_e
         |c, p| c["left"] == p || c["right"] == p,
     );
     assert!(
-        with["contacts"].as_array().unwrap().iter().any(|c| number(&c["max_force"], "max_force") > 0.0),
+        with["contacts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| number(&c["max_force"], "max_force") > 0.0),
         "the released pins must touch: {with}"
     );
 
     let bare = results(&app, "bundle-dynamics", row(json!({}))).await;
     for contact in bare["contacts"].as_array().unwrap() {
-        assert!(contact["utilisation"].is_null() && contact["allowable_force"].is_null(), "{contact}");
+        assert!(
+            contact["utilisation"].is_null() && contact["allowable_force"].is_null(),
+            "{contact}"
+        );
     }
     for pin in bare["pins"].as_array().unwrap() {
-        assert!(pin["utilisation"].is_null() && pin["stress_utilisation"].is_null(), "{pin}");
+        assert!(
+            pin["utilisation"].is_null() && pin["stress_utilisation"].is_null(),
+            "{pin}"
+        );
     }
     assert!(bare["worst_utilisation"].is_null() && bare["max_stress_utilisation"].is_null());
-    assert_eq!(without_margins(&with), without_margins(&bare), "allowables change nothing but the margins");
+    assert_eq!(
+        without_margins(&with),
+        without_margins(&bare),
+        "allowables change nothing but the margins"
+    );
 }
 
 #[tokio::test]
@@ -230,8 +277,17 @@ async fn the_contact_table_carries_each_contacts_allowable_and_utilisation_in_js
         .unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let column = |name: &str| header.iter().position(|c| *c == name).unwrap_or_else(|| panic!("{name} in {header:?}"));
-    let (force, allowable, utilisation) = (column("max_force"), column("allowable_force"), column("utilisation"));
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|c| *c == name)
+            .unwrap_or_else(|| panic!("{name} in {header:?}"))
+    };
+    let (force, allowable, utilisation) = (
+        column("max_force"),
+        column("allowable_force"),
+        column("utilisation"),
+    );
     for (line, contact) in lines.zip(contacts) {
         let cells: Vec<&str> = line.split(',').collect();
         let parse = |k: usize| cells[k].parse::<f64>().unwrap_or_else(|e| panic!("{line}: {e}"));
@@ -243,8 +299,16 @@ async fn the_contact_table_carries_each_contacts_allowable_and_utilisation_in_js
     // Without allowables the table has no such columns (a null is no value).
     let bare = submit(&app, "bundle-dynamics", row(json!({}))).await;
     let table = app.get_json(&format!("/jobs/{bare}/results/contacts")).await;
-    let columns: Vec<&str> = table["columns"].as_array().unwrap().iter().map(|c| c.as_str().unwrap()).collect();
-    assert!(!columns.contains(&"utilisation") && !columns.contains(&"allowable_force"), "{columns:?}");
+    let columns: Vec<&str> = table["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap())
+        .collect();
+    assert!(
+        !columns.contains(&"utilisation") && !columns.contains(&"allowable_force"),
+        "{columns:?}"
+    );
 }
 
 #[tokio::test]
@@ -257,7 +321,12 @@ async fn a_hexagonal_bundles_pins_take_the_utilisations_of_their_wires_and_clads
         hex(json!({"interval": 1e-3, "allowables": {"contact_force": force, "stress": stress}})),
     )
     .await;
-    check_bundle_margins(&document, |_| force, stress, |c, p| c["wire_pin"] == p || c["touched_pin"] == p);
+    check_bundle_margins(
+        &document,
+        |_| force,
+        stress,
+        |c, p| c["wire_pin"] == p || c["touched_pin"] == p,
+    );
 
     // One family only: the other's contacts have none, and the run's worst is among those given.
     let document = results(
@@ -274,7 +343,10 @@ async fn a_hexagonal_bundles_pins_take_the_utilisations_of_their_wires_and_clads
     let worst = document["max_utilisation"]["contact"].as_u64().unwrap() as usize;
     assert!(document["contacts"][worst]["touched_pin"].is_null());
     assert!(document["max_stress_utilisation"].is_null());
-    assert_eq!(document["worst_utilisation"], document["max_utilisation"]["utilisation"]);
+    assert_eq!(
+        document["worst_utilisation"],
+        document["max_utilisation"]["utilisation"]
+    );
 }
 
 #[tokio::test]
@@ -290,18 +362,38 @@ async fn the_cantilevers_tip_contact_and_beam_report_their_utilisations() {
     let numerical = &document["numerical"];
     assert_eq!(numerical["allowable_force"], force);
     let utilisation = number(&numerical["utilisation"], "utilisation");
-    close(utilisation * force, number(&numerical["max_contact_force"], "max_contact_force"), "utilisation × allowable");
+    close(
+        utilisation * force,
+        number(&numerical["max_contact_force"], "max_contact_force"),
+        "utilisation × allowable",
+    );
     let bending = &numerical["max_bending"];
     let by_stress = &numerical["max_stress_utilisation"];
     assert_eq!(by_stress["stress"], bending["stress"]);
     assert_eq!(by_stress["height"], bending["height"]);
     let stress_utilisation = number(&by_stress["utilisation"], "stress utilisation");
-    close(stress_utilisation * stress, number(&bending["stress"], "max_bending.stress"), "stress utilisation × allowable");
-    assert_eq!(number(&numerical["worst_utilisation"], "worst"), utilisation.max(stress_utilisation));
+    close(
+        stress_utilisation * stress,
+        number(&bending["stress"], "max_bending.stress"),
+        "stress utilisation × allowable",
+    );
+    assert_eq!(
+        number(&numerical["worst_utilisation"], "worst"),
+        utilisation.max(stress_utilisation)
+    );
 
     let bare = results(&app, "cantilever-impact", cantilever(json!({}))).await;
-    for member in ["allowable_force", "utilisation", "max_stress_utilisation", "worst_utilisation"] {
-        assert!(bare["numerical"][member].is_null(), "{member}: {}", bare["numerical"]);
+    for member in [
+        "allowable_force",
+        "utilisation",
+        "max_stress_utilisation",
+        "worst_utilisation",
+    ] {
+        assert!(
+            bare["numerical"][member].is_null(),
+            "{member}: {}",
+            bare["numerical"]
+        );
     }
 }
 
@@ -324,15 +416,37 @@ async fn bad_allowables_are_refused_at_their_members_with_the_reason() {
         ],
         "{errors:?}"
     );
-    assert!(errors.iter().all(|(_, detail)| detail.contains("> 0")), "{errors:?}");
+    assert!(
+        errors.iter().all(|(_, detail)| detail.contains("> 0")),
+        "{errors:?}"
+    );
 
     // A family the process has not.
-    let errors = refused(&app, "hex-bundle-dynamics", hex(json!({"allowables": {"contact_force": {"walls": 5.0}}}))).await;
+    let errors = refused(
+        &app,
+        "hex-bundle-dynamics",
+        hex(json!({"allowables": {"contact_force": {"walls": 5.0}}})),
+    )
+    .await;
     assert_eq!(errors.len(), 1, "{errors:?}");
-    assert!(errors[0].0.starts_with("/inputs/output/allowables/contact_force"), "{errors:?}");
-    assert!(errors[0].1.contains("pin_pin") && errors[0].1.contains("pin_wall"), "{errors:?}");
-    let errors = refused(&app, "cantilever-impact", cantilever(json!({"allowables": {"contact_force": {"pin_pin": 5.0}}}))).await;
-    assert_eq!(errors[0].0, "/inputs/output/allowables/contact_force", "{errors:?}");
+    assert!(
+        errors[0].0.starts_with("/inputs/output/allowables/contact_force"),
+        "{errors:?}"
+    );
+    assert!(
+        errors[0].1.contains("pin_pin") && errors[0].1.contains("pin_wall"),
+        "{errors:?}"
+    );
+    let errors = refused(
+        &app,
+        "cantilever-impact",
+        cantilever(json!({"allowables": {"contact_force": {"pin_pin": 5.0}}})),
+    )
+    .await;
+    assert_eq!(
+        errors[0].0, "/inputs/output/allowables/contact_force",
+        "{errors:?}"
+    );
 
     // Given twice: by the family's law and here.
     let mut twice = row(json!({"allowables": {"contact_force": {"pin_wall": 5.0}}}));
@@ -340,14 +454,21 @@ async fn bad_allowables_are_refused_at_their_members_with_the_reason() {
     let errors = refused(&app, "bundle-dynamics", twice).await;
     assert_eq!(errors.len(), 1, "{errors:?}");
     assert_eq!(errors[0].0, "/inputs/output/allowables/contact_force/pin_wall");
-    assert!(errors[0].1.contains("/inputs/bundle/wall_law/allowable_force"), "{errors:?}");
+    assert!(
+        errors[0].1.contains("/inputs/bundle/wall_law/allowable_force"),
+        "{errors:?}"
+    );
     // ... while another family's law is no conflict.
     let mut other = row(json!({"allowables": {"contact_force": {"pin_pin": 5.0}}}));
     other["bundle"]["wall_law"] = json!({"allowable_force": 6.0});
     let document = results(&app, "bundle-dynamics", other).await;
     for contact in document["contacts"].as_array().unwrap() {
         let wall = contact["left"] == "wall" || contact["right"] == "wall";
-        assert_eq!(contact["allowable_force"], if wall { 6.0 } else { 5.0 }, "{contact}");
+        assert_eq!(
+            contact["allowable_force"],
+            if wall { 6.0 } else { 5.0 },
+            "{contact}"
+        );
     }
 
     // A stress with no outer fibre to find it at.
@@ -367,22 +488,40 @@ async fn a_random_sweep_aggregates_the_worst_utilisation_of_its_runs() {
     body["inputs"]["solver"]["duration"] = json!(0.02);
     body["inputs"]["output"]["allowables"] = json!({"contact_force": 2.0, "stress": 5e7});
     let id = app.create_sweep(body).await;
-    app.wait_for_sweep(&id, &["successful"], Duration::from_secs(180)).await;
+    app.wait_for_sweep(&id, &["successful"], Duration::from_secs(180))
+        .await;
     let results = app.sweep_results(&id).await;
     let rows = results["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 3);
     let mut worst = Vec::new();
     for row in rows {
         let contact = number(&row["max_utilisation.utilisation"], "max_utilisation.utilisation");
-        close(contact * 2.0, number(&row["max_contact_force.force"], "max_contact_force.force"), "worst contact");
-        let stress = number(&row["max_stress_utilisation.utilisation"], "max_stress_utilisation.utilisation");
-        close(stress * 5e7, number(&row["max_bending.stress"], "max_bending.stress"), "worst stress");
+        close(
+            contact * 2.0,
+            number(&row["max_contact_force.force"], "max_contact_force.force"),
+            "worst contact",
+        );
+        let stress = number(
+            &row["max_stress_utilisation.utilisation"],
+            "max_stress_utilisation.utilisation",
+        );
+        close(
+            stress * 5e7,
+            number(&row["max_bending.stress"], "max_bending.stress"),
+            "worst stress",
+        );
         let run = number(&row["worst_utilisation"], "worst_utilisation");
         assert_eq!(run, contact.max(stress), "{row}");
         worst.push(run);
     }
     let statistics = &results["aggregates"]["statistics"][0]["metrics"]["worst_utilisation"];
     assert_eq!(statistics["count"], 3, "{statistics}");
-    assert_eq!(number(&statistics["max"], "max"), worst.iter().copied().fold(f64::NEG_INFINITY, f64::max));
-    assert_eq!(number(&statistics["min"], "min"), worst.iter().copied().fold(f64::INFINITY, f64::min));
+    assert_eq!(
+        number(&statistics["max"], "max"),
+        worst.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    );
+    assert_eq!(
+        number(&statistics["min"], "min"),
+        worst.iter().copied().fold(f64::INFINITY, f64::min)
+    );
 }

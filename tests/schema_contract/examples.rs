@@ -275,7 +275,8 @@ pub fn hex() -> Vec<Value> {
     first["output"]["impacts"] = json!({"force_threshold": 0.0, "rest_time": 0.0, "classes": 10,
                                         "max_rows": 1000});
     first["output"]["blocks"] = json!(2);
-    first["output"]["allowables"] = json!({"contact_force": {"pin_pin": 5.0, "pin_wall": 6.0}, "stress": 1e8});
+    first["output"]["allowables"] =
+        json!({"contact_force": {"pin_pin": 5.0, "pin_wall": 6.0}, "stress": 1e8});
     first["warnings"] = json!("on");
     let mut explicit_section = hex_example(
         gap_states[4].clone(),

@@ -182,12 +182,20 @@ impl BundleInputs {
     /// family's in `output.allowables`.
     pub fn allowable_forces(&self, contacts: &[Contact], laws: &[LawInput]) -> Vec<Option<f64>> {
         (contacts.iter().zip(laws))
-            .map(|(c, law)| law.allowable().or(self.output.allowables.force_of(Self::family_of(c))))
+            .map(|(c, law)| {
+                law.allowable()
+                    .or(self.output.allowables.force_of(Self::family_of(c)))
+            })
             .collect()
     }
 
     /// The problems of `output.allowables` ([`AllowablesInput::check`]) for `contacts`.
-    pub fn check_allowables(&self, contacts: &[Contact], fibre: bool, errors: &mut Vec<crate::processes::FieldError>) {
+    pub fn check_allowables(
+        &self,
+        contacts: &[Contact],
+        fibre: bool,
+        errors: &mut Vec<crate::processes::FieldError>,
+    ) {
         let laws: Vec<(Family, String)> = (contacts.iter().enumerate())
             .filter_map(|(k, c)| {
                 let (law, pointer) = self.law_of(c, k);
@@ -200,7 +208,9 @@ impl BundleInputs {
                 pointer,
             })
             .collect();
-        self.output.allowables.check("/inputs/output/allowables", fibre, &laws, errors);
+        self.output
+            .allowables
+            .check("/inputs/output/allowables", fibre, &laws, errors);
     }
 }
 

@@ -11,8 +11,8 @@ use super::bending::{BendingReport, Flexure};
 use super::columns::{self, Column};
 use super::common_inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::contact_law::LawInput;
-use super::margins::{self, StressUtilisation, TipAllowablesInput};
 use super::impact_report::{self, ContactImpacts, ImpactSummary, ImpactsInput};
+use super::margins::{self, StressUtilisation, TipAllowablesInput};
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
@@ -687,7 +687,10 @@ impl Simulation for CantileverImpact {
                 allowable_force,
                 utilisation,
                 max_stress_utilisation,
-                worst_utilisation: margins::largest([utilisation, max_stress_utilisation.map(|s| s.utilisation)]),
+                worst_utilisation: margins::largest([
+                    utilisation,
+                    max_stress_utilisation.map(|s| s.utilisation),
+                ]),
                 max_contact_force_time: stats.max_force_time,
                 contact_time: stats.contact_time,
                 impulse: stats.impulse,

@@ -341,7 +341,12 @@ impl Simulation for HexBundleDynamics {
         errors.extend(contact_law_errors(&inputs));
         // D is required above: without it, the stress is refused there, not here.
         let allowables = &inputs.output.allowables;
-        allowables.check("/inputs/output/allowables", true, &inputs.contact.law_allowables(), &mut errors);
+        allowables.check(
+            "/inputs/output/allowables",
+            true,
+            &inputs.contact.law_allowables(),
+            &mut errors,
+        );
         errors.extend(
             inputs
                 .closure_issues()
@@ -497,7 +502,11 @@ impl Simulation for HexBundleDynamics {
             .collect();
         let given = &plan.inputs.output.allowables;
         let allowables: Vec<Option<f64>> = (plan.contacts.iter())
-            .map(|c| plan.inputs.contact.allowable_force(c.right == RowBody::Wall, given))
+            .map(|c| {
+                plan.inputs
+                    .contact
+                    .allowable_force(c.right == RowBody::Wall, given)
+            })
             .collect();
         let allowable_stress = given.stress;
         let service_time = plan.inputs.output.service_time.unwrap_or(0.0);
