@@ -328,7 +328,7 @@ pub fn worst(peaks: &[f64], allowables: &[Option<f64>]) -> Option<Utilisation> {
         .filter_map(|(contact, (force, allowable))| {
             allowable.map(|allowable_force| Utilisation {
                 contact,
-                utilisation: force / allowable_force,
+                utilisation: super::margins::over(*force, allowable_force),
                 force: *force,
                 allowable_force,
             })

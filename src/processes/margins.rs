@@ -236,9 +236,16 @@ impl TipAllowablesInput {
     }
 }
 
-/// A peak over its allowable, when there is one (dimensionless; ≥ 1: reached).
+/// A peak over its allowable, when there is one (dimensionless; ≥ 1: reached). Held
+/// finite: an allowable so small that the ratio overflows gives the largest number, not
+/// an infinity (which JSON cannot carry).
 pub fn ratio(peak: f64, allowable: Option<f64>) -> Option<f64> {
-    allowable.map(|allowable| peak / allowable)
+    allowable.map(|allowable| over(peak, allowable))
+}
+
+/// [`ratio`] with an allowable given.
+pub fn over(peak: f64, allowable: f64) -> f64 {
+    (peak / allowable).min(f64::MAX)
 }
 
 /// The largest bending stress of a pin, or of the run, over the allowable stress.
@@ -268,7 +275,7 @@ impl StressUtilisation {
             time: bending.time,
             stress,
             allowable_stress,
-            utilisation: stress / allowable_stress,
+            utilisation: over(stress, allowable_stress),
         })
     }
 }
@@ -352,6 +359,13 @@ mod tests {
             stress,
             strain: stress.map(|s| s / 2e11),
         }
+    }
+
+    #[test]
+    fn a_ratio_is_the_peak_over_the_allowable_and_stays_finite() {
+        assert_eq!(ratio(3.0, Some(4.0)), Some(0.75));
+        assert_eq!(ratio(3.0, None), None);
+        assert_eq!(ratio(1e10, Some(1e-300)), Some(f64::MAX));
     }
 
     #[test]
