@@ -254,18 +254,16 @@ export function histogram({id, title, caption, values, xLabel, bins, markers = [
     s('line', {x1: round(X(m.x)), x2: round(X(m.x)), y1: margin.top, y2: margin.top + plotH}),
     s('line', {x1: round(X(m.x)), x2: round(X(m.x)), y1: 12 + 12 * (k % 3), y2: margin.top, class: 'leader'}),
     s('text', {x: round(X(m.x)) + 3, y: 16 + 12 * (k % 3)}, m.label)));
-  const line = reference === null ? null : s('line', {class: 'reference', x1: margin.left, x2: margin.left + plotW,
-    y1: round(Y(reference)), y2: round(Y(reference)), 'data-reference': reference});
   const svg = s('svg', {viewBox: `0 0 ${width} ${height}`, role: 'img', 'aria-label': title, class: 'chart'},
-    ticks, bars, line, s('rect', {class: 'frame', x: margin.left, y: margin.top, width: plotW, height: plotH}), lines,
+    ticks, bars, s('rect', {class: 'frame', x: margin.left, y: margin.top, width: plotW, height: plotH}), lines,
     axisLabels(width, height, margin, xLabel, 'runs'));
   return figure(id, title, caption || h('span', {class: 'muted'}, ` ${finite.length} values`), svg,
     {'data-values': finite.length});
 }
 
-/** A bar chart: one bar per label; `selected` index highlighted; `onselect(k)` on click. */
 /**
- * A bar chart: `labels`, `values`; `bands` (optional) a utilisation band per bar
+ * A bar chart: one bar per label; `selected` index highlighted; `onselect(k)` on click;
+ * `bands` (optional) a utilisation band per bar
  * (`ok`, `near`, `over` or null: margins.js) colouring it; `reference` a value drawn as a
  * dashed line (a utilisation of 1).
  */
