@@ -26,14 +26,18 @@ impl Flexure {
     /// The pin or beam `beam`; `diameter` its outer diameter when given apart from an
     /// explicit section (a hexagonal bundle's D).
     pub fn of(beam: &BeamInput, diameter: Option<f64>) -> Self {
-        let fibre = match beam.section {
-            SectionInput::Tube { outer_diameter, .. } => Some(outer_diameter / 2.0),
-            SectionInput::Explicit { .. } => diameter.map(|d| d / 2.0),
-        };
         Self {
             bending_stiffness: beam.spec().bending_stiffness(),
             young_modulus: beam.young_modulus,
-            fibre,
+            fibre: Self::fibre(beam, diameter),
+        }
+    }
+
+    /// c (m) of `beam`, as [`Flexure::of`] takes it; `None` when unknown (no stress).
+    pub fn fibre(beam: &BeamInput, diameter: Option<f64>) -> Option<f64> {
+        match beam.section {
+            SectionInput::Tube { outer_diameter, .. } => Some(outer_diameter / 2.0),
+            SectionInput::Explicit { .. } => diameter.map(|d| d / 2.0),
         }
     }
 

@@ -46,7 +46,8 @@ pub struct LawInput {
     /// Coulomb friction on the contact's tangent (pins in the transverse plane only).
     pub friction: Option<FrictionInput>,
     /// The force (N) this contact may carry: results report each contact's peak over it
-    /// (`utilisation`) and the worst in the run. Reporting only.
+    /// (`utilisation`) and the worst in the run. Reporting only; `output.allowables`
+    /// gives it per family of contacts instead.
     #[schema(exclusive_minimum = 0.0)]
     pub allowable_force: Option<f64>,
     /// Archard wear of the tube: the volume K P t and the depth it makes, P the wear
@@ -318,11 +319,6 @@ pub struct Utilisation {
     pub allowable_force: f64,
 }
 
-/// A peak force over its allowable force, when there is one.
-pub fn utilisation(peak: f64, allowable: Option<f64>) -> Option<f64> {
-    allowable.map(|allowable| peak / allowable)
-}
-
 /// The contact of largest utilisation among those with an allowable force.
 pub fn worst(peaks: &[f64], allowables: &[Option<f64>]) -> Option<Utilisation> {
     peaks
@@ -332,7 +328,7 @@ pub fn worst(peaks: &[f64], allowables: &[Option<f64>]) -> Option<Utilisation> {
         .filter_map(|(contact, (force, allowable))| {
             allowable.map(|allowable_force| Utilisation {
                 contact,
-                utilisation: force / allowable_force,
+                utilisation: super::margins::over(*force, allowable_force),
                 force: *force,
                 allowable_force,
             })

@@ -26,6 +26,8 @@ pub mod cost;
 pub mod excitation;
 pub mod impact_report;
 pub mod input_schema;
+/// Allowables and the utilisation ratios they give (docs/margins.md).
+pub mod margins;
 pub mod metrics;
 /// The member at fault when a tagged object fails to parse.
 pub mod misfit;

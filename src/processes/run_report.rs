@@ -9,8 +9,9 @@ use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
 use super::bending::{self, BendingReport, Flexure};
-use super::contact_law::{self, Utilisation};
+use super::contact_law;
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
+use super::margins::{self, RunMargins};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryKind, HistoryOutput};
 use super::{History, WorkEstimate, common_inputs};
@@ -36,8 +37,10 @@ pub struct ContactStatistics {
     pub max_penetration: f64,
     /// Its impacts as `output.impacts` counts them (`impacts` above is their number).
     pub impact_statistics: ContactImpacts,
-    /// `max_force` over its law's `allowable_force`; absent without one.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// The force it may carry (N): `output.allowables.contact_force` or its law's
+    /// `allowable_force`; null without one.
+    pub allowable_force: Option<f64>,
+    /// `max_force` over `allowable_force` (dimensionless; ≥ 1: reached); null without one.
     pub utilisation: Option<f64>,
 }
 
@@ -58,7 +61,8 @@ impl ContactStatistics {
                 first_impact_time: s.first_impact_time,
                 max_penetration: s.max_penetration,
                 impact_statistics,
-                utilisation: contact_law::utilisation(s.max_force, *allowable),
+                allowable_force: *allowable,
+                utilisation: margins::ratio(s.max_force, *allowable),
             })
             .collect()
     }
@@ -133,10 +137,10 @@ impl PeakDeflectionResult {
 pub struct RunSummary {
     /// The largest force over all contacts; null without contacts.
     pub max_contact_force: Option<PeakForce>,
-    /// The contact of largest utilisation (peak force over allowable force); absent
-    /// when no law gives an allowable force.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub max_utilisation: Option<Utilisation>,
+    /// The run's worst utilisations (docs/margins.md): `max_utilisation`,
+    /// `max_stress_utilisation`, `worst_utilisation`; null without allowables.
+    #[serde(flatten)]
+    pub margins: RunMargins,
     /// Impacts over all contacts, as `output.impacts` counts them.
     pub impacts: u64,
     /// The run's impacts: counting, totals, histogram, contacts ranked.
@@ -161,17 +165,18 @@ pub struct RunSummary {
 
 impl RunSummary {
     /// The summary of `run`, judged `quality`, counted as `settings` asks, with the
-    /// allowable force of each contact's law, the report of its basis, and its pins'
-    /// flexure.
+    /// allowable force of each contact and the allowable stress (Pa) of the pins, the
+    /// report of its basis, and its pins' flexure.
     pub fn of(
         run: &Simulation,
         quality: QualityReport,
         settings: &Settings,
-        allowables: &[Option<f64>],
+        (allowables, allowable_stress): (&[Option<f64>], Option<f64>),
         (basis, frequencies_hz): (BasisReport, Vec<f64>),
         flexure: &Flexure,
     ) -> Self {
         let peaks: Vec<f64> = run.contact_statistics.iter().map(|s| s.max_force).collect();
+        let bending = BendingReport::of(run, flexure);
         Self {
             max_contact_force: run
                 .contact_statistics
@@ -183,7 +188,11 @@ impl RunSummary {
                     force: s.max_force,
                     time: s.max_force_time,
                 }),
-            max_utilisation: contact_law::worst(&peaks, allowables),
+            margins: RunMargins::of(
+                contact_law::worst(&peaks, allowables),
+                &bending.max_bending,
+                allowable_stress,
+            ),
             impacts: run.contact_statistics.iter().map(|s| s.impacts).sum(),
             impact_summary: impact_report::summary(run, &settings.impacts),
             energy: run.energy.into(),
@@ -194,7 +203,7 @@ impl RunSummary {
             quality,
             frequencies_hz,
             basis,
-            bending: BendingReport::of(run, flexure),
+            bending,
         }
     }
 }

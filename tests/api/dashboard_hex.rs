@@ -278,3 +278,110 @@ async fn a_hex_job_page_draws_its_cross_section_levels_statistics_and_a_clicked_
     browser.screenshot(&screenshot_dir().join("job-hex.png")).await;
     browser.assert_no_exceptions();
 }
+
+/// The results of `job` once successful.
+async fn finished(app: &crate::helpers::TestApp, job: &str) -> Value {
+    let status = app.wait_for(job, &["successful"], Duration::from_secs(120)).await;
+    assert_eq!(status["status"], "successful", "{status}");
+    app.get_json(&format!("/jobs/{job}/results")).await
+}
+
+/// The band the dashboard colours a utilisation by (docs/margins.md): green below 0.8,
+/// amber from 0.8 to 1, red from 1.
+fn band(utilisation: &Value) -> Option<&'static str> {
+    let u = utilisation.as_f64()?;
+    Some(if u >= 1.0 {
+        "over"
+    } else if u >= 0.8 {
+        "near"
+    } else {
+        "ok"
+    })
+}
+
+/// With allowables set from a first run's own peaks (the worst contact at 0.9 of its
+/// allowable, the worst stress at 1.2 of its), the page's margins card states the
+/// served worst utilisation, and every pin of the cross-section and every bar of the
+/// per-pin and per-contact utilisation charts carries the band of its served utilisation.
+#[tokio::test]
+#[cfg_attr(
+    chocmodal_skip_browser_tests,
+    ignore = "needs headless Chromium: none found at build time, or CHOCMODAL_SKIP_BROWSER_TESTS=1 (build.rs)"
+)]
+async fn a_hex_job_page_colours_its_pins_and_margins_by_utilisation() {
+    let chromium = chromium(concat!(
+        module_path!(),
+        "::a_hex_job_page_colours_its_pins_and_margins_by_utilisation"
+    ));
+    let app = spawn_app_with_processes(vec![Arc::new(HexBundleDynamics)], |_| {}).await;
+    let bare = finished(&app, &execute(&app, "hex-bundle-dynamics", &seven_pins()).await).await;
+    let peak = bare["max_contact_force"]["force"].as_f64().unwrap();
+    let stress = bare["max_bending"]["stress"].as_f64().unwrap();
+    assert!(
+        peak > 0.0 && stress > 0.0,
+        "the bundle must rattle: {peak} N, {stress} Pa"
+    );
+    let mut inputs = seven_pins();
+    inputs["inputs"]["output"]["allowables"] = json!({"contact_force": peak / 0.9, "stress": stress / 1.2});
+    let job = execute(&app, "hex-bundle-dynamics", &inputs).await;
+    let results = finished(&app, &job).await;
+    let worst = results["worst_utilisation"].as_f64().unwrap();
+    assert!(same(worst, 1.2), "the worst is the stress's 1.2: {worst}");
+
+    let mut browser = Browser::launch(&chromium, 1280, 1400).await;
+    browser.goto(&app.url(&format!("/jobs/{job}"))).await;
+    browser
+        .wait_for(
+            "document.querySelector('[data-plot=\"cross-section\"]') !== null && \
+             document.querySelector('[data-margins]') !== null",
+            WITHIN,
+        )
+        .await;
+    let page = browser
+        .eval(
+            "(() => { const bars = (id) => [...document.querySelectorAll(`[data-plot=\"${id}\"] rect[data-bar]`)] \
+               .map((b) => [b.dataset.bar, Number(b.dataset.value), b.dataset.band || null]); \
+             return {worst: Number(document.querySelector('[data-margins]').dataset.worst), \
+               pins: [...document.querySelectorAll('[data-plot=\"cross-section\"] svg circle[data-pin]')] \
+                 .map((c) => [Number(c.dataset.pin), c.dataset.band || null]), \
+               pin_bars: bars('margin-pins'), contact_bars: bars('margin-contacts')}; })()",
+        )
+        .await;
+    assert!(same(page["worst"].as_f64().unwrap(), worst), "{page}");
+    let pins = results["pins"].as_array().unwrap();
+    let drawn = page["pins"].as_array().unwrap();
+    assert_eq!(drawn.len(), pins.len(), "{page}");
+    for circle in drawn {
+        let p = circle[0].as_u64().unwrap() as usize;
+        assert_eq!(
+            circle[1].as_str(),
+            band(&pins[p]["utilisation"]),
+            "pin {p}: drawn {circle}, served {}",
+            pins[p]
+        );
+    }
+    let pin_bars = page["pin_bars"].as_array().unwrap();
+    assert_eq!(pin_bars.len(), pins.len(), "{page}");
+    for (bar, pin) in pin_bars.iter().zip(pins) {
+        assert!(
+            same(bar[1].as_f64().unwrap(), pin["utilisation"].as_f64().unwrap()),
+            "{bar} {pin}"
+        );
+        assert_eq!(bar[2].as_str(), band(&pin["utilisation"]), "{bar} {pin}");
+    }
+    let contacts = results["contacts"].as_array().unwrap();
+    let contact_bars = page["contact_bars"].as_array().unwrap();
+    assert_eq!(contact_bars.len(), contacts.len(), "{page}");
+    for (bar, contact) in contact_bars.iter().zip(contacts) {
+        assert_eq!(bar[2].as_str(), band(&contact["utilisation"]), "{bar}");
+    }
+    let bands: Vec<Option<&str>> = drawn.iter().map(|c| c[1].as_str()).collect();
+    assert!(bands.contains(&Some("over")), "the worst pin is red: {bands:?}");
+    browser
+        .eval("document.querySelector('[data-margins]').scrollIntoView({block: 'start'})")
+        .await;
+    browser
+        .screenshot(&screenshot_dir().join("job-hex-margins.png"))
+        .await;
+    browser.assert_no_exceptions();
+}

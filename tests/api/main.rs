@@ -30,6 +30,7 @@ mod impacts;
 mod limits;
 mod listing;
 mod load;
+mod margins;
 mod negotiation;
 mod physics;
 mod quality;

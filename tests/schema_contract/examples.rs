@@ -104,7 +104,8 @@ pub fn cantilever() -> Vec<Value> {
                "reference": {"modes": 6},
                "output": {"interval": 1e-4, "blocks": 2,
                           "impacts": {"force_threshold": 0.0, "rest_time": 0.0, "classes": 10,
-                                      "max_rows": 1000}},
+                                      "max_rows": 1000},
+                          "allowables": {"contact_force": 0.5, "stress": 1e8}},
                "warnings": "on"}),
         json!({"beam": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
                         "section": {"type": "explicit", "area": 1.49e-5, "inertia": 1.68e-10},
@@ -147,12 +148,15 @@ pub fn bundle() -> Vec<Value> {
         "point_forces": [{"pin": 1, "height": 0.5, "time": [0.0, 0.002, 0.004], "force": [0.0, 5.0, 0.0]}]});
     explicit["output"] = json!({"interval": 1e-4, "heights": [0.5, 1.0], "blocks": 2,
                                 "impacts": {"force_threshold": 0.0, "rest_time": 0.0, "classes": 10,
-                                            "max_rows": 1000}});
+                                            "max_rows": 1000},
+                                "allowables": {"contact_force": {"pin_pin": 5.0, "pin_wall": 6.0},
+                                               "stress": 1e8}});
     explicit["warnings"] = json!("on");
     let mut explicit_section = explicit_row();
     explicit_section["pin"] = explicit_beam(1.0);
     explicit_section["solver"] = tchamwa(0.01);
     explicit_section["initial"] = json!({"tip_displacements": [0.0, 0.001]});
+    explicit_section["output"] = json!({"allowables": {"contact_force": 5.0}});
     let generator = |gaps: Value, base: Value| {
         json!({"pin": tube_beam(1.0),
                "bundle": {"pins": 3, "levels": {"first": 0.5, "spacing": 0.5, "count": 2},
@@ -271,6 +275,8 @@ pub fn hex() -> Vec<Value> {
     first["output"]["impacts"] = json!({"force_threshold": 0.0, "rest_time": 0.0, "classes": 10,
                                         "max_rows": 1000});
     first["output"]["blocks"] = json!(2);
+    first["output"]["allowables"] =
+        json!({"contact_force": {"pin_pin": 5.0, "pin_wall": 6.0}, "stress": 1e8});
     first["warnings"] = json!("on");
     let mut explicit_section = hex_example(
         gap_states[4].clone(),
@@ -279,6 +285,7 @@ pub fn hex() -> Vec<Value> {
     );
     explicit_section["pin"] = explicit_beam(PIN_LENGTH);
     explicit_section["solver"] = tchamwa(0.005);
+    explicit_section["output"]["allowables"] = json!({"contact_force": 5.0, "stress": 1e8});
     // Moved by loads alone: the centre pin released along 45°, point forces along a
     // direction and along x (the default).
     let mut loaded = hex_example(gap_states[0].clone(), json!({}), selections[4].clone());

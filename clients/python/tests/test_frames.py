@@ -37,3 +37,15 @@ def test_an_empty_impact_table_still_has_its_columns_and_units() -> None:
     table = frames.impacts_frame([])
     assert list(table.columns) == list(frames.IMPACT_UNITS)
     assert table.empty and table.attrs["units"]["impulse"] == "N·s"
+
+
+def test_a_pins_utilisations_are_dimensionless_and_its_stress_in_pascals() -> None:
+    pins = [{"pin": 0, "max_abs_deflection": 1e-3, "bending": {"stress": 2e7, "moment": 1.0},
+             "stress_utilisation": 0.1, "contact_utilisation": 0.9, "utilisation": 0.9},
+            {"pin": 1, "max_abs_deflection": 2e-3, "bending": {"stress": 4e7, "moment": 2.0},
+             "stress_utilisation": 0.2, "contact_utilisation": None, "utilisation": 0.2}]
+    frame = frames.pins_frame(pins)
+    units = frame.attrs["units"]
+    assert units["utilisation"] == units["stress_utilisation"] == units["contact_utilisation"] == "1"
+    assert units["bending.stress"] == "Pa"
+    assert frame.loc[1, "utilisation"] == 0.2 and np.isnan(frame.loc[1, "contact_utilisation"])

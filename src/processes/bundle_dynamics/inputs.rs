@@ -13,6 +13,7 @@ use crate::processes::contact_law::{Families, LawInput};
 use crate::processes::excitation::BaseAccelerationInput;
 use crate::processes::impact_report::ImpactsInput;
 use crate::processes::input_schema::{NonNegativeNumber, PositiveNumber};
+use crate::processes::margins::{AllowablesInput, Family, LawAllowable};
 use crate::processes::random_gaps::DistributionInput;
 use crate::processes::warnings::WarningsInput;
 
@@ -165,6 +166,51 @@ impl BundleInputs {
             ),
             (None, None) => (LawInput::default(), "/inputs".to_owned()),
         }
+    }
+}
+
+impl BundleInputs {
+    /// The family of a contact: against a wall or between two pins.
+    pub fn family_of(contact: &Contact) -> Family {
+        match contact.left == Body::Wall || contact.right == Body::Wall {
+            true => Family::PinWall,
+            false => Family::PinPin,
+        }
+    }
+
+    /// The allowable force of each contact (N): its law's `allowable_force`, else its
+    /// family's in `output.allowables`.
+    pub fn allowable_forces(&self, contacts: &[Contact], laws: &[LawInput]) -> Vec<Option<f64>> {
+        (contacts.iter().zip(laws))
+            .map(|(c, law)| {
+                law.allowable()
+                    .or(self.output.allowables.force_of(Self::family_of(c)))
+            })
+            .collect()
+    }
+
+    /// The problems of `output.allowables` ([`AllowablesInput::check`]) for `contacts`.
+    pub fn check_allowables(
+        &self,
+        contacts: &[Contact],
+        fibre: bool,
+        errors: &mut Vec<crate::processes::FieldError>,
+    ) {
+        let laws: Vec<(Family, String)> = (contacts.iter().enumerate())
+            .filter_map(|(k, c)| {
+                let (law, pointer) = self.law_of(c, k);
+                law.allowable_force.map(|_| (Self::family_of(c), pointer))
+            })
+            .collect();
+        let laws: Vec<LawAllowable<'_>> = (laws.iter())
+            .map(|(family, pointer)| LawAllowable {
+                family: *family,
+                pointer,
+            })
+            .collect();
+        self.output
+            .allowables
+            .check("/inputs/output/allowables", fibre, &laws, errors);
     }
 }
 
@@ -506,4 +552,10 @@ pub struct OutputInput {
     /// reported as their mean and standard deviation (code_aster's NB_BLOC; 1…100).
     #[schema(minimum = 1, maximum = 100, default = 1)]
     pub blocks: Option<usize>,
+    /// What the contacts and the clad may carry (docs/margins.md): each contact's peak
+    /// force and each pin's largest stress over them, as utilisation ratios. Families:
+    /// `pin_pin` (between two pins), `pin_wall` (a pin and a wall). None by default.
+    #[serde(default)]
+    #[schema(default = json!({}))]
+    pub allowables: AllowablesInput,
 }

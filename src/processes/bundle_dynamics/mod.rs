@@ -16,6 +16,7 @@ use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::LawInput;
 use super::excitation::BaseAccelerationInput;
 use super::impact_report;
+use super::margins::PinUtilisation;
 use super::model_check::{self, StandIn};
 use super::run_report::{self, ContactStatistics, LineExtremes, RunSize, RunSummary};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
@@ -181,6 +182,9 @@ pub struct PinResult {
     pub extremes: LineExtremes,
     /// Its largest bending over its height and the output samples.
     pub bending: Bending,
+    /// Its utilisations against `output.allowables` (null without them).
+    #[serde(flatten)]
+    pub utilisation: PinUtilisation,
 }
 
 /// The explicit model the generator form expands to.
@@ -357,6 +361,8 @@ impl Simulation for BundleDynamics {
                 )]));
             }
         };
+        let fibre = Flexure::fibre(&inputs.pin, None).is_some();
+        inputs.check_allowables(&contacts, fibre, &mut errors);
         if inputs.bundle.is_some() && pins > MAX_PINS {
             errors.push(FieldError::new(
                 "/inputs/bundle/pins",
@@ -483,7 +489,8 @@ impl Simulation for BundleDynamics {
         let laws: Vec<LawInput> = (plan.contacts.iter().enumerate())
             .map(|(k, c)| plan.inputs.law_of(c, k).0)
             .collect();
-        let allowables: Vec<Option<f64>> = laws.iter().map(LawInput::allowable).collect();
+        let allowables = plan.inputs.allowable_forces(&plan.contacts, &laws);
+        let allowable_stress = plan.inputs.output.allowables.stress;
         let contacts: Vec<ContactResult> = (plan.contacts.iter().zip(&laws))
             .zip(ContactStatistics::of_run(&simulation, &allowables))
             .map(|((c, law), statistics)| ContactResult {
@@ -494,10 +501,17 @@ impl Simulation for BundleDynamics {
         let heights = &plan.settings.output_heights;
         let flexure = plan.flexure();
         let pins: Vec<PinResult> = (0..plan.pins)
-            .map(|p| PinResult {
-                pin: p,
-                extremes: LineExtremes::of_line(&simulation, heights, p),
-                bending: flexure.bending(&simulation.pin_curvatures[p]),
+            .map(|p| {
+                let bending = flexure.bending(&simulation.pin_curvatures[p]);
+                let on_pin = (contacts.iter())
+                    .filter(|c| [c.contact.left, c.contact.right].contains(&BodyInput::Pin(p)))
+                    .map(|c| c.statistics.utilisation);
+                PinResult {
+                    pin: p,
+                    extremes: LineExtremes::of_line(&simulation, heights, p),
+                    utilisation: PinUtilisation::of(&bending, allowable_stress, on_pin),
+                    bending,
+                }
             })
             .collect();
         let basis = BasisReport::of(
@@ -513,7 +527,7 @@ impl Simulation for BundleDynamics {
                 &simulation,
                 quality,
                 &plan.settings,
-                &allowables,
+                (&allowables, allowable_stress),
                 (basis, plan.basis.frequencies_hz()),
                 &flexure,
             ),
@@ -534,7 +548,8 @@ impl Simulation for BundleDynamics {
 
 /// Sweep columns: the scalars of the document, plus the peak force of each contact
 /// (`contacts.<k>.max_force`, N) and the largest deflection of each pin
-/// (`pins.<p>.max_abs_deflection`, m).
+/// (`pins.<p>.max_abs_deflection`, m), and with allowables their utilisations
+/// (`contacts.<k>.utilisation`, `pins.<p>.utilisation`).
 fn bundle_metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
     let mut metrics = super::metrics::flatten_scalars(document);
     let entries = |list: &str, field: &str| {
@@ -551,6 +566,10 @@ fn bundle_metrics(document: &serde_json::Value) -> Vec<(String, serde_json::Valu
     };
     metrics.extend(entries("contacts", "max_force"));
     metrics.extend(entries("pins", "max_abs_deflection"));
+    // With allowables (docs/margins.md), each contact's and pin's utilisation.
+    let given = |(_, value): &(String, serde_json::Value)| !value.is_null();
+    metrics.extend(entries("contacts", "utilisation").into_iter().filter(given));
+    metrics.extend(entries("pins", "utilisation").into_iter().filter(given));
     metrics.extend(super::metrics::item_scalars(
         document,
         "contacts",

@@ -10,8 +10,9 @@ use super::basis_report::BasisReport;
 use super::bending::{BendingReport, Flexure};
 use super::columns::{self, Column};
 use super::common_inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
-use super::contact_law::{self, LawInput};
+use super::contact_law::LawInput;
 use super::impact_report::{self, ContactImpacts, ImpactSummary, ImpactsInput};
+use super::margins::{self, StressUtilisation, TipAllowablesInput};
 use super::model_check::{self, StandIn};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
@@ -157,6 +158,11 @@ pub struct OutputInput {
     /// reported as their mean and standard deviation (code_aster's NB_BLOC; 1…100).
     #[schema(minimum = 1, maximum = 100, default = 1)]
     pub blocks: Option<usize>,
+    /// What the tip contact and the beam may carry (docs/margins.md): the peak force and
+    /// the largest bending stress over them, as utilisation ratios. None by default.
+    #[serde(default)]
+    #[schema(default = json!({}))]
+    pub allowables: TipAllowablesInput,
 }
 
 /// Validated inputs, ready to run.
@@ -239,9 +245,18 @@ pub struct NumericalResults {
     pub impact_summary: ImpactSummary,
     /// Largest contact force over every step (N).
     pub max_contact_force: f64,
-    /// `max_contact_force` over the law's `allowable_force`; absent without one.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// The force the contact may carry (N): `output.allowables.contact_force` or the
+    /// law's `allowable_force`; null without one.
+    pub allowable_force: Option<f64>,
+    /// `max_contact_force` over `allowable_force` (dimensionless; ≥ 1: reached); null
+    /// without one.
     pub utilisation: Option<f64>,
+    /// The largest bending stress (`max_bending`) over `output.allowables.stress`, where
+    /// and when; null without it.
+    pub max_stress_utilisation: Option<StressUtilisation>,
+    /// The worse of `utilisation` and `max_stress_utilisation` (dimensionless); null
+    /// without allowables.
+    pub worst_utilisation: Option<f64>,
     /// Its time (s).
     pub max_contact_force_time: f64,
     /// Total time in contact (s).
@@ -498,6 +513,9 @@ impl Simulation for CantileverImpact {
         let contact_stiffness = contact_stiffness(&inputs.contact, tip_stiffness, &mut errors);
         let solver = common_inputs::solver(&inputs.solver, SOLVER_DEFAULTS, &mut errors);
         common_inputs::check_output_interval(inputs.output.interval, &mut errors);
+        let law_allowable = (inputs.contact.law.allowable_force.is_some()).then_some("/inputs/contact/law");
+        let fibre = Flexure::fibre(&inputs.beam, None).is_some();
+        (inputs.output.allowables).check("/inputs/output/allowables", fibre, law_allowable, &mut errors);
         let mut settings = solver.integration(inputs.output.interval, vec![spec.length]);
         settings.impacts = impact_report::counting(inputs.output.impacts.as_ref(), inputs.output.blocks);
         let stand_in = StandIn::of(&inputs.beam);
@@ -648,6 +666,11 @@ impl Simulation for CantileverImpact {
             );
         }
         let spec = plan.inputs.beam.spec();
+        let given = &plan.inputs.output.allowables;
+        let allowable_force = contact.law.allowable().or(given.contact_force);
+        let utilisation = margins::ratio(stats.max_force, allowable_force);
+        let bending = BendingReport::of(&simulation, &Flexure::of(&plan.inputs.beam, None));
+        let max_stress_utilisation = StressUtilisation::of(&bending.max_bending, given.stress);
         let results = CantileverResults {
             model: CantileverModel {
                 contact_stiffness: plan.contact_stiffness,
@@ -661,7 +684,13 @@ impl Simulation for CantileverImpact {
                 impact_statistics: impact_report::contact_reports(&simulation).remove(0),
                 impact_summary: impact_report::summary(&simulation, &plan.settings.impacts),
                 max_contact_force: stats.max_force,
-                utilisation: contact_law::utilisation(stats.max_force, contact.law.allowable()),
+                allowable_force,
+                utilisation,
+                max_stress_utilisation,
+                worst_utilisation: margins::largest([
+                    utilisation,
+                    max_stress_utilisation.map(|s| s.utilisation),
+                ]),
                 max_contact_force_time: stats.max_force_time,
                 contact_time: stats.contact_time,
                 impulse: stats.impulse,
@@ -672,7 +701,7 @@ impl Simulation for CantileverImpact {
                 output_interval: simulation.output_interval,
                 frequencies_hz: plan.basis.frequencies_hz(),
                 energy: simulation.energy.into(),
-                bending: BendingReport::of(&simulation, &Flexure::of(&plan.inputs.beam, None)),
+                bending,
             },
             basis: BasisReport::of(
                 &model,

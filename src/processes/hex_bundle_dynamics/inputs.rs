@@ -7,6 +7,7 @@
 //! k·60° + 30°; pins from the centre outward, ring by ring (docs/hex-bundle.md).
 
 use crate::processes::contact_law::{Families, LawInput};
+use crate::processes::margins::{AllowablesInput, Family, LawAllowable};
 use serde::Deserialize;
 use utoipa::ToSchema;
 
@@ -161,6 +162,26 @@ impl HexContactInput {
         } else {
             (self.stiffness, self.damping, law, pointer)
         }
+    }
+
+    /// The family of a pin–wrapper contact (`wall`) or a pin–pin one, and the
+    /// allowable force of its contacts (N): the law's `allowable_force`, else the
+    /// family's in `allowables`.
+    pub fn allowable_force(&self, wall: bool, allowables: &AllowablesInput) -> Option<f64> {
+        let family = if wall { Family::PinWall } else { Family::PinPin };
+        self.family(wall).2.allowable().or(allowables.force_of(family))
+    }
+
+    /// The laws that give their own `allowable_force`, by family, for
+    /// [`AllowablesInput::check`].
+    pub fn law_allowables(&self) -> Vec<LawAllowable<'_>> {
+        [(false, Family::PinPin), (true, Family::PinWall)]
+            .into_iter()
+            .filter_map(|(wall, family)| {
+                let (_, _, law, pointer) = self.family(wall);
+                law.allowable_force.map(|_| LawAllowable { family, pointer })
+            })
+            .collect()
     }
 
     /// Every problem of the two laws, at their pointers: the physics' own check of a
@@ -352,6 +373,13 @@ pub struct HexOutputInput {
     /// volume and depth after it, at the run's wear power. Required with a `wear`.
     #[schema(exclusive_minimum = 0.0)]
     pub service_time: Option<f64>,
+    /// What the contacts and the clad may carry (docs/margins.md): each contact's peak
+    /// force and each pin's largest stress over them, as utilisation ratios. Families:
+    /// `pin_pin` (a wire on a neighbour's clad), `pin_wall` (a wire on the wrapper). None
+    /// by default.
+    #[serde(default)]
+    #[schema(default = json!({}))]
+    pub allowables: AllowablesInput,
 }
 
 /// A selection of contacts: `all`, `none`, `walls`, `list`, `levels` or `rings`.

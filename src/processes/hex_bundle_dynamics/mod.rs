@@ -21,6 +21,7 @@ use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::{FrictionReport, LawInput, WearDepth, WearReport};
 use super::excitation::{PlaneSignal, plane_signal};
 use super::impact_report;
+use super::margins::PinUtilisation;
 use super::run_report::{self, ContactStatistics, LineExtremes, RunSize, RunSummary};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
@@ -213,6 +214,9 @@ pub struct HexPinResult {
     /// Its largest bending (the resultant of x and y) over its height and the output
     /// samples.
     pub bending: Bending,
+    /// Its utilisations against `output.allowables` (null without them).
+    #[serde(flatten)]
+    pub utilisation: PinUtilisation,
 }
 
 /// A pin's largest resultant deflection.
@@ -335,6 +339,14 @@ impl Simulation for HexBundleDynamics {
             }
         });
         errors.extend(contact_law_errors(&inputs));
+        // D is required above: without it, the stress is refused there, not here.
+        let allowables = &inputs.output.allowables;
+        allowables.check(
+            "/inputs/output/allowables",
+            true,
+            &inputs.contact.law_allowables(),
+            &mut errors,
+        );
         errors.extend(
             inputs
                 .closure_issues()
@@ -488,7 +500,15 @@ impl Simulation for HexBundleDynamics {
         let laws: Vec<&LawInput> = (plan.contacts.iter())
             .map(|c| plan.inputs.contact.family(c.right == RowBody::Wall).2)
             .collect();
-        let allowables: Vec<Option<f64>> = laws.iter().map(|law| law.allowable()).collect();
+        let given = &plan.inputs.output.allowables;
+        let allowables: Vec<Option<f64>> = (plan.contacts.iter())
+            .map(|c| {
+                plan.inputs
+                    .contact
+                    .allowable_force(c.right == RowBody::Wall, given)
+            })
+            .collect();
+        let allowable_stress = given.stress;
         let service_time = plan.inputs.output.service_time.unwrap_or(0.0);
         let contacts: Vec<HexContactResult> = (plan.geometry.iter().zip(&plan.contacts))
             .zip(ContactStatistics::of_run(&simulation, &allowables))
@@ -536,6 +556,10 @@ impl Simulation for HexBundleDynamics {
         let pins: Vec<HexPinResult> = (0..pin_count)
             .map(|p| {
                 let position = plan.bundle.position(p);
+                let bending = flexure.bending(&simulation.pin_curvatures[p]);
+                let on_pin = (contacts.iter())
+                    .filter(|c| c.wire_pin == p || c.touched_pin == Some(p))
+                    .map(|c| c.statistics.utilisation);
                 HexPinResult {
                     pin: p,
                     ring: plan.bundle.lattice().ring(p),
@@ -543,7 +567,8 @@ impl Simulation for HexBundleDynamics {
                     x: LineExtremes::of_line(&simulation, heights, p),
                     y: LineExtremes::of_line(&simulation, heights, pin_count + p),
                     deflection: ResultantDeflection::of(&simulation.resultant_extremes[p]),
-                    bending: flexure.bending(&simulation.pin_curvatures[p]),
+                    utilisation: PinUtilisation::of(&bending, allowable_stress, on_pin),
+                    bending,
                 }
             })
             .collect();
@@ -563,7 +588,7 @@ impl Simulation for HexBundleDynamics {
                 &simulation,
                 quality,
                 &plan.settings,
-                &allowables,
+                (&allowables, allowable_stress),
                 (basis, plan.basis.frequencies_hz()),
                 &flexure,
             ),

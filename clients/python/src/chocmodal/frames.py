@@ -112,6 +112,10 @@ PIN_UNITS: dict[str, str] = {
     "moment": "N·m",
     "stress": "Pa",
     "strain": "1",
+    # Margins (docs/margins.md): utilisations against `output.allowables`.
+    "stress_utilisation": "1",
+    "contact_utilisation": "1",
+    "utilisation": "1",
 }
 
 

@@ -44,6 +44,7 @@ pub const ASSETS: &[Asset] = &[
     asset!("job.js", JS),
     asset!("hex.js", JS),
     asset!("impacts.js", JS),
+    asset!("margins.js", JS),
     asset!("spectra.js", JS),
     asset!("signals.js", JS),
     asset!("sweep.js", JS),

@@ -14,10 +14,11 @@ import {barChart, figure, svgElement as s, viridis} from './plot.js';
 import {linePlot} from './lines.js';
 import {envelope, envelopeSeries, history, qualityBadge, reportedPeak, seriesOf, thinned} from './job.js';
 import {STATISTICS, contactImpacts, impactsCard, statisticPicker} from './impacts.js';
+import {band, marginsCard} from './margins.js';
 
 /**
  * What the segments may be coloured by: every impact statistic, the wear work rate, and
- * where the contact laws give them (docs/contact-laws.md) the utilisation, friction's
+ * where the contact laws or `output.allowables` give them (docs/margins.md) the utilisation, friction's
  * wear power and slip, and the Archard wear depth.
  */
 const WEAR = {wear_work_rate: {label: 'wear work rate', unit: 'W', of: (c) => c.wear_work_rate}};
@@ -31,7 +32,7 @@ const MEASURES = {...STATISTICS, ...WEAR, ...LAWS};
 
 /** The measures of the laws some contact of the run reports. */
 function lawMeasures(contacts) {
-  return Object.fromEntries(Object.entries(LAWS).filter(([, m]) => contacts.some((c) => m.of(c) !== undefined)));
+  return Object.fromEntries(Object.entries(LAWS).filter(([, m]) => contacts.some((c) => m.of(c) != null)));
 }
 const SIZE = 560;
 
@@ -54,12 +55,14 @@ export async function hexBundle(box, id, results) {
     ['steps', fmt(results.steps)],
     ['energy balance residual', `${fmt(energy.relative_residual, 3)} (relative)`],
   ])));
-  if (contacts.length && pins.length) box.append(crossSectionCard(id, results, levels, contacts, pins, peak));
   const describe = (k) => {
     const c = contacts[k];
     return `c${k}: pin ${c.wire_pin} on ${c.touched_pin === null ? `flat ${c.touched_flat}` : `pin ${c.touched_pin}`}` +
       ` at level ${c.level}`;
   };
+  const margins = marginsCard({margins: results, contacts, pins, describe});
+  if (margins) box.append(margins);
+  if (contacts.length && pins.length) box.append(crossSectionCard(id, results, levels, contacts, pins, peak));
   const impacts = impactsCard(results, results.impact_summary, describe);
   if (impacts) box.append(impacts);
   if (pins.length) box.append(await pinsCard(id, results, pins));
@@ -97,7 +100,7 @@ function crossSectionCard(id, results, levels, contacts, pins, peak) {
       ['max force', `${withUnit(c.max_force, 'N')} at ${withUnit(c.max_force_time, 's')}`],
       ['impacts', fmt(c.impacts)], ['time in contact', withUnit(c.contact_time, 's')],
       ['impulse', withUnit(c.impulse, 'N·s')], ['wear work rate', withUnit(c.wear_work_rate, 'W')],
-      ...(c.utilisation === undefined ? [] : [['utilisation', fmt(c.utilisation, 3)]]),
+      ...(c.utilisation == null ? [] : [['utilisation', fmt(c.utilisation, 3)]]),
       ...(c.friction ? [
         ['tangential force', `mean ${withUnit(c.friction.mean_tangential_force, 'N')}, RMS ` +
           `${withUnit(c.friction.rms_tangential_force, 'N')}, max ${withUnit(c.friction.max_tangential_force, 'N')}`],
@@ -149,9 +152,11 @@ function crossSection(results, pins, contacts, level, shown, measure, selected, 
   const valueOf = (c) => m.of(c) ?? 0;
   const top = Math.max(...contacts.map(valueOf), 0) || 1;
   const radius = (g.pin_diameter / 2) * scale;
-  const circles = pins.map((p) => s('circle', {class: 'pin', cx: X(p.position[0]).toFixed(1), cy: Y(p.position[1]).toFixed(1),
-    r: radius.toFixed(1), fill: '#eef1f4', stroke: '#9aa5b1', 'data-pin': p.pin},
-  s('title', {}, `pin ${p.pin} (ring ${p.ring})`)));
+  // Pins filled by their utilisation's band when the run has allowables (margins.js).
+  const circles = pins.map((p) => s('circle', {class: band(p.utilisation) ? `pin margin-${band(p.utilisation)}` : 'pin',
+    cx: X(p.position[0]).toFixed(1), cy: Y(p.position[1]).toFixed(1),
+    r: radius.toFixed(1), fill: '#eef1f4', stroke: '#9aa5b1', 'data-pin': p.pin, 'data-band': band(p.utilisation)},
+  s('title', {}, `pin ${p.pin} (ring ${p.ring})` + (p.utilisation == null ? '' : `, utilisation ${fmt(p.utilisation, 3)}`))));
   const numbers = pins.length <= 61 ? pins.map((p) => s('text', {class: 'tick', x: X(p.position[0]).toFixed(1),
     y: (Y(p.position[1]) + 4).toFixed(1), 'text-anchor': 'middle'}, p.pin)) : [];
   const segments = shown.map((k) => {

@@ -17,6 +17,7 @@ import {linePlot} from './lines.js';
 import {hexBundle} from './hex.js';
 import {responseSpectrumCard} from './spectra.js';
 import {STATISTICS, contactImpacts, impactsCard, statisticPicker} from './impacts.js';
+import {band, marginsCard} from './margins.js';
 
 /** Points asked of a history for a plot (min/max thinning keeps every peak). */
 const PLOT_POINTS = 2400;
@@ -243,6 +244,11 @@ async function cantilever(box, id, results) {
         row('time step', `${fmt(n.time_step)} (critical ${fmt(n.critical_time_step)})`, '', 's'),
         row('modes', fmt((n.frequencies_hz || []).length), fmt(r.modes)))),
     (r.notes || []).map((note) => h('p', {class: 'muted'}, note))));
+  append(box, marginsCard({
+    margins: {worst_utilisation: n.worst_utilisation, max_stress_utilisation: n.max_stress_utilisation,
+      max_utilisation: n.utilisation === null || n.utilisation === undefined ? null
+        : {contact: 0, utilisation: n.utilisation, force: n.max_contact_force, allowable_force: n.allowable_force}},
+    contacts: [{utilisation: n.utilisation}], describe: () => 'the tip contact'}));
   append(box, impactsCard(results, n.impact_summary, () => 'the tip contact'),
     card('Impacts of the tip contact', contactImpacts(id, 0, {impact_statistics: n.impact_statistics})));
   const plots = h('div');
@@ -311,6 +317,8 @@ async function bundle(box, id, results) {
     ['steps', fmt(results.steps)],
     ['energy balance residual', `${fmt(energy.relative_residual, 3)} (relative)`],
   ])));
+  const describe = (k) => `c${k}: ${side(contacts[k].left)} – ${side(contacts[k].right)} at ${fmt(contacts[k].height)} m`;
+  append(box, marginsCard({margins: results, contacts, pins, describe}));
   if (contacts.length) {
     // Columns: the places between two neighbours, left to right; rows: the levels, top up.
     const positions = [];
@@ -325,7 +333,11 @@ async function bundle(box, id, results) {
     let statistic = 'max_force';
     let selected = contacts.reduce((best, c, k) => (c.max_force > contacts[best].max_force ? k : best), 0);
     const gridBox = h('div');
-    const statistics = statisticPicker((key) => { statistic = key; drawGrid(); });
+    // With allowables (docs/margins.md) the grid may show each contact's utilisation.
+    const extra = contacts.some((c) => c.utilisation != null)
+      ? {utilisation: {label: 'utilisation (peak / allowable)', unit: '', of: (c) => c.utilisation}} : {};
+    const measures = {...STATISTICS, ...extra};
+    const statistics = statisticPicker((key) => { statistic = key; drawGrid(); }, extra);
     const picker = h('select', {'aria-label': 'contact', 'data-picker': 'contact',
       onchange: (event) => select(Number(event.target.value))},
     contacts.map((c, k) => h('option', {value: k},
@@ -333,7 +345,7 @@ async function bundle(box, id, results) {
     const detail = h('div');
     const plotBox = h('div');
     const drawGrid = () => {
-      const m = STATISTICS[statistic];
+      const m = measures[statistic];
       const value = (c) => m.of(c) ?? 0;
       const top = Math.max(...contacts.map(value), 0);
       replace(gridBox, heatMap({id: 'max-force-grid', title: `${m.label[0].toUpperCase()}${m.label.slice(1)} by level and position`,
@@ -373,17 +385,19 @@ async function bundle(box, id, results) {
     };
     append(box, card('Contact forces', h('p', {class: 'inline'}, h('label', {}, 'Show ', statistics)), gridBox,
       h('p', {class: 'inline'}, h('label', {}, 'Contact ', picker)), detail, plotBox, impactsBox),
-    impactsCard(results, results.impact_summary,
-      (k) => `c${k}: ${side(contacts[k].left)} – ${side(contacts[k].right)} at ${fmt(contacts[k].height)} m`));
+    impactsCard(results, results.impact_summary, describe));
     await select(selected);
   }
   if (pins.length) {
     const pinBox = h('div');
     const barBox = h('div');
     const drawPin = async (p) => {
+      // Coloured by the pin's utilisation when the run has allowables (margins.js).
+      const bands = pins.some((x) => band(x.utilisation)) ? pins.map((x) => band(x.utilisation)) : null;
       replace(barBox, barChart({id: 'pin-deflection', title: 'Largest |deflection| per pin', labels: pins.map((x) => `${x.pin}`),
         values: pins.map((x) => x.max_abs_deflection), yLabel: 'max |w| (m)', xLabel: 'pin', selected: p,
-        onselect: drawPin}));
+        onselect: drawPin, bands,
+        caption: bands ? h('span', {class: 'muted'}, ' coloured by utilisation: green < 0.8 ≤ amber < 1 ≤ red') : null}));
       try {
         const names = await seriesNames(id, 'displacements');
         const name = names.find((n) => n === `p${p}`) || names.find((n) => n.startsWith(`p${p}@`)) || names[0];

@@ -261,20 +261,28 @@ export function histogram({id, title, caption, values, xLabel, bins, markers = [
     {'data-values': finite.length});
 }
 
-/** A bar chart: one bar per label; `selected` index highlighted; `onselect(k)` on click. */
-export function barChart({id, title, caption, labels, values, yLabel, xLabel, selected = -1, onselect}) {
+/**
+ * A bar chart: one bar per label; `selected` index highlighted; `onselect(k)` on click;
+ * `bands` (optional) a utilisation band per bar
+ * (`ok`, `near`, `over` or null: margins.js) colouring it; `reference` a value drawn as a
+ * dashed line (a utilisation of 1).
+ */
+export function barChart({id, title, caption, labels, values, yLabel, xLabel, selected = -1, onselect, bands = null,
+  reference = null}) {
   const margin = {left: 78, right: 18, top: 14, bottom: 46};
   const width = WIDTH;
   const height = 220;
   const plotW = width - margin.left - margin.right;
   const plotH = height - margin.top - margin.bottom;
-  const top = Math.max(...values.filter(Number.isFinite), 0) || 1;
+  const top = Math.max(...values.filter(Number.isFinite), reference ?? 0, 0) || 1;
   const bw = plotW / Math.max(1, values.length);
   const Y = (v) => margin.top + plotH - (v / top) * plotH;
   const bars = values.map((v, k) => {
-    const bar = s('rect', {class: k === selected ? 'bar selected' : 'bar', x: round(margin.left + k * bw) + 0.5,
+    const band = bands ? bands[k] : null;
+    const bar = s('rect', {class: `bar${k === selected ? ' selected' : ''}${band ? ` margin-${band}` : ''}`,
+      x: round(margin.left + k * bw) + 0.5,
       y: round(Y(v)), width: Math.max(1, round(bw) - 1), height: round(margin.top + plotH - Y(v)),
-      'data-bar': labels[k], 'data-value': v}, s('title', {}, `${labels[k]}: ${fmt(v)}`));
+      'data-bar': labels[k], 'data-value': v, 'data-band': band}, s('title', {}, `${labels[k]}: ${fmt(v)}`));
     if (onselect) bar.addEventListener('click', () => onselect(k));
     return bar;
   });
@@ -290,8 +298,10 @@ export function barChart({id, title, caption, labels, values, yLabel, xLabel, se
         'text-anchor': 'middle'}, label));
     }
   });
+  const line = reference === null ? null : s('line', {class: 'reference', x1: margin.left, x2: margin.left + plotW,
+    y1: round(Y(reference)), y2: round(Y(reference)), 'data-reference': reference});
   const svg = s('svg', {viewBox: `0 0 ${width} ${height}`, role: 'img', 'aria-label': title, class: 'chart'},
-    ticks, bars, s('rect', {class: 'frame', x: margin.left, y: margin.top, width: plotW, height: plotH}),
+    ticks, bars, line, s('rect', {class: 'frame', x: margin.left, y: margin.top, width: plotW, height: plotH}),
     axisLabels(width, height, margin, xLabel, yLabel));
   return figure(id, title, caption || null, svg);
 }
