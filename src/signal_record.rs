@@ -31,6 +31,7 @@ use serde::Deserialize;
 
 use crate::physics::loads::Table;
 use crate::processes::FieldError;
+pub use crate::processes::excitation::{AccelerationUnit, STANDARD_GRAVITY};
 
 mod at2;
 
@@ -68,40 +69,6 @@ pub enum RecordError {
     /// 413 `payload-too-large`: more samples than the limit.
     #[error("the record has {samples} samples, more than the limit of {limit}")]
     TooLarge { samples: usize, limit: usize },
-}
-
-/// The standard gravity (m/s²): 1 g.
-pub const STANDARD_GRAVITY: f64 = 9.80665;
-
-/// The unit of a record's accelerations.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, Deserialize, utoipa::ToSchema)]
-pub enum AccelerationUnit {
-    /// m/s² (the default).
-    #[default]
-    #[serde(rename = "m/s2")]
-    MetresPerSecondSquared,
-    /// The standard gravity, 9.80665 m/s².
-    #[serde(rename = "g")]
-    G,
-}
-
-impl AccelerationUnit {
-    /// From its name in a query: `m/s2` (also `m/s^2`, `m/s²`) or `g`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "m/s2" | "m/s^2" | "m/s²" => Some(Self::MetresPerSecondSquared),
-            "g" => Some(Self::G),
-            _ => None,
-        }
-    }
-
-    /// m/s² per unit.
-    pub fn factor(self) -> f64 {
-        match self {
-            Self::MetresPerSecondSquared => 1.0,
-            Self::G => STANDARD_GRAVITY,
-        }
-    }
 }
 
 /// Parses and checks a record of at most `max_samples` samples, into m/s².

@@ -8,7 +8,40 @@ use crate::physics::loads::{BaseAcceleration, Pulse, Table};
 use crate::processes::FieldError;
 use crate::processes::common_inputs::at;
 use crate::processes::input_schema::NonNegativeNumber;
-use crate::signal_record::AccelerationUnit;
+
+/// The standard gravity (m/s²): 1 g.
+pub const STANDARD_GRAVITY: f64 = 9.80665;
+
+/// The unit of a record's accelerations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, Deserialize, ToSchema)]
+pub enum AccelerationUnit {
+    /// m/s² (the default).
+    #[default]
+    #[serde(rename = "m/s2")]
+    MetresPerSecondSquared,
+    /// The standard gravity, 9.80665 m/s².
+    #[serde(rename = "g")]
+    G,
+}
+
+impl AccelerationUnit {
+    /// From its name in a query: `m/s2` (also `m/s^2`, `m/s²`) or `g`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "m/s2" | "m/s^2" | "m/s²" => Some(Self::MetresPerSecondSquared),
+            "g" => Some(Self::G),
+            _ => None,
+        }
+    }
+
+    /// m/s² per unit.
+    pub fn factor(self) -> f64 {
+        match self {
+            Self::MetresPerSecondSquared => 1.0,
+            Self::G => STANDARD_GRAVITY,
+        }
+    }
+}
 
 /// Base acceleration a(t) (m/s²), positive toward the right wall (the +x axis of a
 /// hexagonal bundle's direction), starting at t = 0.

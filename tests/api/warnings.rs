@@ -89,6 +89,17 @@ fn has(warnings: &[(String, String)], code: &str, pointer: &str) -> bool {
     warnings.iter().any(|(c, p)| c == code && p == pointer)
 }
 
+/// The message of the warning with `code` in a 201 body.
+fn message_of(body: &Value, code: &str) -> String {
+    let warning = body["warnings"]
+        .as_array()
+        .and_then(|all| all.iter().find(|w| w["code"] == code));
+    let message = warning.and_then(|w| w["message"].as_str());
+    message
+        .unwrap_or_else(|| panic!("no {code} warning: {body}"))
+        .to_owned()
+}
+
 /// The first frequency (Hz) of a clamped-free tube: λ₁² √(EI/m) / (2π L²), λ₁ = 1.875104.
 fn clamped_free_first_frequency(
     length: f64,
@@ -472,15 +483,7 @@ async fn a_static_correction_that_shrinks_the_step_is_flagged_with_its_cost() {
         ),
         "{body}"
     );
-    let message = body["warnings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|w| w["code"] == "costly_static_correction")
-        .unwrap()["message"]
-        .as_str()
-        .unwrap()
-        .to_owned();
+    let message = message_of(&body, "costly_static_correction");
     let ratio = number_before(&message, "times smaller");
     assert!(ratio > 4.0, "{message}");
     inputs["pin"]["static_correction"] = json!("none");
@@ -509,15 +512,7 @@ async fn a_run_that_ends_before_its_record_is_flagged_with_the_record_end() {
         has(&found, "excitation_outlasts_run", "/inputs/solver/duration"),
         "{body}"
     );
-    let message = body["warnings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|w| w["code"] == "excitation_outlasts_run")
-        .unwrap()["message"]
-        .as_str()
-        .unwrap()
-        .to_owned();
+    let message = message_of(&body, "excitation_outlasts_run");
     assert!(message.contains(&format!("({record_end} s)")), "{message}");
     inputs["solver"]["duration"] = json!(record_end);
     let body = accepted(&app, "bundle-dynamics", &inputs).await;
