@@ -72,7 +72,7 @@ pub enum BaseAccelerationInput {
         /// Sample times (s), at least two, ≥ 0 and strictly increasing.
         #[schema(value_type = Vec<NonNegativeNumber>)]
         time: Vec<f64>,
-        /// Acceleration at each time, in `unit`.
+        /// Acceleration at each time (m/s², or g when `unit` is `g`).
         acceleration: Vec<f64>,
         /// The unit of `acceleration`: `m/s2` (the default) or `g` (9.80665 m/s²).
         #[serde(default)]
