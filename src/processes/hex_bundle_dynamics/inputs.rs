@@ -164,9 +164,8 @@ impl HexContactInput {
         }
     }
 
-    /// The family of a pin–wrapper contact (`wall`) or a pin–pin one, and the
-    /// allowable force of its contacts (N): the law's `allowable_force`, else the
-    /// family's in `allowables`.
+    /// The allowable force (N) of the contacts of one family (pin–wrapper when `wall`,
+    /// else pin–pin): the law's `allowable_force`, else the family's in `allowables`.
     pub fn allowable_force(&self, wall: bool, allowables: &AllowablesInput) -> Option<f64> {
         let family = if wall { Family::PinWall } else { Family::PinPin };
         self.family(wall).2.allowable().or(allowables.force_of(family))
