@@ -83,6 +83,23 @@ pub struct CurvaturePeak {
     pub time: f64,
 }
 
+/// The largest resultant of the contact forces on one pin at one contact height: the
+/// vector sum of every contact there acting on the pin (normal and friction forces;
+/// the contacts on both of its sides at once), its magnitude tracked at every step.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct ResultantPeak {
+    /// The pin.
+    pub pin: usize,
+    /// The contact height (m).
+    pub height: f64,
+    /// How many of the model's contacts act on the pin at this height.
+    pub contacts: usize,
+    /// max |Σ F| (N), ≥ 0; 0 when none of them ever closed.
+    pub force: f64,
+    /// When (s): the step's time (0 when it never closed).
+    pub time: f64,
+}
+
 /// The deflection of largest magnitude at one height of one pin, over every step.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct PeakDeflection {

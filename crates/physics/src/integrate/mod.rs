@@ -43,6 +43,7 @@
 
 pub use super::statistics::{
     ContactStatistics, CurvaturePeak, EnergyBalance, FrictionStatistics, PeakDeflection, PinExtreme,
+    ResultantPeak,
 };
 use crate::InputIssue;
 pub use crate::impacts::{ImpactCounting, ImpactHistogram, ImpactStatistics, ImpactTable};
@@ -141,6 +142,9 @@ pub struct Simulation {
     /// Per pin, its largest curvature over its nodes and the samples (in the plane, the
     /// resultant), where and when.
     pub pin_curvatures: Vec<CurvaturePeak>,
+    /// Per pin and contact height where a contact acts on it (by pin, then height), the
+    /// largest resultant of those contacts' forces on the pin, at every step.
+    pub resultant_forces: Vec<ResultantPeak>,
     /// Energy balance at the end of the run.
     pub energy: EnergyBalance,
     /// Mechanical energy (kinetic + strain + contact) per sample (J).
@@ -178,6 +182,7 @@ mod plan;
 mod plane_step;
 pub mod quality;
 mod recorder;
+mod resultants;
 mod state;
 pub mod step_size;
 mod stepper;
@@ -208,3 +213,5 @@ mod thread_tests;
 mod bending_tests;
 #[cfg(test)]
 mod law_tests;
+#[cfg(test)]
+mod resultant_tests;

@@ -8,6 +8,7 @@ use pulp::Simd;
 
 use super::kernels::level_deflections;
 use super::layout::{ContactModel, Layout};
+use super::resultants::Resultants;
 use super::state::State;
 use super::{
     ContactStatistics, CurvaturePeak, EnergyBalance, FrictionStatistics, PeakDeflection, PinExtreme,
@@ -79,6 +80,8 @@ pub(super) struct Recorder {
     /// The height of every mesh node (m), as the decimal it stands for: computed once,
     /// not at every sample.
     node_heights: Vec<f64>,
+    /// The resultant contact force on every pin at every contact height (every step).
+    pub resultants: Resultants,
 }
 
 impl Recorder {
@@ -146,6 +149,7 @@ impl Recorder {
                 })
                 .collect(),
             node_heights,
+            resultants: Resultants::new(layout),
             pin_curvatures: (0..layout.model.pins)
                 .map(|pin| CurvaturePeak {
                     pin,
@@ -447,6 +451,7 @@ impl Recorder {
             curvatures: self.curvatures,
             curvature_envelope: self.curvature_envelope,
             pin_curvatures: self.pin_curvatures,
+            resultant_forces: self.resultants.finish(),
             energy: self.energy,
             mechanical_energy: self.mechanical_energy,
         }

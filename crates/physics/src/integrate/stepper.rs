@@ -183,6 +183,7 @@ impl<'m> Integrator<'m> {
             ..
         } = &mut integrator;
         recorder.record_initial_contacts(layout, state);
+        recorder.resultants.track(layout, state, 0);
         let (base_x, base_y) = base_accelerations(model, 0.0);
         let (row, pins) = (layout.row, model.pins);
         if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
@@ -266,6 +267,7 @@ impl<'m> Integrator<'m> {
                 gaps,
                 contact_state,
             );
+            state.closed_count = count;
             if threads > 1 {
                 return shared_plane_contact_forces(
                     simd,
@@ -288,6 +290,7 @@ impl<'m> Integrator<'m> {
             );
         }
         let count = penetrations(simd, &layout.contacts, deflections, gaps, contact_state);
+        state.closed_count = count;
 
         let (mut dissipation_power, mut wall_power) = (0.0, 0.0);
         let walls = layout.walls.as_ref().zip(state.wall.as_ref());
@@ -436,6 +439,7 @@ impl<'m> Integrator<'m> {
             threads,
             ..
         } = self;
+        recorder.resultants.track(layout, state, n);
         if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
             transport_outputs(layout, walls, wall, &mut state.level_deflections);
         }
