@@ -90,6 +90,7 @@ fn main() {
         gap: 0.0,
         damping_ratios: vec![0.01],
         tip_displacement: 1e-3,
+        tip_velocity: 0.0,
         duration: 0.5,
         modes: 30,
         max_events: 100_000,

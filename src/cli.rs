@@ -213,10 +213,19 @@ fn write_histories(dir: &Path, output: &RunOutput) -> Result<(), String> {
         };
         std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
-    if let Some(table) = crate::contact_table::ContactTable::of(&output.document) {
-        let text = table.to_csv();
-        let path = dir.join("contacts.csv");
-        std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    // The run's tables beside its histories, by the writer the service serves them with.
+    use crate::contact_table::{ContactTable, PinTable, ResultantTable};
+    let document = &output.document;
+    let tables = [
+        ("contacts.csv", ContactTable::of(document).map(|t| t.to_csv())),
+        ("pins.csv", PinTable::of(document).map(|t| t.to_csv())),
+        ("resultants.csv", ResultantTable::of(document).map(|t| t.to_csv())),
+    ];
+    for (name, text) in tables {
+        if let Some(text) = text {
+            let path = dir.join(name);
+            std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        }
     }
     Ok(())
 }

@@ -1,11 +1,17 @@
-//! The per-contact statistics table of a results document: one row per entry of its
-//! `contacts` list, in input order, with `contact` (the index k of the history column
-//! `c<k>`) then every scalar of the entry, dotted (its description, statistics, impact
-//! statistics, friction and wear: `left`, `max_force`, `impact_statistics.impacts`).
+//! The tables of a results document, one row per entry of one of its lists:
+//! - [`ContactTable`]: the per-contact statistics, one row per entry of `contacts` in input
+//!   order, with `contact` (the index k of the history column `c<k>`) then every scalar
+//!   of the entry, dotted (its description, statistics, impact statistics, friction and
+//!   wear: `left`, `max_force`, `impact_statistics.impacts`);
+//! - [`PinTable`]: one row per entry of `pins` (every scalar: deflections, bending stress
+//!   and strain, utilisations, the largest resultant contact force);
+//! - [`ResultantTable`]: one row per pin and contact height, `pin` then the scalars of
+//!   each entry of the pin's `resultant_forces`.
 //!
-//! One writer for every place the table goes: `chocmodal run --out DIR` writes
-//! `DIR/contacts.csv`, and `GET /jobs/{jobId}/results/contacts` serves it as CSV or JSON
-//! (the same columns, the same values).
+//! One writer for every place a table goes: `chocmodal run --out DIR` writes
+//! `DIR/contacts.csv`, `DIR/pins.csv` and `DIR/resultants.csv`, and `GET
+//! /jobs/{jobId}/results/contacts` (`pins`, `resultants`) serves each as CSV or JSON (the
+//! same columns, the same values).
 
 use serde::Serialize;
 use serde_json::{Map, Value};
@@ -25,49 +31,125 @@ pub struct ContactTable {
     pub contacts: Vec<Map<String, Value>>,
 }
 
+/// The per-pin table: its columns and one flat record per pin.
+#[derive(Debug, Clone, PartialEq, Serialize, utoipa::ToSchema)]
+pub struct PinTable {
+    /// Column names: `pin`, then every scalar member some pin has, dotted
+    /// (`bending.stress`, `max_resultant_force.max_force`), in order of first appearance.
+    pub columns: Vec<String>,
+    /// One record per pin, units as in the results document (m, s, N·m, Pa, N).
+    #[schema(value_type = Vec<Object>)]
+    pub pins: Vec<Map<String, Value>>,
+}
+
+/// The resultant contact forces: one flat record per pin and contact height.
+#[derive(Debug, Clone, PartialEq, Serialize, utoipa::ToSchema)]
+pub struct ResultantTable {
+    /// Column names: `pin`, `height` (m), `contacts`, `max_force` (N), `time` (s).
+    pub columns: Vec<String>,
+    /// One record per pin and height where a contact acts on it, by pin then height.
+    #[schema(value_type = Vec<Object>)]
+    pub resultants: Vec<Map<String, Value>>,
+}
+
+/// Columns (the union of the records' names, first seen first) and records.
+type Rows = (Vec<String>, Vec<Map<String, Value>>);
+
+/// The rows of `records`, each a list of (name, scalar).
+fn rows(records: impl Iterator<Item = Vec<(String, Value)>>) -> Rows {
+    let mut columns: Vec<String> = Vec::new();
+    let rows = records
+        .map(|pairs| {
+            let mut record = Map::new();
+            for (name, value) in pairs {
+                if !columns.contains(&name) {
+                    columns.push(name.clone());
+                }
+                record.insert(name, value);
+            }
+            record
+        })
+        .collect();
+    (columns, rows)
+}
+
+/// CSV: the columns as header, a row per record; a member a record lacks is an empty
+/// cell. Numbers and quoting as [`csv_format`] writes them.
+fn csv(columns: &[String], records: &[Map<String, Value>]) -> String {
+    let header: Vec<String> = columns
+        .iter()
+        .map(|c| csv_format::quote(c).into_owned())
+        .collect();
+    let mut out = header.join(",");
+    out.push('\n');
+    for record in records {
+        let cells: Vec<String> = columns
+            .iter()
+            .map(|name| record.get(name).map_or_else(String::new, csv_format::cell))
+            .collect();
+        out.push_str(&cells.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// The non-empty list `name` of a results document.
+fn list<'a>(document: &'a Value, name: &str) -> Option<&'a Vec<Value>> {
+    document[name].as_array().filter(|entries| !entries.is_empty())
+}
+
 impl ContactTable {
     /// The table of a results document; `None` for a process without a contact list.
     pub fn of(document: &Value) -> Option<ContactTable> {
-        let entries = document["contacts"].as_array().filter(|c| !c.is_empty())?;
-        let mut columns = vec!["contact".to_owned()];
-        let contacts = entries
-            .iter()
-            .enumerate()
-            .map(|(k, entry)| {
-                let mut record = Map::new();
-                record.insert("contact".into(), Value::from(k));
-                for (name, value) in flatten_scalars(entry) {
-                    if !columns.contains(&name) {
-                        columns.push(name.clone());
-                    }
-                    record.insert(name, value);
-                }
-                record
-            })
-            .collect();
+        let entries = list(document, "contacts")?;
+        let records = entries.iter().enumerate().map(|(k, entry)| {
+            let mut pairs = vec![("contact".to_owned(), Value::from(k))];
+            pairs.extend(flatten_scalars(entry));
+            pairs
+        });
+        let (columns, contacts) = rows(records);
         Some(ContactTable { columns, contacts })
     }
 
-    /// CSV: the columns as header, a row per contact; a member a contact lacks is an
-    /// empty cell. Numbers and quoting as [`csv_format`] writes them.
+    /// The table as CSV ([`csv`]).
     pub fn to_csv(&self) -> String {
-        let header: Vec<String> = self
-            .columns
-            .iter()
-            .map(|c| csv_format::quote(c).into_owned())
-            .collect();
-        let mut out = header.join(",");
-        out.push('\n');
-        for record in &self.contacts {
-            let cells: Vec<String> = self
-                .columns
-                .iter()
-                .map(|name| record.get(name).map_or_else(String::new, csv_format::cell))
-                .collect();
-            out.push_str(&cells.join(","));
-            out.push('\n');
-        }
-        out
+        csv(&self.columns, &self.contacts)
+    }
+}
+
+impl PinTable {
+    /// The table of a results document; `None` for a process without a pin list.
+    pub fn of(document: &Value) -> Option<PinTable> {
+        let (columns, pins) = rows(list(document, "pins")?.iter().map(flatten_scalars));
+        Some(PinTable { columns, pins })
+    }
+
+    /// The table as CSV ([`csv`]).
+    pub fn to_csv(&self) -> String {
+        csv(&self.columns, &self.pins)
+    }
+}
+
+impl ResultantTable {
+    /// The table of a results document; `None` for a process whose pins report no
+    /// resultant contact forces.
+    pub fn of(document: &Value) -> Option<ResultantTable> {
+        let pins = list(document, "pins")?;
+        let records = pins.iter().flat_map(|pin| {
+            let entries = pin["resultant_forces"].as_array().map_or(&[][..], Vec::as_slice);
+            entries.iter().map(|entry| {
+                let mut pairs = vec![("pin".to_owned(), pin["pin"].clone())];
+                pairs.extend(flatten_scalars(entry));
+                pairs
+            })
+        });
+        let (columns, resultants) = rows(records);
+        (!resultants.is_empty()).then_some(ResultantTable { columns, resultants })
+    }
+
+    /// The table as CSV ([`csv`]).
+    pub fn to_csv(&self) -> String {
+        csv(&self.columns, &self.resultants)
     }
 }
 
@@ -108,5 +190,36 @@ mod tests {
     fn a_document_without_contacts_has_no_table() {
         assert_eq!(ContactTable::of(&json!({"numerical": {"impacts": 3}})), None);
         assert_eq!(ContactTable::of(&json!({"contacts": []})), None);
+        assert_eq!(PinTable::of(&json!({"numerical": {"impacts": 3}})), None);
+        assert_eq!(
+            ResultantTable::of(&json!({"pins": [{"pin": 0, "resultant_forces": []}]})),
+            None
+        );
+    }
+
+    #[test]
+    fn one_row_per_pin_and_one_per_pin_and_height_for_the_resultants() {
+        let document = json!({"pins": [
+            {"pin": 0, "bending": {"stress": 200}, "resultant_forces": [
+                {"height": 0.5, "contacts": 2, "max_force": 3.5, "time": 0.01},
+                {"height": 1.25, "contacts": 1, "max_force": 4.5, "time": 0.02}
+            ]},
+            {"pin": 1, "bending": {"stress": 100}, "resultant_forces": [
+                {"height": 1.25, "contacts": 1, "max_force": 0.5, "time": 0.03}
+            ]}
+        ]});
+        let pins = PinTable::of(&document).unwrap();
+        // The per-height list is an array: not a column of the pin table.
+        assert_eq!(pins.columns, ["bending.stress", "pin"]);
+        assert_eq!(pins.to_csv(), "bending.stress,pin\n200,0\n100,1\n");
+        let resultants = ResultantTable::of(&document).unwrap();
+        assert_eq!(
+            resultants.columns,
+            ["pin", "contacts", "height", "max_force", "time"]
+        );
+        assert_eq!(
+            resultants.to_csv(),
+            "pin,contacts,height,max_force,time\n0,2,0.5,3.5,0.01\n0,1,1.25,4.5,0.02\n1,1,1.25,0.5,0.03\n"
+        );
     }
 }

@@ -1,3 +1,7 @@
+    let output = run_piped(
+        &["run", "cantilever-impact", "-", "--out", out.to_str().unwrap()],
+        &body,
+    );
 //! The `chocmodal run` command through the real binary: results on stdout, histories
 //! and the per-impact table as CSV with `--out`, invalid inputs as a problem document on stderr with exit 2.
 
@@ -141,6 +145,21 @@ fn a_bundle_run_writes_its_contact_statistics_as_csv() {
         );
     }
     assert_numbers_canonical(&csv, "contacts.csv");
+    // The per-pin table and the resultants, one row per pin and per pin and height.
+    let pins = std::fs::read_to_string(out.join("pins.csv")).unwrap();
+    let pin_rows = document["pins"].as_array().unwrap();
+    assert_eq!(pins.lines().count(), 1 + pin_rows.len());
+    assert!(pins.lines().next().unwrap().contains("max_resultant_force.max_force"));
+    let resultants = std::fs::read_to_string(out.join("resultants.csv")).unwrap();
+    let per_height: usize = (pin_rows.iter())
+        .map(|p| p["resultant_forces"].as_array().unwrap().len())
+        .sum();
+    assert_eq!(
+        resultants.lines().next(),
+        Some("pin,contacts,height,max_force,time")
+    );
+    assert_eq!(resultants.lines().count(), 1 + per_height);
+    assert_numbers_canonical(&resultants, "resultants.csv");
     std::fs::remove_dir_all(&out).ok();
 }
 

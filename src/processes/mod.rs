@@ -38,6 +38,8 @@ pub mod random_gaps;
 pub mod report;
 /// Every missing member at once, with the other problems of the inputs.
 pub mod required;
+/// The resultant contact force on each pin at each contact height.
+pub mod resultants;
 /// What every run of pins with point contacts reports: per contact, per line, the run.
 pub mod run_report;
 /// The `signal` base acceleration: a stored accelerogram by id, or a file for the CLI.

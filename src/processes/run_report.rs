@@ -13,6 +13,7 @@ use super::contact_law;
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::margins::{self, RunMargins};
 use super::report::{EnergyReport, QualityReport};
+use super::resultants::RunResultant;
 use super::simulation::{HistoryKind, HistoryOutput};
 use super::{History, WorkEstimate, common_inputs};
 use crate::physics::discretisation::auto::Choice as BasisChoice;
@@ -137,6 +138,10 @@ impl PeakDeflectionResult {
 pub struct RunSummary {
     /// The largest force over all contacts; null without contacts.
     pub max_contact_force: Option<PeakForce>,
+    /// The largest resultant contact force on a pin at a contact height (the vector sum
+    /// of the contacts acting on it there, every step): which pin, where, when; null
+    /// without contacts.
+    pub max_resultant_force: Option<RunResultant>,
     /// The run's worst utilisations (docs/margins.md): `max_utilisation`,
     /// `max_stress_utilisation`, `worst_utilisation`; null without allowables.
     #[serde(flatten)]
@@ -188,6 +193,7 @@ impl RunSummary {
                     force: s.max_force,
                     time: s.max_force_time,
                 }),
+            max_resultant_force: RunResultant::of(run),
             margins: RunMargins::of(
                 contact_law::worst(&peaks, allowables),
                 &bending.max_bending,

@@ -168,6 +168,7 @@ impl Subject<'_> {
                 .is_some_and(|plane| plane.base_acceleration_y.is_some())
             || !model.point_forces.is_empty()
             || model.initial_tip_displacements.iter().any(|u| *u != 0.0)
+            || model.initial_tip_velocities.iter().any(|v| *v != 0.0)
             || model.walls.is_some()
     }
 }
@@ -295,8 +296,8 @@ pub fn assess(subject: &Subject<'_>, steps: f64) -> Vec<Warning> {
         warnings.push(Warning::new(
             WarningCode::NothingExcites,
             subject.excitation_pointer,
-            "nothing excites the model (no base acceleration, initial displacement or point force): every \
-             history will be zero",
+            "nothing excites the model (no base acceleration, initial displacement or velocity, or point \
+             force): every history will be zero",
         ));
     }
 

@@ -180,7 +180,7 @@ async fn a_point_force_along_theta_moves_its_pin_along_theta_by_the_rows_respons
 }
 
 #[tokio::test]
-async fn a_tip_release_along_theta_swings_its_pin_along_theta_like_the_row() {
+async fn a_tip_release_or_throw_along_theta_swings_its_pin_along_theta_like_the_row() {
     let app = spawn().await;
     let release = 1e-3;
     let mut row = lone_pin();
@@ -193,6 +193,19 @@ async fn a_tip_release_along_theta_swings_its_pin_along_theta_like_the_row() {
             {"pin": 5, "x": release * radians.cos(), "y": release * radians.sin()}]});
         let hex = run(&app, "hex-bundle-dynamics", hex).await;
         assert_turned_row("release", &hex, &row, 5, degrees);
+    }
+    // Thrown along θ from straight: the row's pin thrown at the same speed, turned.
+    let speed = 0.05;
+    let mut row = lone_pin();
+    row["initial"] = json!({"tip_velocities": [speed]});
+    let row = run(&app, "bundle-dynamics", row).await;
+    for degrees in [0.0, 37.0] {
+        let radians = f64::to_radians(degrees);
+        let mut hex = open_bundle();
+        hex["initial"] = json!({"tip_velocities": [
+            {"pin": 5, "x": speed * radians.cos(), "y": speed * radians.sin()}]});
+        let hex = run(&app, "hex-bundle-dynamics", hex).await;
+        assert_turned_row("throw", &hex, &row, 5, degrees);
     }
 }
 

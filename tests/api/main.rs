@@ -37,6 +37,7 @@ mod quality;
 mod recovery;
 mod response_spectra;
 mod responsiveness;
+mod resultants;
 mod results;
 mod robustness;
 mod scale_out;

@@ -229,6 +229,27 @@ def test_per_contact_statistics_are_a_frame_whose_max_force_is_the_peak_envelope
         assert sampled[column].max() <= contacts.loc[k, "max_force"] * (1 + 1e-12), "samples never exceed the peak"
 
 
+def test_resultant_contact_forces_are_a_frame_by_pin_and_height_bounded_by_the_contacts(bundle: chocmodal.Job) -> None:
+    resultants = bundle.resultants()
+    assert resultants.index.names == ["pin", "height"]
+    assert resultants.attrs["units"]["max_force"] == "N" and resultants.attrs["units"]["height"] == "m"
+    contacts = bundle.contacts()
+    for (pin, height), row in resultants.iterrows():
+        here = contacts[(contacts["height"] == height) & ((contacts["left"] == pin) | (contacts["right"] == pin))]
+        assert row["contacts"] == len(here), (pin, height)
+        if len(here) == 1:
+            assert row["max_force"] == pytest.approx(here["max_force"].iloc[0], rel=1e-12), "a lone contact's resultant is its peak"
+        else:
+            assert row["max_force"] <= here["max_force"].sum() * (1 + 1e-12)
+    results = bundle.results()
+    for entry in results["pins"]:
+        largest = resultants.loc[entry["pin"], "max_force"].max()
+        assert entry["max_resultant_force"]["max_force"] == largest
+    assert results["max_resultant_force"]["max_force"] == resultants["max_force"].max()
+    # The per-pin frame keeps one row per pin; the per-height list is the frame above.
+    assert "resultant_forces" not in bundle.pins().columns
+
+
 def test_the_impact_table_holds_every_impact_of_every_contact(bundle: chocmodal.Job) -> None:
     results = bundle.results()
     assert results["impact_summary"]["untabulated"] == 0

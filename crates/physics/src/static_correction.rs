@@ -423,6 +423,7 @@ mod tests {
             damping_ratios: vec![0.0; 5],
             contacts: vec![tip_wall(1e5)],
             initial_tip_displacements: vec![0.0],
+            initial_tip_velocities: vec![],
             base_acceleration: None,
             walls: None,
             plane: None,
@@ -494,6 +495,7 @@ mod tests {
             damping_ratios: vec![0.02; basis.modes()],
             contacts,
             initial_tip_displacements: tips.to_vec(),
+            initial_tip_velocities: vec![],
             base_acceleration: shock.then_some(BaseAcceleration::HalfSine {
                 amplitude: 20.0,
                 duration: 0.01,

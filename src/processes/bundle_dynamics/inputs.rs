@@ -430,6 +430,13 @@ pub struct InitialInput {
     #[serde(default)]
     #[schema(default = json!([]))]
     pub tip_displacements: Vec<f64>,
+    /// Initial velocity of each pin in its static tip-load shape, given by its tip
+    /// velocity (m/s, positive toward the right wall): a pin thrown, or cut loose from a
+    /// support moving at that speed; one per pin, or empty for all at rest. Combines with
+    /// `tip_displacements`. Needs a free top.
+    #[serde(default)]
+    #[schema(default = json!([]))]
+    pub tip_velocities: Vec<f64>,
 }
 
 /// Loads.

@@ -18,6 +18,7 @@ use super::excitation::BaseAccelerationInput;
 use super::impact_report;
 use super::margins::PinUtilisation;
 use super::model_check::{self, StandIn};
+use super::resultants::PinResultants;
 use super::run_report::{self, ContactStatistics, LineExtremes, RunSize, RunSummary};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
@@ -69,6 +70,7 @@ fn row_model<'a>(
         damping_ratios: inputs.pin.damping_ratios_for(basis.modes()),
         contacts: contacts.to_vec(),
         initial_tip_displacements: inputs.initial.tip_displacements.clone(),
+        initial_tip_velocities: inputs.initial.tip_velocities.clone(),
         base_acceleration: inputs.excitation.base_acceleration.as_ref().map(|b| b.physics()),
         walls: inputs.excitation.walls(),
         plane: None,
@@ -105,6 +107,8 @@ fn pointer_of(inputs: &BundleInputs, path: &str, pins_refused: bool) -> Option<S
         ("contacts", Some(k), rest) => model_check::join(&format!("/inputs/contacts/{k}"), rest),
         ("initial_tip_displacements", None, "") => "/inputs/initial/tip_displacements".to_owned(),
         ("initial_tip_displacements", Some(p), "") => format!("/inputs/initial/tip_displacements/{p}"),
+        ("initial_tip_velocities", None, "") => "/inputs/initial/tip_velocities".to_owned(),
+        ("initial_tip_velocities", Some(p), "") => format!("/inputs/initial/tip_velocities/{p}"),
         ("base_acceleration", _, _)
             if inputs
                 .excitation
@@ -185,6 +189,9 @@ pub struct PinResult {
     /// Its utilisations against `output.allowables` (null without them).
     #[serde(flatten)]
     pub utilisation: PinUtilisation,
+    /// The resultant contact force at each of its contact heights, and the largest.
+    #[serde(flatten)]
+    pub resultants: PinResultants,
 }
 
 /// The explicit model the generator form expands to.
@@ -500,6 +507,7 @@ impl Simulation for BundleDynamics {
             .collect();
         let heights = &plan.settings.output_heights;
         let flexure = plan.flexure();
+        let mut resultants = PinResultants::by_pin(&simulation, plan.pins).into_iter();
         let pins: Vec<PinResult> = (0..plan.pins)
             .map(|p| {
                 let bending = flexure.bending(&simulation.pin_curvatures[p]);
@@ -511,6 +519,7 @@ impl Simulation for BundleDynamics {
                     extremes: LineExtremes::of_line(&simulation, heights, p),
                     utilisation: PinUtilisation::of(&bending, allowable_stress, on_pin),
                     bending,
+                    resultants: resultants.next().expect("one per pin"),
                 }
             })
             .collect();

@@ -576,3 +576,49 @@ fn a_timoshenko_pin_has_the_exact_thick_beam_frequency() {
     bad["pin"]["timoshenko"] = json!({});
     assert_eq!(pointers(&bad), ["/inputs/pin/timoshenko/shear_coefficient"]);
 }
+
+/// A pin thrown from straight with tip velocity V moves in its tip-load shape: its tip
+/// starts at w(t) = c V t (1 + O(ω²t²)), where c = Σ φᵢ(L) uᵢ is the tip deflection the
+/// basis gives the unit tip-load shape, read from a pin released from it with tip D
+/// (w(0) = c D); thrown toward the right wall it meets it first, thrown away the left one.
+/// A wrong count, or a throw with a top that is not free, is refused at its pointer.
+#[test]
+fn a_pin_thrown_moves_in_its_tip_load_shape_at_its_tip_velocity() {
+    let contacts = |gap: f64| {
+        json!([{"left": "wall", "right": 0, "height": 1.0, "gap": gap, "stiffness": 1e4},
+               {"left": 0, "right": "wall", "height": 1.0, "gap": gap, "stiffness": 1e4}])
+    };
+    let (speed, tip) = (0.02, 1e-3);
+    let body = |initial: Value| {
+        json!({"pin": pin(), "pins": 1, "contacts": contacts(1e-3), "initial": initial,
+               "solver": {"duration": 0.01, "time_step": 1e-6, "check": "none"},
+               "output": {"interval": 1e-5, "heights": [1.0]}})
+    };
+    let released = run(&body(json!({"tip_displacements": [tip]})));
+    let c = series(&released.histories[1], "p0")[0] / tip;
+    assert!(
+        (0.95..1.05).contains(&c),
+        "the basis gives the tip-load shape a tip of {c}"
+    );
+    let thrown = run(&body(json!({"tip_velocities": [speed]})));
+    let tips = series(&thrown.histories[1], "p0");
+    assert_eq!(tips[0], 0.0, "thrown from straight");
+    let t = 1e-5;
+    let measured = tips[1] / (c * speed * t);
+    assert!((measured - 1.0).abs() < 2e-3, "w(t)/(c V t) = {measured}");
+    // Toward the right wall (contact 1) first: the left one has not closed then.
+    let first = |document: &Value, k: usize| document["contacts"][k]["first_impact_time"].as_f64();
+    let right = first(&thrown.document, 1).expect("reaches the right wall");
+    assert!(first(&thrown.document, 0).is_none_or(|left| left > right));
+    let away = run(&body(json!({"tip_velocities": [-speed]})));
+    assert_eq!(first(&away.document, 0), Some(right), "the mirror image");
+
+    let two = json!({"pin": pin(), "pins": 1, "contacts": contacts(1e-3),
+                     "initial": {"tip_velocities": [speed, 0.0]}});
+    assert_eq!(pointers(&two), ["/inputs/initial/tip_velocities"]);
+    let mut clamped_top = pin();
+    clamped_top["supports"] = json!({"foot": "clamped", "top": "clamped"});
+    let held = json!({"pin": clamped_top, "pins": 1, "contacts": contacts(1e-3),
+                      "initial": {"tip_velocities": [speed]}});
+    assert_eq!(pointers(&held), ["/inputs/initial/tip_velocities"]);
+}

@@ -103,7 +103,8 @@ pub struct ContactInput {
     pub law: LawInput,
 }
 
-/// Initial state: released at rest from the static shape of a tip load.
+/// Initial state: released from the static shape of a tip load, at rest or moving in
+/// that shape.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ReleaseInput {
@@ -111,11 +112,19 @@ pub struct ReleaseInput {
     #[serde(default = "default_release")]
     #[schema(default = 1e-3)]
     pub tip_displacement: f64,
+    /// Tip velocity of the release shape at t = 0 (m/s), positive away from the spring:
+    /// the beam thrown (or cut loose from a support moving at this speed), the velocity
+    /// field v ψ(x) with ψ the unit tip-load shape; 0 (the default) releases it at rest.
+    /// The reference takes it exactly as the numerical model does.
+    #[serde(default)]
+    #[schema(default = 0.0)]
+    pub tip_velocity: f64,
 }
 impl Default for ReleaseInput {
     fn default() -> Self {
         Self {
             tip_displacement: default_release(),
+            tip_velocity: 0.0,
         }
     }
 }
@@ -200,6 +209,7 @@ fn tip_model<'a>(inputs: &CantileverInputs, basis: &'a ModalBasis, contact_stiff
             law: inputs.contact.law.law(),
         }],
         initial_tip_displacements: vec![inputs.release.tip_displacement],
+        initial_tip_velocities: vec![inputs.release.tip_velocity],
         base_acceleration: None,
         walls: None,
         plane: None,
@@ -385,6 +395,8 @@ fn pointer_of(inputs: &CantileverInputs, path: &str, beam_refused: bool) -> Opti
         ("contacts", _, _) => "/inputs/contact",
         ("initial_tip_displacements", Some(_), "") => "/inputs/release/tip_displacement",
         ("initial_tip_displacements", None, "") => "/inputs/beam/supports",
+        ("initial_tip_velocities", Some(_), "") => "/inputs/release/tip_velocity",
+        ("initial_tip_velocities", None, "") => "/inputs/beam/supports",
         ("damping_ratios", mode, _) => {
             return Some(model_check::damping_ratio_pointer(
                 &inputs.beam,
@@ -554,6 +566,7 @@ impl Simulation for CantileverImpact {
             gap: inputs.contact.gap,
             damping_ratios: inputs.beam.damping_ratios_for(basis.eigenmodes()),
             tip_displacement: inputs.release.tip_displacement,
+            tip_velocity: inputs.release.tip_velocity,
             duration: solver.duration,
             modes: inputs.reference.modes,
             max_events: 100_000,

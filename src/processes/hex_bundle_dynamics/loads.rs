@@ -32,6 +32,24 @@ pub struct HexInitialInput {
     #[serde(default)]
     #[schema(default = json!([]))]
     pub tip_displacements: Vec<TipReleaseInput>,
+    /// Pins moving at t = 0 in their static tip-load shape with these tip velocities
+    /// (thrown, or cut loose from a support moving at that speed); each pin at most once,
+    /// the pins not listed at rest. Combines with `tip_displacements`. Needs a free top.
+    #[serde(default)]
+    #[schema(default = json!([]))]
+    pub tip_velocities: Vec<TipVelocityInput>,
+}
+
+/// One pin's initial velocity: its tip velocity (x, y) at t = 0.
+#[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TipVelocityInput {
+    /// The moving pin (0 … pins − 1, numbered from the centre, ring by ring).
+    pub pin: usize,
+    /// Tip velocity along +x (m/s).
+    pub x: f64,
+    /// Tip velocity along +y (m/s).
+    pub y: f64,
 }
 
 /// One pin's release: its tip deflection (x, y) at t = 0.
@@ -73,6 +91,8 @@ pub struct PlaneLoads {
     /// One tip deflection (m) per line, the x lines then the y lines; empty when no pin
     /// is released.
     pub initial_tip_displacements: Vec<f64>,
+    /// One tip velocity (m/s) per line, likewise; empty when no pin moves at t = 0.
+    pub initial_tip_velocities: Vec<f64>,
     /// One or two per point force of the inputs (its x and y components).
     pub point_forces: Vec<PointForce>,
 }
@@ -103,7 +123,8 @@ pub fn plane_loads(inputs: &HexInputs, errors: &mut Vec<FieldError>) -> PlaneLoa
     let rings = inputs.bundle.rings;
     let pins = (1..=MAX_RINGS).contains(&rings).then(|| pin_count(rings));
     PlaneLoads {
-        initial_tip_displacements: releases(inputs, pins, errors),
+        initial_tip_displacements: releases(inputs, pins, Initial::Displacements, errors),
+        initial_tip_velocities: releases(inputs, pins, Initial::Velocities, errors),
         point_forces: point_forces(inputs, pins, errors),
     }
 }
@@ -130,51 +151,89 @@ fn existing_pin(
     None
 }
 
-fn releases(inputs: &HexInputs, pins: Option<usize>, errors: &mut Vec<FieldError>) -> Vec<f64> {
-    let list = &inputs.initial.tip_displacements;
-    let pointer = "/inputs/initial/tip_displacements";
+/// Which list of `initial` a release is in.
+#[derive(Debug, Clone, Copy)]
+enum Initial {
+    Displacements,
+    Velocities,
+}
+
+impl Initial {
+    /// (member, unit, what it is, what a pin listed is, in messages).
+    fn names(self) -> (&'static str, &'static str, &'static str, &'static str) {
+        match self {
+            Initial::Displacements => ("tip_displacements", "m", "a tip release", "released"),
+            Initial::Velocities => (
+                "tip_velocities",
+                "m/s",
+                "an initial tip velocity",
+                "given a velocity",
+            ),
+        }
+    }
+
+    /// Its entries as (pin, x, y).
+    fn entries(self, inputs: &HexInputs) -> Vec<(usize, f64, f64)> {
+        match self {
+            Initial::Displacements => (inputs.initial.tip_displacements.iter())
+                .map(|r| (r.pin, r.x, r.y))
+                .collect(),
+            Initial::Velocities => (inputs.initial.tip_velocities.iter())
+                .map(|r| (r.pin, r.x, r.y))
+                .collect(),
+        }
+    }
+}
+
+/// One value per line of the `initial` list `which` (empty without entries).
+fn releases(
+    inputs: &HexInputs,
+    pins: Option<usize>,
+    which: Initial,
+    errors: &mut Vec<FieldError>,
+) -> Vec<f64> {
+    let list = which.entries(inputs);
+    let (member, unit, what, listed) = which.names();
+    let pointer = format!("/inputs/initial/{member}");
     let mut tips = match (pins, list.is_empty()) {
         (Some(pins), false) => vec![0.0; 2 * pins],
         _ => Vec::new(),
     };
     let mut released: BTreeMap<usize, usize> = BTreeMap::new();
-    for (i, release) in list.iter().enumerate() {
+    for (i, &(pin, x, y)) in list.iter().enumerate() {
         let at = format!("{pointer}/{i}");
         let mut finite = true;
-        for (axis, value) in [("x", release.x), ("y", release.y)] {
+        for (axis, value) in [("x", x), ("y", y)] {
             if !value.is_finite() {
                 errors.push(FieldError::new(
                     format!("{at}/{axis}"),
-                    "must be a finite number (m)",
+                    format!("must be a finite number ({unit})"),
                 ));
                 finite = false;
             }
         }
-        if let Some(first) = released.insert(release.pin, i) {
+        if let Some(first) = released.insert(pin, i) {
             errors.push(FieldError::new(
                 format!("{at}/pin"),
-                format!(
-                    "pin {} is released twice (also by tip_displacements/{first}): each pin at most once",
-                    release.pin
-                ),
+                format!("pin {pin} is {listed} twice (also by {member}/{first}): each pin at most once"),
             ));
             continue;
         }
         if let (Some(pin), Some(pins), true) = (
-            existing_pin(release.pin, pins, &format!("{at}/pin"), errors),
+            existing_pin(pin, pins, &format!("{at}/pin"), errors),
             pins,
             finite,
         ) {
-            tips[pin] = release.x;
-            tips[pins + pin] = release.y;
+            tips[pin] = x;
+            tips[pins + pin] = y;
         }
     }
-    let bent = list.iter().any(|r| r.x != 0.0 || r.y != 0.0);
-    if bent && StandIn::of(&inputs.pin).basis.unit_tip_release().is_none() {
+    let moved = list.iter().any(|&(_, x, y)| x != 0.0 || y != 0.0);
+    if moved && StandIn::of(&inputs.pin).basis.unit_tip_release().is_none() {
         errors.push(FieldError::new(
             pointer,
             format!(
-                "a tip release needs a free top: the pins' top is {} (no tip-load shape to release from)",
+                "{what} needs a free top: the pins' top is {} (no tip-load shape to move in)",
                 inputs.pin.supports.top.name()
             ),
         ));

@@ -22,6 +22,7 @@ use super::contact_law::{FrictionReport, LawInput, WearDepth, WearReport};
 use super::excitation::{PlaneSignal, plane_signal};
 use super::impact_report;
 use super::margins::PinUtilisation;
+use super::resultants::PinResultants;
 use super::run_report::{self, ContactStatistics, LineExtremes, RunSize, RunSummary};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::Subject;
@@ -95,6 +96,7 @@ fn plane_model<'a>(
         damping_ratios: inputs.pin.damping_ratios_for(basis.modes()),
         contacts: contacts.to_vec(),
         initial_tip_displacements: loads.initial_tip_displacements.clone(),
+        initial_tip_velocities: loads.initial_tip_velocities.clone(),
         base_acceleration: x.clone(),
         point_forces: loads.point_forces.clone(),
         walls: walls.clone(),
@@ -217,6 +219,10 @@ pub struct HexPinResult {
     /// Its utilisations against `output.allowables` (null without them).
     #[serde(flatten)]
     pub utilisation: PinUtilisation,
+    /// The resultant contact force at each of its contact heights (wire on a clad, the
+    /// neighbours' wires on it, the wrapper), and the largest.
+    #[serde(flatten)]
+    pub resultants: PinResultants,
 }
 
 /// A pin's largest resultant deflection.
@@ -553,6 +559,7 @@ impl Simulation for HexBundleDynamics {
         let pin_count = plan.bundle.pin_count();
         let heights = &plan.settings.output_heights;
         let flexure = plan.flexure();
+        let mut resultants = PinResultants::by_pin(&simulation, pin_count).into_iter();
         let pins: Vec<HexPinResult> = (0..pin_count)
             .map(|p| {
                 let position = plan.bundle.position(p);
@@ -569,6 +576,7 @@ impl Simulation for HexBundleDynamics {
                     deflection: ResultantDeflection::of(&simulation.resultant_extremes[p]),
                     utilisation: PinUtilisation::of(&bending, allowable_stress, on_pin),
                     bending,
+                    resultants: resultants.next().expect("one per pin"),
                 }
             })
             .collect();

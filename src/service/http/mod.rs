@@ -128,6 +128,8 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/jobs/{jobId}/inputs", get(job_inputs::inputs))
         .route("/jobs/{jobId}/results/impacts", get(impacts::impacts))
         .route("/jobs/{jobId}/results/contacts", get(contacts::contacts))
+        .route("/jobs/{jobId}/results/pins", get(contacts::pins))
+        .route("/jobs/{jobId}/results/resultants", get(contacts::resultants))
         .route("/jobs/{jobId}/results/{output}", get(results::output))
         .route("/jobs/{jobId}/results/{output}/spectrum", get(spectra::spectrum))
         .route(

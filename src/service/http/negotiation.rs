@@ -91,6 +91,8 @@ pub fn offers(route: &str) -> Option<&'static [Format]> {
         "/jobs/{jobId}/results/{output}"
         | "/jobs/{jobId}/results/impacts"
         | "/jobs/{jobId}/results/contacts"
+        | "/jobs/{jobId}/results/pins"
+        | "/jobs/{jobId}/results/resultants"
         | "/jobs/{jobId}/results/{output}/spectrum"
         | "/jobs/{jobId}/results/{output}/response_spectrum"
         | "/sweeps/{sweepId}/results"

@@ -21,6 +21,7 @@ __all__ = [
     "contacts_frame",
     "contact_table_frame",
     "pins_frame",
+    "resultant_table_frame",
     "impacts_frame",
     "spectrum_frame",
     "table_frame",
@@ -116,6 +117,9 @@ PIN_UNITS: dict[str, str] = {
     "stress_utilisation": "1",
     "contact_utilisation": "1",
     "utilisation": "1",
+    # The resultant contact force on a pin at a contact height (docs/bending.md).
+    "contacts": "1",
+    "max_force": "N",
 }
 
 
@@ -207,9 +211,18 @@ def contact_table_frame(text: str) -> pd.DataFrame:
     return frame
 
 
+def resultant_table_frame(text: str) -> pd.DataFrame:
+    """The service's resultant contact forces (``/jobs/{jobId}/results/resultants``, CSV)
+    indexed by (``pin``, ``height``): ``contacts`` acting there, ``max_force`` (N), ``time`` (s)."""
+    frame = pd.read_csv(io.StringIO(text), index_col=["pin", "height"], **_EXACT)
+    frame.attrs["units"] = {c: PIN_UNITS[c] for c in ["pin", "height", *frame.columns]}
+    return frame
+
+
 def pins_frame(pins: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
-    """The results' ``pins`` (per pin: largest |deflection|, where and when) indexed by ``pin``."""
-    frame = pd.json_normalize([dict(p) for p in pins], sep=".")
+    """The results' ``pins`` (per pin: largest |deflection|, where and when) indexed by
+    ``pin``; the per-height resultant contact forces are :func:`resultant_table_frame`'s."""
+    frame = pd.json_normalize([{k: v for k, v in p.items() if k != "resultant_forces"} for p in pins], sep=".")
     if "pin" in frame.columns:
         frame = frame.set_index("pin")
     else:

@@ -296,6 +296,19 @@ class Job:
         frame.attrs["job"] = self.id
         return frame
 
+    def resultants(self) -> pd.DataFrame:
+        """The resultant contact force on every pin at every contact height where a
+        contact acts on it (``/jobs/{jobId}/results/resultants``, docs/bending.md), indexed
+        by (``pin``, ``height``): ``contacts`` (how many act there), ``max_force`` (N: the
+        largest magnitude of their vector sum over every step), ``time`` (s). A process
+        without pins raises :class:`ChocmodalError` (404)."""
+        response = self._client._transport.request(
+            "GET", f"/jobs/{self.id}/results/resultants", params={"format": "csv"}, headers={"Accept": "text/csv"}
+        )
+        frame = frames.resultant_table_frame(response.text)
+        frame.attrs["job"] = self.id
+        return frame
+
     def bending(self) -> pd.DataFrame:
         """The bending envelope along the height (``bending_envelope``: per mesh node the
         largest bending moment (N·m), outer-fibre stress (Pa) and strain over every pin and

@@ -95,6 +95,7 @@ impl Row {
             damping_ratios: vec![0.01; basis.modes()],
             contacts,
             initial_tip_displacements: vec![],
+            initial_tip_velocities: vec![],
             base_acceleration: Some(self.excitation.clone()),
             walls: None,
             plane: None,

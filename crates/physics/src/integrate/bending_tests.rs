@@ -31,6 +31,7 @@ fn lone_pin(basis: &ModalBasis, plane: bool) -> Model<'_> {
         damping_ratios: vec![1.0; basis.modes()],
         contacts: vec![],
         initial_tip_displacements: vec![],
+        initial_tip_velocities: vec![],
         base_acceleration: None,
         point_forces: vec![],
         walls: None,

@@ -43,6 +43,7 @@ fn one_pin<'a>(basis: &'a ModalBasis, contacts: Vec<Contact>, tip: f64, kind: Lo
         damping_ratios: vec![0.0; basis.modes()],
         contacts,
         initial_tip_displacements: vec![tip],
+        initial_tip_velocities: vec![],
         base_acceleration: None,
         walls: None,
         plane: None,
@@ -417,6 +418,7 @@ fn clamped_in_the_plane(
         damping_ratios: vec![0.0; basis.modes()],
         contacts: vec![below, above],
         initial_tip_displacements: vec![tip, 0.0],
+        initial_tip_velocities: vec![],
         base_acceleration: None,
         walls,
         plane: Some(Plane {

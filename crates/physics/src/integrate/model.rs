@@ -29,6 +29,10 @@ pub struct Model<'a> {
     /// plane the x lines, then the y lines) from its static tip-load shape with this tip
     /// deflection (m); empty means all at rest.
     pub initial_tip_displacements: Vec<f64>,
+    /// Initial velocity of each deflection line (as `initial_tip_displacements`): the
+    /// static tip-load shape moving with this tip velocity (m/s) at t = 0; empty means
+    /// all at rest. A pin thrown, or cut loose from a support moving at this speed.
+    pub initial_tip_velocities: Vec<f64>,
     /// Base acceleration (m/s²); along x in the plane.
     pub base_acceleration: Option<BaseAcceleration>,
     /// Point forces, each on one deflection line (along x or y in the plane).
@@ -364,30 +368,43 @@ impl Model<'_> {
     }
 
     fn validate_release(&self, issues: &mut Vec<InputIssue>) {
-        let (tips, lines) = (&self.initial_tip_displacements, self.lines());
-        if !tips.is_empty() && tips.len() != lines {
-            issues.push(InputIssue::new(
+        let lines = self.lines();
+        for (field, values, what) in [
+            (
                 "initial_tip_displacements",
-                format!(
-                    "needs one value per deflection line ({lines}, {}) or none, got {}",
-                    self.lines_per_pin(),
-                    tips.len()
-                ),
-            ));
-        }
-        for (line, tip) in tips.iter().enumerate() {
-            if !tip.is_finite() {
+                &self.initial_tip_displacements,
+                "a tip release",
+            ),
+            (
+                "initial_tip_velocities",
+                &self.initial_tip_velocities,
+                "an initial tip velocity",
+            ),
+        ] {
+            if !values.is_empty() && values.len() != lines {
                 issues.push(InputIssue::new(
-                    format!("initial_tip_displacements/{line}"),
-                    "must be a finite number",
+                    field,
+                    format!(
+                        "needs one value per deflection line ({lines}, {}) or none, got {}",
+                        self.lines_per_pin(),
+                        values.len()
+                    ),
                 ));
             }
-        }
-        if tips.iter().any(|t| *t != 0.0) && self.basis.unit_tip_release().is_none() {
-            issues.push(InputIssue::new(
-                "initial_tip_displacements",
-                "a tip release needs a free top (the basis has no tip-load shape)",
-            ));
+            for (line, value) in values.iter().enumerate() {
+                if !value.is_finite() {
+                    issues.push(InputIssue::new(
+                        format!("{field}/{line}"),
+                        "must be a finite number",
+                    ));
+                }
+            }
+            if values.iter().any(|v| *v != 0.0) && self.basis.unit_tip_release().is_none() {
+                issues.push(InputIssue::new(
+                    field,
+                    format!("{what} needs a free top (the basis has no tip-load shape)"),
+                ));
+            }
         }
     }
 }
@@ -526,6 +543,7 @@ mod tests {
                 contact(Body::Pin(1), Body::Wall, 0.5),
             ],
             initial_tip_displacements: vec![1e-3, 0.0],
+            initial_tip_velocities: vec![],
             base_acceleration: Some(BaseAcceleration::HalfSine {
                 amplitude: 5.0,
                 duration: 0.01,

@@ -40,6 +40,7 @@ fn lone_pin(basis: &ModalBasis, plane: bool) -> Model<'_> {
         damping_ratios: vec![0.02; basis.modes()],
         contacts: vec![],
         initial_tip_displacements: vec![],
+        initial_tip_velocities: vec![],
         base_acceleration: None,
         point_forces: vec![],
         walls: None,
@@ -163,6 +164,7 @@ fn energy_balance_closes_with_a_point_force_in_the_plane() {
             })
             .collect(),
         initial_tip_displacements: vec![-1e-4, 5e-5],
+        initial_tip_velocities: vec![],
         point_forces: [(0, theta.cos()), (1, theta.sin())]
             .map(|(line, factor)| PointForce {
                 line,

@@ -54,6 +54,7 @@ fn shaken_row(basis: &ModalBasis, amplitude: f64) -> Model<'_> {
         damping_ratios: vec![0.02; basis.modes()],
         contacts,
         initial_tip_displacements: vec![],
+        initial_tip_velocities: vec![],
         base_acceleration: Some(BaseAcceleration::HalfSine {
             amplitude,
             duration: 0.01,
@@ -299,6 +300,7 @@ fn triangle(basis: &ModalBasis) -> Model<'_> {
         contacts,
         // Along x (lines 0..3); the y lines 3..6 start straight.
         initial_tip_displacements: vec![2e-4, 0.0, -1e-4, 0.0, 0.0, 0.0],
+        initial_tip_velocities: vec![],
         base_acceleration: Some(BaseAcceleration::HalfSine {
             amplitude: 15.0,
             duration: 0.01,
@@ -382,6 +384,7 @@ fn a_contact_between_two_pins_exchanges_equal_and_opposite_impulses() {
         damping_ratios: vec![0.01; basis.modes()],
         contacts: vec![contact(1.0, 2e-5), contact(0.7, 1e-5)],
         initial_tip_displacements: vec![-3e-4, 3e-4, 0.0, 0.0],
+        initial_tip_velocities: vec![],
         base_acceleration: None,
         point_forces: vec![],
         walls: None,
@@ -616,6 +619,7 @@ fn the_planes_critical_step_matches_brute_force_divergence() {
             law: Law::LINEAR,
         }],
         initial_tip_displacements: vec![0.0, 0.0],
+        initial_tip_velocities: vec![],
         base_acceleration: None,
         // Toward the wall: δ = n·(0 − u) = −0.6 u_x − 0.8 u_y > 0 for u_x < 0.
         point_forces: vec![crate::loads::PointForce {
@@ -719,6 +723,7 @@ fn large_plane_speed() {
                 _ => -2e-4,
             })
             .collect(),
+        initial_tip_velocities: vec![],
         base_acceleration: Some(BaseAcceleration::HalfSine {
             amplitude: 30.0,
             duration: 0.005,
@@ -790,6 +795,7 @@ fn one_pin_in_the_wrapper_shaken_sixty_degrees_further_gives_the_turned_response
             })
             .collect(),
         initial_tip_displacements: vec![],
+        initial_tip_velocities: vec![],
         base_acceleration: Some(BaseAcceleration::HalfSine {
             amplitude: 20.0 * theta.cos(),
             duration: 0.01,

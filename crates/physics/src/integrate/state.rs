@@ -42,15 +42,22 @@ pub(super) struct State {
 
 impl State {
     /// At rest, or released from the static tip-load shape with the model's initial tip
-    /// deflections, one per line (in the plane the x lines, then the y lines); contacts
-    /// open and no load yet.
+    /// deflections and moving in it with its initial tip velocities, one per line (in
+    /// the plane the x lines, then the y lines); contacts open and no load yet.
     pub fn new(layout: &Layout<'_>) -> Self {
         let (model, row, lines) = (layout.model, layout.row, layout.lines);
         let mut q = vec![0.0; lines * row];
+        // The pins' rows of v (the walls' row of zeros after them).
+        let mut v = vec![0.0; (lines + 1) * row];
         if let Some(unit) = model.basis.unit_tip_release() {
-            for (coordinates, tip) in q.chunks_exact_mut(row).zip(&model.initial_tip_displacements) {
-                for (x, u) in coordinates.iter_mut().zip(unit.iter()) {
-                    *x = tip * u;
+            for (values, tips) in [
+                (&mut q, &model.initial_tip_displacements),
+                (&mut v, &model.initial_tip_velocities),
+            ] {
+                for (coordinates, tip) in values.chunks_exact_mut(row).zip(tips) {
+                    for (x, u) in coordinates.iter_mut().zip(unit.iter()) {
+                        *x = tip * u;
+                    }
                 }
             }
         }
@@ -58,7 +65,7 @@ impl State {
         let groups = lanes / layout.lanes;
         Self {
             q,
-            v: vec![0.0; (lines + 1) * row],
+            v,
             a: vec![0.0; (lines + 1) * row],
             force: vec![0.0; lines * row],
             penetration: vec![0.0; lanes],

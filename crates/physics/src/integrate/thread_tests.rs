@@ -66,6 +66,7 @@ fn bundle(basis: &ModalBasis) -> Model<'_> {
         initial_tip_displacements: (0..2 * pins.len())
             .map(|p| if p % 2 == 0 { 2e-4 } else { -1e-4 })
             .collect(),
+        initial_tip_velocities: vec![],
         base_acceleration: shake(30.0, 0.004),
         // On pin 5 along x and on pin 8 along y.
         point_forces: [5, pins.len() + 8]

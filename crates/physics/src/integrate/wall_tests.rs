@@ -96,6 +96,7 @@ fn opposite_wall_motions_give_a_mirror_symmetric_response() {
             contact(Body::Pin(1), Body::Wall, 1.0),
         ],
         initial_tip_displacements: vec![],
+        initial_tip_velocities: vec![],
         base_acceleration: None,
         walls: Some(WallMotion {
             left_x: Some(sine(30.0, 25.0, 2.0)),
@@ -151,6 +152,7 @@ fn a_pin_held_at_both_ends_follows_its_moving_top_support_quasi_statically() {
         damping_ratios: vec![0.05; basis.modes()],
         contacts: vec![],
         initial_tip_displacements: vec![],
+        initial_tip_velocities: vec![],
         base_acceleration: None,
         walls: Some(WallMotion::rigid(Some(sine(amplitude, 1.0 / period, 1.0)), None)),
         plane: None,

@@ -2,7 +2,8 @@
 //! section 2, BRIEF §5): the public input, its validation, and the typed errors.
 //!
 //! The beam (clamped at x = 0, uniform, Euler–Bernoulli) is released from the static
-//! tip-load shape w(x) = u₀ (x/L)²(3 − x/L)/2 with zero velocity. While w(L) + g ≥ 0 it
+//! tip-load shape w(x) = u₀ ψ(x), ψ(x) = (x/L)²(3 − x/L)/2, moving in that shape with
+//! the velocity ẇ(x) = v₀ ψ(x) (v₀ = 0: at rest). While w(L) + g ≥ 0 it
 //! flies on its clamped-free modes; while w(L) < −g the spring Kc pushes back with
 //! F = Kc(−w(L) − g) and the beam moves on its clamped-spring modes around the static
 //! solution of that phase. Each phase is solved in closed form; the switching instants
@@ -52,6 +53,8 @@ pub struct CantileverReference {
     pub damping_ratios: Vec<f64>,
     /// Tip deflection u₀ of the release shape (m), any sign.
     pub tip_displacement: f64,
+    /// Tip velocity v₀ (m/s) of the release shape at t = 0, any sign (0: at rest).
+    pub tip_velocity: f64,
     /// Simulated duration (s), > 0.
     pub duration: f64,
     /// Modes per basis (clamped-free and clamped-spring), 1..=[`MAX_MODES`].
@@ -162,12 +165,17 @@ impl CantileverReference {
                 value: bad,
             });
         }
-        if !self.tip_displacement.is_finite() {
-            return Err(ReferenceError::InvalidInput {
-                field: "tip_displacement",
-                requirement: "finite",
-                value: self.tip_displacement,
-            });
+        for (field, value) in [
+            ("tip_displacement", self.tip_displacement),
+            ("tip_velocity", self.tip_velocity),
+        ] {
+            if !value.is_finite() {
+                return Err(ReferenceError::InvalidInput {
+                    field,
+                    requirement: "finite",
+                    value,
+                });
+            }
         }
         if self.modes == 0 || self.modes > MAX_MODES {
             return Err(ReferenceError::InvalidModeCount(self.modes));

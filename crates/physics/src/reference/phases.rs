@@ -49,6 +49,9 @@ pub(super) struct Setup {
     pub release_free: Vec<f64>,
     /// ∫ m φ_spring (w₀ − w_s) dx: release state on the spring basis.
     pub release_spring: Vec<f64>,
+    /// ∫ m φ_free ẇ₀ dx and ∫ m φ_spring ẇ₀ dx: the initial velocity on each basis.
+    pub throw_free: Vec<f64>,
+    pub throw_spring: Vec<f64>,
     /// ∫ m φ_free w_s dx and ∫ m φ_spring w_s dx.
     pub static_free: Vec<f64>,
     pub static_spring: Vec<f64>,
@@ -74,6 +77,11 @@ impl Setup {
             .iter()
             .map(|&s| input.tip_displacement * tip_load_shape(s))
             .collect();
+        let throw: Vec<f64> = rule
+            .nodes
+            .iter()
+            .map(|&s| input.tip_velocity * tip_load_shape(s))
+            .collect();
         let static_shape: Vec<f64> = rule
             .nodes
             .iter()
@@ -86,11 +94,12 @@ impl Setup {
         let free_table = free.tabulate(&rule);
         let free_damping: Vec<f64> = (0..n).map(|i| input.damping_ratio(i)).collect();
         let release_free = free_table.iter().map(|phi| inner(phi, &release)).collect();
+        let throw_free = free_table.iter().map(|phi| inner(phi, &throw)).collect();
         let static_free = free_table.iter().map(|phi| inner(phi, &static_shape)).collect();
         let free_tip = free.shapes_at_reduced(1.0);
 
         let (mut projection, mut spring_damping, mut spring_tip) = (Vec::new(), Vec::new(), Vec::new());
-        let (mut release_spring, mut static_spring) = (Vec::new(), Vec::new());
+        let (mut release_spring, mut static_spring, mut throw_spring) = (Vec::new(), Vec::new(), Vec::new());
         if let Some(spring) = &spring {
             let spring_table = spring.tabulate(&rule);
             projection = free_table
@@ -121,6 +130,7 @@ impl Setup {
                 .map(|phi| inner(phi, &offset_release))
                 .collect();
             static_spring = spring_table.iter().map(|phi| inner(phi, &static_shape)).collect();
+            throw_spring = spring_table.iter().map(|phi| inner(phi, &throw)).collect();
             spring_tip = spring.shapes_at_reduced(1.0);
         }
         Self {
@@ -133,6 +143,8 @@ impl Setup {
             spring_tip,
             release_free,
             release_spring,
+            throw_free,
+            throw_spring,
             static_free,
             static_spring,
             static_tip,
@@ -338,12 +350,12 @@ pub(super) fn solve(
         });
         (
             PhaseKind::Contact,
-            (setup.release_spring.clone(), vec![0.0; input.modes]),
+            (setup.release_spring.clone(), setup.throw_spring.clone()),
         )
     } else {
         (
             PhaseKind::Flight,
-            (setup.release_free.clone(), vec![0.0; input.modes]),
+            (setup.release_free.clone(), setup.throw_free.clone()),
         )
     };
     let mut phases: Vec<Phase> = Vec::new();

@@ -23,6 +23,7 @@ fn default_case(rk: f64) -> CantileverReference {
         gap: 0.0,
         damping_ratios: vec![0.01],
         tip_displacement: 1e-3,
+        tip_velocity: 0.0,
         duration: 0.5,
         modes: 30,
         max_events: 10_000,
@@ -455,6 +456,64 @@ fn mass_proportional_damping_carries_over_to_the_contact_basis() {
             (ratio - expected).abs() < 1e-6 * expected,
             "contact mode {}: ξ_r = {ratio}, expected α/(2ω_r) = {expected}",
             j + 1
+        );
+    }
+}
+
+// A cantilever thrown in its tip-load shape ψ (tip velocity v₀) while released from it
+// (tip u₀): its energy is ½(3EI/L³)u₀² + ½ v₀² m L ∫₀¹ψ² ds, with ∫₀¹ (s²(3 − s)/2)² ds =
+// 33/140 (up to the truncation of ψ on the basis), conserved across the impacts of an
+// undamped run; without a spring, with the modes above the first damped away, the tip
+// moves as the first mode's damped response to both, 12/λ⁴ (u₀ cos + (v₀ + ξωu₀)/ω_d sin).
+#[test]
+fn a_thrown_cantilever_carries_its_kinetic_energy_and_moves_as_its_first_mode() {
+    let mut input = default_case(80.0);
+    input.damping_ratios = vec![0.0];
+    input.tip_velocity = -0.2;
+    let solution = run(&input);
+    let setup = Setup::new(&input);
+    let expected = 0.5 * input.tip_stiffness() * input.tip_displacement.powi(2)
+        + 0.5 * input.tip_velocity.powi(2) * input.mass_per_length() * input.length * 33.0 / 140.0;
+    let initial = phase_energy(&setup, &input, &solution.phases[0], 0.0);
+    assert!(
+        (initial - expected).abs() < 1e-5 * expected,
+        "{initial} J against {expected} J"
+    );
+    assert!(
+        solution.impact_count() >= 5,
+        "{} impacts",
+        solution.impact_count()
+    );
+    for phase in &solution.phases {
+        let energy = phase_energy(&setup, &input, phase, phase.end - phase.start);
+        assert!(
+            (energy - initial).abs() < 1e-7 * initial,
+            "energy {energy} J at {} s",
+            phase.end
+        );
+    }
+
+    let mut input = default_case(0.0);
+    input.damping_ratios = vec![0.01, 1.0];
+    input.tip_velocity = 0.3;
+    let solution = run(&input);
+    let lambda = clamped_free_roots(1)[0];
+    let omega = lambda * lambda * (input.bending_stiffness() / input.mass_per_length()).sqrt();
+    let xi = 0.01_f64;
+    let damped = omega * (1.0 - xi * xi).sqrt();
+    let shape = 12.0 / lambda.powi(4);
+    let (u0, v0) = (input.tip_displacement, input.tip_velocity);
+    for k in 0..=40 {
+        let t = 0.1 + 0.01 * k as f64;
+        let expected = shape
+            * (-xi * omega * t).exp()
+            * (u0 * (damped * t).cos() + (v0 + xi * omega * u0) / damped * (damped * t).sin());
+        let measured = solution.tip_deflection(t).unwrap_or(f64::NAN);
+        assert_close(
+            &format!("tip at {t} s (m)"),
+            measured,
+            expected,
+            1e-12 * u0.abs().max(v0.abs() / omega),
         );
     }
 }

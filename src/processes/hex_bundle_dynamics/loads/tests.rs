@@ -82,13 +82,15 @@ fn axis_directions_have_exact_factors() {
 
 /// Pin p along x is line p, along y line 7 + p: a force along 37° is two line forces,
 /// one along 90° or left at 0° loads its axis alone with the force as given; a release
-/// fills both lines of its pin and leaves the others straight.
+/// (or an initial velocity) fills both lines of its pin and leaves the others straight
+/// (or at rest).
 #[test]
 fn loads_land_on_the_pins_x_and_y_lines() {
     let mut inputs = inputs();
     inputs["excitation"] = json!({"point_forces": [force(3, Some(37.0)), force(5, Some(90.0)),
                                                    force(2, None), force(6, Some(-180.0))]});
-    inputs["initial"] = json!({"tip_displacements": [{"pin": 4, "x": 1e-3, "y": -2e-4}]});
+    inputs["initial"] = json!({"tip_displacements": [{"pin": 4, "x": 1e-3, "y": -2e-4}],
+                               "tip_velocities": [{"pin": 1, "x": -0.5, "y": 0.25}]});
     let loads = loads_of(&inputs);
     let given = [0.0, 2.0, -1.0];
     let (cos, sin) = (37f64.to_radians().cos(), 37f64.to_radians().sin());
@@ -114,6 +116,9 @@ fn loads_land_on_the_pins_x_and_y_lines() {
     let mut tips = vec![0.0; 14];
     (tips[4], tips[11]) = (1e-3, -2e-4);
     assert_eq!(loads.initial_tip_displacements, tips);
+    let mut velocities = vec![0.0; 14];
+    (velocities[1], velocities[8]) = (-0.5, 0.25);
+    assert_eq!(loads.initial_tip_velocities, velocities);
     assert_eq!(
         loads_of(&self::inputs()),
         PlaneLoads::default(),
@@ -133,6 +138,10 @@ fn bad_loads_are_refused_at_their_pointers_with_the_bound() {
         {"pin": 2, "x": 1e-3, "y": 0.0},
         {"pin": 9, "x": 1e-3, "y": 0.0},
         {"pin": 2, "x": 0.0, "y": 1e-3}
+    ], "tip_velocities": [
+        {"pin": 3, "x": 0.1, "y": 0.0},
+        {"pin": 3, "x": 0.0, "y": 0.1},
+        {"pin": 7, "x": 0.0, "y": 0.1}
     ]});
     let errors = errors(&bad);
     let pointers: Vec<&str> = errors.iter().map(|(p, _)| p.as_str()).collect();
@@ -142,6 +151,11 @@ fn bad_loads_are_refused_at_their_pointers_with_the_bound() {
             "/inputs/initial/tip_displacements/2/pin",
             "released twice (also by tip_displacements/0)",
         ),
+        (
+            "/inputs/initial/tip_velocities/1/pin",
+            "given a velocity twice (also by tip_velocities/0)",
+        ),
+        ("/inputs/initial/tip_velocities/2/pin", "7 pins (0 to 6)"),
         ("/inputs/excitation/point_forces/0/pin", "7 pins (0 to 6)"),
         ("/inputs/excitation/point_forces/1/height", "0 to 0.6 m"),
         (

@@ -96,6 +96,7 @@ fn shock_peak(basis: &ModalBasis, tolerance: f64) -> f64 {
         damping_ratios: vec![0.01; basis.modes()],
         contacts,
         initial_tip_displacements: vec![],
+        initial_tip_velocities: vec![],
         base_acceleration: Some(BaseAcceleration::HalfSine {
             amplitude: -196.2,
             duration: 0.005,
@@ -202,6 +203,7 @@ impl Shock {
             damping_ratios: vec![0.01; basis.modes()],
             contacts: row(self.pins, &self.levels, self.stiffness, self.gap),
             initial_tip_displacements: vec![],
+            initial_tip_velocities: vec![],
             base_acceleration: Some(BaseAcceleration::HalfSine {
                 amplitude: self.amplitude,
                 duration: self.duration,
