@@ -1,7 +1,3 @@
-    let output = run_piped(
-        &["run", "cantilever-impact", "-", "--out", out.to_str().unwrap()],
-        &body,
-    );
 //! The `chocmodal run` command through the real binary: results on stdout, histories
 //! and the per-impact table as CSV with `--out`, invalid inputs as a problem document on stderr with exit 2.
 
@@ -149,7 +145,12 @@ fn a_bundle_run_writes_its_contact_statistics_as_csv() {
     let pins = std::fs::read_to_string(out.join("pins.csv")).unwrap();
     let pin_rows = document["pins"].as_array().unwrap();
     assert_eq!(pins.lines().count(), 1 + pin_rows.len());
-    assert!(pins.lines().next().unwrap().contains("max_resultant_force.max_force"));
+    assert!(
+        pins.lines()
+            .next()
+            .unwrap()
+            .contains("max_resultant_force.max_force")
+    );
     let resultants = std::fs::read_to_string(out.join("resultants.csv")).unwrap();
     let per_height: usize = (pin_rows.iter())
         .map(|p| p["resultant_forces"].as_array().unwrap().len())
@@ -468,21 +469,10 @@ fn a_capped_impacts_csv_keeps_the_largest_and_says_truncated() {
         serde_json::from_str(&std::fs::read_to_string(example()).unwrap()).unwrap();
     body["inputs"]["solver"]["duration"] = serde_json::json!(0.3);
     body["inputs"]["output"] = serde_json::json!({"impacts": {"max_rows": 2}});
-    let mut child = chocmodal()
-        .args(["run", "cantilever-impact", "-", "--out"])
-        .arg(&out)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(body.to_string().as_bytes())
-        .unwrap();
-    let output = child.wait_with_output().unwrap();
+    let output = run_piped(
+        &["run", "cantilever-impact", "-", "--out", out.to_str().unwrap()],
+        &body,
+    );
     assert!(
         output.status.success(),
         "stderr: {}",
