@@ -590,9 +590,9 @@ fn a_pin_thrown_moves_in_its_tip_load_shape_at_its_tip_velocity() {
     };
     let (speed, tip) = (0.02, 1e-3);
     let body = |initial: Value| {
-        json!({"pin": pin(), "pins": 1, "contacts": contacts(1e-3), "initial": initial,
+        json!({"pin": pin(), "pins": 1, "contacts": contacts(1e-4), "initial": initial,
                "solver": {"duration": 0.01, "time_step": 1e-6, "check": "none"},
-               "output": {"interval": 1e-5, "heights": [1.0]}})
+               "output": {"interval": 1e-5}})
     };
     let released = run(&body(json!({"tip_displacements": [tip]})));
     let c = series(&released.histories[1], "p0")[0] / tip;
