@@ -94,6 +94,10 @@ pub fn offers(route: &str) -> Option<&'static [Format]> {
         | "/jobs/{jobId}/results/{output}/spectrum"
         | "/jobs/{jobId}/results/{output}/response_spectrum"
         | "/sweeps/{sweepId}/results"
+        | "/sweeps/{sweepId}/statistics"
+        | "/sweeps/{sweepId}/statistics/contacts"
+        | "/sweeps/{sweepId}/statistics/pins"
+        | "/sweeps/{sweepId}/statistics/convergence"
         | "/signals/{signalId}/samples"
         | "/signals/{signalId}/spectrum" => Some(JSON_OR_CSV),
         "/metrics" => Some(PROMETHEUS),
