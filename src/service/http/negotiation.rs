@@ -501,6 +501,10 @@ mod tests {
             assert_eq!(offers(route), Some(JSON_OR_HTML), "{route}");
         }
         assert_eq!(offers("/jobs/{jobId}/results/contacts"), Some(JSON_OR_CSV));
+        for table in ["", "/contacts", "/pins", "/convergence"] {
+            let route = format!("/sweeps/{{sweepId}}/statistics{table}");
+            assert_eq!(offers(&route), Some(JSON_OR_CSV), "{route}");
+        }
         assert_eq!(offers("/jobs/{jobId}/results"), Some(JSON));
         assert_eq!(offers("/ui/assets/{file}"), None);
     }

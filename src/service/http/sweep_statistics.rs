@@ -231,9 +231,10 @@ pub async fn convergence(
     let figure = match query.figures.as_slice() {
         [figure] => figure.clone(),
         [] => {
-            return Err(
-                Problem::invalid_query("`figure` is required: a numeric column of the results table").into(),
-            );
+            return Err(Problem::invalid_query(
+                "`figure` is required: a numeric column of the results table",
+            )
+            .into());
         }
         _ => return Err(Problem::invalid_query("`figure` names one column, given more than once").into()),
     };
@@ -369,7 +370,7 @@ pub async fn contacts(
         Computed {
             kind: SweepStatisticsKind::Contacts,
             request,
-            table: table,
+            table,
         },
         &headers,
         format,
@@ -418,7 +419,7 @@ pub async fn pins(
         Computed {
             kind: SweepStatisticsKind::Pins,
             request,
-            table: table,
+            table,
         },
         &headers,
         format,
