@@ -24,7 +24,7 @@ use crate::quality_note::parse_verdict;
 /// A row of the results table.
 type Row = Map<String, Value>;
 /// The list-axis values of a grid cell, with its rows.
-type Cell<'a> = (Row, Vec<&'a Row>);
+pub type Cell<'a> = (Row, Vec<&'a Row>);
 /// For given values of the other axes: the best valid (value, value as JSON, run) so far.
 type Choice = (Row, Option<(f64, Value, Value)>);
 
@@ -203,25 +203,35 @@ pub fn quantile(sorted: &[f64], p: f64) -> f64 {
     sorted[below] + (sorted[above] - sorted[below]) * weight
 }
 
-/// Statistics per grid cell of `list_axes`, for `numeric_axes` and every metric column
-/// but seeds ([`super::table::is_seed`]).
-pub fn cell_statistics(table: &Table, list_axes: &[String], numeric_axes: &[String]) -> Value {
-    let successful: Vec<&Map<String, Value>> = table
-        .rows
-        .iter()
-        .filter(|row| row.get("status").and_then(Value::as_str) == Some("successful"))
-        .collect();
-    let mut cells: Vec<Cell<'_>> = Vec::new();
-    for row in successful {
-        let cell: Map<String, Value> = list_axes
-            .iter()
-            .map(|p| (p.clone(), row.get(p).cloned().unwrap_or(Value::Null)))
-            .collect();
+/// The successful rows of `table` grouped by grid cell of `list_axes` (the axes' values
+/// of the row), cells in order of first appearance, rows in table order.
+pub fn cells<'a>(table: &'a Table, list_axes: &[String]) -> Vec<Cell<'a>> {
+    let mut cells: Vec<Cell<'a>> = Vec::new();
+    for row in &table.rows {
+        if row.get("status").and_then(Value::as_str) != Some("successful") {
+            continue;
+        }
+        let cell = cell_of(row, list_axes);
         match cells.iter_mut().find(|(c, _)| *c == cell) {
             Some((_, rows)) => rows.push(row),
             None => cells.push((cell, vec![row])),
         }
     }
+    cells
+}
+
+/// The values at `list_axes` of a row.
+fn cell_of(row: &Row, list_axes: &[String]) -> Row {
+    list_axes
+        .iter()
+        .map(|p| (p.clone(), row.get(p).cloned().unwrap_or(Value::Null)))
+        .collect()
+}
+
+/// Statistics per grid cell of `list_axes`, for `numeric_axes` and every metric column
+/// but seeds ([`super::table::is_seed`]).
+pub fn cell_statistics(table: &Table, list_axes: &[String], numeric_axes: &[String]) -> Value {
+    let cells = cells(table, list_axes);
     // A seed names a draw: its mean or spread means nothing.
     let columns: Vec<&String> = numeric_axes
         .iter()

@@ -19,12 +19,17 @@
 //! - [`sampling`]: the seeded uniforms and the laws' quantiles;
 //! - [`pointer`]: writing a value at a JSON pointer;
 //! - [`table`]: one row per run, metrics flattened with dots, as JSON or CSV;
-//! - [`aggregate`]: statistics of random sweeps, validity maps of calibration grids.
+//! - [`aggregate`]: statistics of random sweeps, validity maps of calibration grids;
+//! - [`figures`]: long statistics tables at a requested Wilks bound, and how the
+//!   quantile and the bound converge as runs are added;
+//! - [`items`]: the same per contact and per pin, fed one results document at a time.
 
 pub mod admission;
 pub mod aggregate;
 pub mod definition;
+pub mod figures;
 pub mod input_schema;
+pub mod items;
 pub mod member;
 pub mod pointer;
 pub mod request;

@@ -45,6 +45,7 @@ mod schema_check;
 mod shutdown;
 mod signals;
 mod spectra;
+mod sweep_statistics;
 mod sweeps;
 mod tenants;
 mod threads;

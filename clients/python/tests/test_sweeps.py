@@ -10,7 +10,9 @@ this test recomputes from the table with pandas.
 from __future__ import annotations
 
 import copy
+import math
 import uuid
+from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 import pytest
@@ -18,6 +20,9 @@ import pytest
 import chocmodal
 from chocmodal import axes
 from conftest import example
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
 
 
 @pytest.fixture(scope="module")
@@ -156,3 +161,76 @@ def test_a_sweep_resubmitted_with_its_key_is_the_same_sweep_and_can_be_dismissed
     status = sweep.dismiss()
     assert status["status"] == "dismissed"
     assert sweep.follow(progress=False, timeout=30)["status"] == "dismissed"
+
+
+def _wilks_rank(runs: int, coverage: float, confidence: float) -> Optional[int]:
+    """The tightest rank from the top whose value bounds the ``coverage`` quantile with
+    ``confidence``: the largest r with P(Binomial(runs, 1 − coverage) ≥ r) ≥ confidence."""
+    best = None
+    for r in range(1, runs + 1):
+        below = sum(math.comb(runs, j) * (1 - coverage) ** j * coverage ** (runs - j) for j in range(r))
+        if 1 - below < confidence:
+            break
+        best = r
+    return best
+
+
+def _assert_statistics(row: "pd.Series", values: "np.ndarray", coverage: float, confidence: float) -> None:
+    ordered = np.sort(values.astype(float))
+    assert row["count"] == len(ordered)
+    assert row["mean"] == pytest.approx(ordered.mean(), rel=1e-12)
+    assert row["min"] == ordered[0] and row["max"] == ordered[-1]
+    assert row["quantile"] == pytest.approx(float(np.quantile(ordered, coverage, method="linear")), rel=1e-12)
+    rank = _wilks_rank(len(ordered), coverage, confidence)
+    if rank is None:
+        assert np.isnan(row["bound"]) and np.isnan(row["bound_rank"])
+    else:
+        assert row["bound_rank"] == rank
+        assert row["bound"] == ordered[len(ordered) - rank]
+
+
+def test_each_contacts_statistics_are_those_of_the_member_jobs_contact_tables(
+    client: chocmodal.Client, monte_carlo: chocmodal.Sweep
+) -> None:
+    # 16 runs at 80 %/80 %: a bound exists (1 − 0.8^16 ≥ 0.8) at the rank the binomial gives.
+    coverage, confidence = 0.8, 0.8
+    contacts = monte_carlo.contact_statistics(coverage=coverage, confidence=confidence)
+    assert contacts.index.names == ["contact", "figure"]
+    tables = [client.job(job).contacts() for job in monte_carlo.results()["job"]]
+    for k in tables[0].index:
+        for figure in ("max_force", "impacts", "impulse", "gap"):
+            values = np.array([table.loc[k, figure] for table in tables])
+            _assert_statistics(contacts.loc[(k, figure)], values, coverage, confidence)
+    only = monte_carlo.contact_statistics(["max_force"])
+    assert set(only.index.get_level_values("figure")) == {"max_force"}
+
+
+def test_each_pins_statistics_are_those_of_the_member_jobs_pins(
+    client: chocmodal.Client, monte_carlo: chocmodal.Sweep
+) -> None:
+    pins = monte_carlo.pin_statistics(["max_abs_deflection"])
+    documents = [client.job(job).results() for job in monte_carlo.results()["job"]]
+    for p in range(len(documents[0]["pins"])):
+        values = np.array([d["pins"][p]["max_abs_deflection"] for d in documents])
+        _assert_statistics(pins.loc[(p, "max_abs_deflection")], values, 0.95, 0.95)
+
+
+def test_the_convergence_of_a_figure_follows_the_runs_in_draw_order(monte_carlo: chocmodal.Sweep) -> None:
+    table = monte_carlo.results()
+    track = monte_carlo.convergence("max_contact_force.force", coverage=0.9, confidence=0.5)
+    assert list(track.index) == list(range(len(table)))
+    values = table["max_contact_force.force"].astype(float).to_numpy()
+    for n, (_, step) in enumerate(track.iterrows(), start=1):
+        assert step["value"] == values[n - 1]
+        assert step["quantile"] == pytest.approx(float(np.quantile(values[:n], 0.9, method="linear")), rel=1e-12)
+        rank = _wilks_rank(n, 0.9, 0.5)
+        assert (np.isnan(step["bound_rank"]) if rank is None else step["bound_rank"] == rank), (n, step)
+
+
+def test_a_bound_outside_zero_to_one_is_refused_naming_the_parameter(monte_carlo: chocmodal.Sweep) -> None:
+    with pytest.raises(chocmodal.ChocmodalError) as raised:
+        monte_carlo.figure_statistics(coverage=1.0)
+    assert raised.value.status == 400
+    assert "`coverage`" in str(raised.value)
+    runs = monte_carlo.figure_statistics(coverage=0.99, confidence=0.95)
+    assert (runs["runs_needed"] == math.ceil(math.log(0.05) / math.log(0.99))).all(), "no bound from 16 runs"

@@ -27,6 +27,7 @@ pub mod signals;
 pub mod spectra;
 pub mod streamed;
 pub mod sweep_models;
+pub mod sweep_statistics;
 pub mod sweeps;
 
 use std::sync::Arc;
@@ -137,6 +138,7 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
             get(response_spectra::response_spectrum),
         )
         .route("/sweeps", get(sweeps::list).post(sweeps::create))
+        .route("/sweeps/runs-needed", get(sweep_statistics::runs_needed))
         // A record is far larger than an execution request: this route has its own
         // body limit (the innermost limit is the one that applies).
         .route(
@@ -151,6 +153,16 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/signals/{signalId}/spectrum", get(signals::spectrum))
         .route("/sweeps/{sweepId}", get(sweeps::status).delete(sweeps::dismiss))
         .route("/sweeps/{sweepId}/results", get(sweeps::results))
+        .route("/sweeps/{sweepId}/statistics", get(sweep_statistics::statistics))
+        .route(
+            "/sweeps/{sweepId}/statistics/contacts",
+            get(sweep_statistics::contacts),
+        )
+        .route("/sweeps/{sweepId}/statistics/pins", get(sweep_statistics::pins))
+        .route(
+            "/sweeps/{sweepId}/statistics/convergence",
+            get(sweep_statistics::convergence),
+        )
         .merge(dashboard::routes())
         .fallback(not_found)
         // The representation of every GET (innermost: it sees the route): the `format`

@@ -96,6 +96,10 @@ pub fn offers(route: &str) -> Option<&'static [Format]> {
         | "/jobs/{jobId}/results/{output}/spectrum"
         | "/jobs/{jobId}/results/{output}/response_spectrum"
         | "/sweeps/{sweepId}/results"
+        | "/sweeps/{sweepId}/statistics"
+        | "/sweeps/{sweepId}/statistics/contacts"
+        | "/sweeps/{sweepId}/statistics/pins"
+        | "/sweeps/{sweepId}/statistics/convergence"
         | "/signals/{signalId}/samples"
         | "/signals/{signalId}/spectrum" => Some(JSON_OR_CSV),
         "/metrics" => Some(PROMETHEUS),
@@ -499,6 +503,10 @@ mod tests {
             assert_eq!(offers(route), Some(JSON_OR_HTML), "{route}");
         }
         assert_eq!(offers("/jobs/{jobId}/results/contacts"), Some(JSON_OR_CSV));
+        for table in ["", "/contacts", "/pins", "/convergence"] {
+            let route = format!("/sweeps/{{sweepId}}/statistics{table}");
+            assert_eq!(offers(&route), Some(JSON_OR_CSV), "{route}");
+        }
         assert_eq!(offers("/jobs/{jobId}/results"), Some(JSON));
         assert_eq!(offers("/ui/assets/{file}"), None);
     }

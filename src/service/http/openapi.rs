@@ -19,7 +19,7 @@ use utoipa::{Modify, OpenApi};
 
 use super::{
     contacts, impacts, job_inputs, jobs, landing, models, processes, response_spectra, results,
-    signal_models, signals, spectra, sweep_models, sweeps,
+    signal_models, signals, spectra, sweep_models, sweep_statistics, sweeps,
 };
 use crate::processes::Registry;
 use crate::service::queue::JobStatus;
@@ -244,6 +244,11 @@ impl Modify for ResourceLinks {
         sweeps::status,
         sweeps::dismiss,
         sweeps::results,
+        sweep_statistics::statistics,
+        sweep_statistics::contacts,
+        sweep_statistics::pins,
+        sweep_statistics::convergence,
+        sweep_statistics::runs_needed,
         signals::create,
         signals::list,
         signals::metadata,
@@ -289,6 +294,10 @@ impl Modify for ResourceLinks {
         crate::sweep::SweepAxis,
         crate::sweep::SweepRequest,
         sweep_models::SweepResults,
+        sweep_models::SweepStatistics,
+        sweep_models::SweepStatisticsKind,
+        sweep_models::RunsNeeded,
+        sweep_models::RankRuns,
         SignalUploadSchema,
         signal_models::SignalMetadata,
         signal_models::SignalList,

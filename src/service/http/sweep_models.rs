@@ -117,6 +117,21 @@ impl SweepStatus {
                 .titled("Results table and aggregates"),
             Link::new(format!("{href}/results?format=csv"), RESULTS_REL, "text/csv")
                 .titled("Results table as CSV"),
+            Link::new(format!("{href}/statistics"), "describedby", "application/json").titled(
+                "Statistics of the run-wide figures, with a Wilks bound at a chosen coverage and confidence",
+            ),
+            Link::new(
+                format!("{href}/statistics/contacts"),
+                "describedby",
+                "application/json",
+            )
+            .titled("Statistics of each contact's figures"),
+            Link::new(
+                format!("{href}/statistics/pins"),
+                "describedby",
+                "application/json",
+            )
+            .titled("Statistics of each pin's figures"),
             Link::new(
                 format!("/jobs?sweepID={}", record.id),
                 "http://www.opengis.net/def/rel/ogc/1.0/job-list",
@@ -201,4 +216,109 @@ pub struct SweepResults {
     #[schema(value_type = Object)]
     pub aggregates: serde_json::Value,
     pub links: Vec<Link>,
+}
+
+/// Which statistics table of a sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum SweepStatisticsKind {
+    /// Run-wide figures (`/sweeps/{sweepId}/statistics`).
+    Runs,
+    /// Per contact (`/statistics/contacts`).
+    Contacts,
+    /// Per pin (`/statistics/pins`).
+    Pins,
+    /// One figure run by run (`/statistics/convergence`).
+    Convergence,
+}
+
+impl SweepStatisticsKind {
+    /// The path of the table under `/sweeps/{sweepId}`.
+    fn path(self) -> &'static str {
+        match self {
+            SweepStatisticsKind::Runs => "/statistics",
+            SweepStatisticsKind::Contacts => "/statistics/contacts",
+            SweepStatisticsKind::Pins => "/statistics/pins",
+            SweepStatisticsKind::Convergence => "/statistics/convergence",
+        }
+    }
+}
+
+/// A statistics table of a sweep: one flat record per row, the same columns as its CSV.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct SweepStatistics {
+    #[serde(rename = "sweepID")]
+    pub sweep_id: String,
+    pub status: SweepState,
+    pub kind: SweepStatisticsKind,
+    /// The quantile bounded, p (default 0.95).
+    pub coverage: f64,
+    /// The confidence of the bound, γ (default 0.95).
+    pub confidence: f64,
+    /// The fewest runs (per grid cell) whose largest value is the bound:
+    /// ⌈ln(1 − γ) / ln p⌉ (59 at 95 %/95 %).
+    pub runs_needed: Option<usize>,
+    /// The list axes (pointers), the item's key (`contact`, `pin`) for per-item tables,
+    /// `figure`, then `runs`, `count`, `mean`, `std`, `min`, `max`, `q05`, `q50`, `q95`,
+    /// `quantile`, `bound`, `bound_rank`, `runs_needed`; for the convergence table the
+    /// list axes, `sample`, `run`, `value`, `quantile`, `bound`, `bound_rank`, `runs`.
+    /// Values in the figure's unit (SI).
+    pub columns: Vec<String>,
+    /// One object per row, keyed by column; a bound is null below the runs it needs.
+    #[schema(value_type = Vec<Object>)]
+    pub rows: Vec<serde_json::Map<String, serde_json::Value>>,
+    pub links: Vec<Link>,
+}
+
+impl SweepStatistics {
+    pub fn new(
+        record: &SweepRecord,
+        status: SweepState,
+        kind: SweepStatisticsKind,
+        request: crate::sweep::figures::BoundRequest,
+        table: crate::sweep::figures::StatisticsTable,
+    ) -> Self {
+        let href = format!("/sweeps/{}", record.id);
+        let query = format!("coverage={}&confidence={}", request.coverage, request.confidence);
+        let path = kind.path();
+        Self {
+            sweep_id: record.id.clone(),
+            status,
+            kind,
+            coverage: request.coverage,
+            confidence: request.confidence,
+            runs_needed: request.runs_needed(1),
+            columns: table.columns,
+            rows: table.rows,
+            links: vec![
+                Link::new(format!("{href}{path}?{query}"), "self", "application/json"),
+                Link::new(
+                    format!("{href}{path}?{query}&format=csv"),
+                    "alternate",
+                    "text/csv",
+                ),
+                Link::new(&href, "up", "application/json").titled("Sweep status"),
+            ],
+        }
+    }
+}
+
+/// The runs a one-sided Wilks bound needs, rank by rank (`/sweeps/runs-needed`).
+#[derive(Debug, Serialize, ToSchema)]
+pub struct RunsNeeded {
+    /// The quantile bounded, p.
+    pub coverage: f64,
+    /// The confidence of the bound, γ.
+    pub confidence: f64,
+    /// Rank 1 (the largest value) first.
+    pub runs_needed: Vec<RankRuns>,
+}
+
+/// The fewest independent runs whose `rank`-th largest value is the bound.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct RankRuns {
+    /// From the top: 1 is the largest value.
+    pub rank: usize,
+    /// Null beyond 10¹² runs.
+    pub runs: Option<usize>,
 }

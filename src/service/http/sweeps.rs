@@ -175,7 +175,7 @@ fn refusal(refusal: Refusal) -> ApiError {
     problem.into()
 }
 
-async fn sweep_status(
+pub(super) async fn sweep_status(
     state: &AppState,
     tenant: &Tenant,
     record: &SweepRecord,
@@ -190,7 +190,7 @@ async fn sweep_status(
     ))
 }
 
-async fn find(state: &AppState, tenant: &Tenant, sweep_id: &str) -> Result<SweepRecord, ApiError> {
+pub(super) async fn find(state: &AppState, tenant: &Tenant, sweep_id: &str) -> Result<SweepRecord, ApiError> {
     Ok(state
         .queue
         .get_sweep(tenant.as_str(), sweep_id)
@@ -451,7 +451,7 @@ fn render_results(
 
 /// What the results table needs of an ended run: its stored inputs, and the scalar
 /// metrics of its stored results document (none when it has none).
-fn run_record(run: SweepRun, process: Option<&dyn Process>) -> RunRecord {
+pub(super) fn run_record(run: SweepRun, process: Option<&dyn Process>) -> RunRecord {
     let document: Option<serde_json::Value> = run
         .results
         .as_deref()

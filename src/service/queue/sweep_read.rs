@@ -179,4 +179,40 @@ impl JobQueue {
             })
             .collect())
     }
+
+    /// The successful runs of sweep `id` numbered after `after` (−1: from the first), at
+    /// most `limit`, in run order: the results documents a page at a time, so that a
+    /// reader holds a few of them, not the sweep's.
+    pub async fn successful_sweep_runs_after(
+        &self,
+        tenant: &str,
+        id: &str,
+        after: i64,
+        limit: i64,
+    ) -> Result<Vec<SweepRun>, sqlx::Error> {
+        type Row = (String, Option<i64>, String, String, Option<String>);
+        let rows: Vec<Row> = with_pool!(&self.db, pool => {
+            sqlx::query_as(
+                "SELECT id, sweep_run, status, inputs, results FROM jobs \
+                 WHERE sweep_id = $1 AND tenant = $2 AND status = 'successful' AND sweep_run > $3 \
+                 ORDER BY sweep_run LIMIT $4",
+            )
+            .bind(id)
+            .bind(tenant)
+            .bind(after)
+            .bind(limit)
+            .fetch_all(pool)
+            .await?
+        });
+        Ok(rows
+            .into_iter()
+            .map(|(job_id, run, status, inputs, results)| SweepRun {
+                run: run.unwrap_or(0),
+                job_id,
+                status: JobStatus::parse(&status).unwrap_or(JobStatus::Failed),
+                inputs,
+                results,
+            })
+            .collect())
+    }
 }

@@ -138,6 +138,64 @@ class Sweep:
         frame = pd.DataFrame(records, columns=[*axis_names, "metric", *_STATISTICS])
         return frame.set_index([*axis_names, "metric"])
 
+    def _statistics_table(self, path: str, params: dict[str, Any], index: list[str]) -> pd.DataFrame:
+        """A long statistics table of the sweep (``/sweeps/{id}/statistics...``) from its
+        CSV form, indexed by the columns of ``index`` it has (the list axes first)."""
+        response = self._client._transport.request(
+            "GET", f"/sweeps/{self.id}/{path}", params={**params, "format": "csv"}, headers={"Accept": "text/csv"}
+        )
+        frame = frames.table_frame(response.text)
+        axes = [c for c in frame.columns if c.startswith("/")]
+        keys = [*axes, *[c for c in index if c in frame.columns]]
+        frame = pd.DataFrame(frame.set_index(keys)) if keys else frame
+        frame.attrs["sweep"] = self.id
+        return frame
+
+    def figure_statistics(self, *, coverage: float = 0.95, confidence: float = 0.95) -> pd.DataFrame:
+        """The run-wide statistics at a chosen bound: one row per (grid cell of the list
+        axes, ``figure``: a numeric column of the results table), columns ``runs, count,
+        mean, std, min, max, q05, q50, q95, quantile`` (the empirical ``coverage``
+        quantile), ``bound, bound_rank`` (the one-sided ``coverage``/``confidence`` upper
+        bound of Wilks and its rank from the top, NaN with too few runs) and
+        ``runs_needed`` (the fewest runs for that rank, rank 1 while there is none)."""
+        return self._statistics_table(
+            "statistics", {"coverage": coverage, "confidence": confidence}, ["figure"]
+        )
+
+    def contact_statistics(
+        self, figures: Optional[list[str]] = None, *, coverage: float = 0.95, confidence: float = 0.95
+    ) -> pd.DataFrame:
+        """Each contact's statistics over the runs (bundle processes): as
+        :meth:`figure_statistics`, one row per (cell, ``contact``, ``figure``), the
+        figures the numeric members of each contact's entry (``max_force``, ``impacts``,
+        ``utilisation``...), only ``figures`` when given."""
+        params: dict[str, Any] = {"coverage": coverage, "confidence": confidence}
+        if figures:
+            params["figure"] = list(figures)
+        return self._statistics_table("statistics/contacts", params, ["contact", "figure"])
+
+    def pin_statistics(
+        self, figures: Optional[list[str]] = None, *, coverage: float = 0.95, confidence: float = 0.95
+    ) -> pd.DataFrame:
+        """Each pin's statistics over the runs: as :meth:`contact_statistics`, for the
+        pins (``max_abs_deflection``, ``bending.stress``, ``utilisation``...)."""
+        params: dict[str, Any] = {"coverage": coverage, "confidence": confidence}
+        if figures:
+            params["figure"] = list(figures)
+        return self._statistics_table("statistics/pins", params, ["pin", "figure"])
+
+    def convergence(self, figure: str, *, coverage: float = 0.95, confidence: float = 0.95) -> pd.DataFrame:
+        """How ``figure`` (a numeric column of the results table) converges as runs are
+        added, in the order they were drawn: one row per (cell, ``sample``) with the
+        ``run``, its ``value``, and over the first ``runs`` values the empirical
+        ``quantile`` and the Wilks ``bound`` with its ``bound_rank`` (NaN until enough
+        runs)."""
+        return self._statistics_table(
+            "statistics/convergence",
+            {"figure": figure, "coverage": coverage, "confidence": confidence},
+            ["sample"],
+        )
+
     def quality_counts(self) -> pd.DataFrame:
         """Successful runs per quality verdict: a row ``("all", "")`` for the total, then
         one per (axis, value) of each list axis."""

@@ -1,6 +1,7 @@
 // One sweep: status and progress (live), definition, the calibration map of f_err over
-// two axes with its 0.2 contour, histograms of Monte Carlo metrics, the quality verdicts
-// of the runs (how many poor, per axis value), and the results table.
+// two axes with its 0.2 contour, histograms of Monte Carlo metrics with the q95 and the
+// 95 %/95 % Wilks bound against the number of runs, the quality verdicts of the runs
+// (how many poor, per axis value), and the results table.
 
 import {FINISHED, api, badge, card, download, errorBox, fmt, fmtColumn, fmtTime, h, keyValueTable, poll, progressBar,
   replace, shortId, sweepBadge} from './util.js';
@@ -208,6 +209,7 @@ function monteCarloCard(groups, doc, definition) {
   const state = {metric: preferred.find((m) => metrics.includes(m)) || metrics[0], cell: 0};
   const listAxes = Object.keys(groups[0].cell || {});
   const plotBox = h('div');
+  const convergenceBox = h('div');
   const tableBox = h('div');
   const cellLabel = (g) => Object.entries(g.cell).map(([p, v]) => `${p} = ${fmtColumn(v, p)}`).join(', ') || 'all runs';
   const draw = () => {
@@ -221,6 +223,7 @@ function monteCarloCard(groups, doc, definition) {
         (stats.bound_95_95 == null ? ' (a 95 %/95 % bound needs 59 runs)' : `, 95 %/95 % bound ${fmt(stats.bound_95_95)}`)),
       markers: [{x: stats.q05, label: 'q05'}, {x: stats.q50, label: 'median'}, {x: stats.q95, label: 'q95'},
         {x: stats.mean, label: 'mean'}]}));
+    showConvergence(convergenceBox, doc.sweepID, state.metric, group.cell, listAxes);
     replace(tableBox, h('details', {}, h('summary', {}, `statistics of every column (${cellLabel(group)})`),
       h('div', {class: 'scroll'}, h('table', {class: 'list', 'data-statistics': ''},
         h('thead', {}, h('tr', {}, ['column', 'count', 'mean', 'std', 'min', 'q05', 'q50', 'q95', 'max', 'bound 95/95'].map((c) => h('th', {}, c)))),
@@ -239,7 +242,41 @@ function monteCarloCard(groups, doc, definition) {
   const random = ((definition && definition.axes) || []).filter((a) => a.values === undefined && a.linspace === undefined &&
     a.logspace === undefined).map((a) => a.pointer);
   return card('Monte Carlo statistics', random.length ? h('p', {class: 'muted'}, `random: ${random.join(', ')}`) : null,
-    controls, plotBox, tableBox);
+    controls, plotBox, convergenceBox, tableBox);
+}
+
+/** The latest convergence plot asked for: an older answer arriving late is dropped. */
+let convergenceAsked = 0;
+
+/**
+ * The empirical 95 % quantile and the 95 %/95 % Wilks bound of `figure` over the first n
+ * runs of the cell, against n in the order the runs were drawn: has the campaign
+ * converged? (`/sweeps/{id}/statistics/convergence`, also as CSV.)
+ */
+async function showConvergence(box, id, figure, cell, listAxes) {
+  const asked = ++convergenceAsked;
+  const path = `/sweeps/${id}/statistics/convergence?figure=${encodeURIComponent(figure)}`;
+  let track;
+  try {
+    track = await api(path);
+  } catch (error) {
+    if (asked === convergenceAsked) replace(box, errorBox(error));
+    return;
+  }
+  if (asked !== convergenceAsked) return;
+  const rows = track.rows.filter((row) => listAxes.every((p) => same(row[p], cell[p])));
+  const runs = rows.map((row) => row.runs);
+  const first = rows.find((row) => row.bound !== null);
+  replace(box, linePlot({id: 'convergence', title: `${figure} against the number of runs`, xName: 'runs', xLabel: 'runs',
+    yLabel: figure,
+    caption: h('span', {class: 'muted'}, first ? ` the bound from run ${first.runs} (${track.runs_needed} needed)`
+      : ` a 95 %/95 % bound needs ${track.runs_needed} runs`),
+    series: [
+      {name: 'value', label: 'each run', x: runs, y: rows.map((row) => row.value), envelope: true},
+      {name: 'quantile', label: 'q95 of the runs so far', x: runs, y: rows.map((row) => row.quantile)},
+      {name: 'bound', label: 'Wilks 95 %/95 % bound', x: runs, y: rows.map((row) => row.bound), dashed: true},
+    ]}),
+  h('p', {class: 'actions'}, download(`${path}&format=csv`, 'convergence.csv')));
 }
 
 function tableCard(doc) {
