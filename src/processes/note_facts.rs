@@ -3,7 +3,7 @@
 //! contact's and each pin's figures, the bending envelope along the height, and which
 //! histories to plot. A process says where these are in its document
 //! ([`super::Simulation::note`]); the readers here are shared, so the note itself is
-//! drawn once for every process (`crate::calculation_note`).
+//! drawn once for every process (`src/calculation_note/`).
 //!
 //! Every figure is a [`Figure`]: the value as the document has it, its unit and the JSON
 //! pointer of the member it comes from, so that a note can say where each of its numbers
