@@ -52,7 +52,8 @@ pub enum Axis {
 /// order; every point when there are few.
 pub fn decimate(x: &[f64], y: &[f64], buckets: usize) -> Vec<(f64, f64)> {
     let n = x.len().min(y.len());
-    if n <= 4 * buckets.max(1) {
+    let buckets = buckets.max(1);
+    if n <= 4 * buckets {
         return x.iter().copied().zip(y.iter().copied()).take(n).collect();
     }
     let mut kept = Vec::with_capacity(4 * buckets);

@@ -10,7 +10,8 @@
 //!   and each reason are the document's; the provenance is the document's;
 //! - labels and notes are escaped; a job not finished has no note (404
 //!   `result-not-ready`), nor a dismissed one; the note is HTML only (`?format=json`: 400);
-//! - in Chromium every section is visible on screen and in print, and printing to PDF
+//! - in Chromium every section is visible on screen and in print (and the job's dashboard
+//!   page links to the note), and printing to PDF
 //!   (A4) puts each plot whole on one page: each plot links to its data, and the link
 //!   annotations Chromium writes into the PDF (one per fragment of the link's box) say
 //!   on which page and how tall each plot came out.
@@ -544,4 +545,19 @@ async fn in_chromium_every_section_shows_and_the_printed_pdf_keeps_each_plot_who
             "the plot linking to {href} printed {width} pt wide, not the page's width"
         );
     }
+
+    // The job's dashboard page links to its note.
+    browser.goto(&app.url(&format!("/jobs/{job}"))).await;
+    let link = browser
+        .wait_for(
+            "document.querySelector('[data-report-link]')?.getAttribute('href')",
+            Duration::from_secs(30),
+        )
+        .await;
+    assert_eq!(
+        link,
+        json!(format!("/jobs/{job}/report")),
+        "the job page's link to its note"
+    );
+    browser.assert_no_exceptions();
 }
