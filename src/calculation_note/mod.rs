@@ -637,7 +637,7 @@ fn plots(page: &mut String, plots: &[Plot]) {
         if let Some((time, value)) = &request.peak {
             let _ = write!(
                 caption,
-                "; the reported peak {} at {} s is circled",
+                "; the reported peak {} at {} is circled",
                 inline(value),
                 inline(time)
             );
