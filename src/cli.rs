@@ -6,6 +6,7 @@
 //! A result whose quality verdict is not `good` still exits 0 (as its job would be
 //! `successful`) but says so on stderr: `warning: quality poor: <reason>; <reason>`;
 //! each plausibility warning about the inputs is a line `warning: <pointer>: <message>`.
+//! `--out DIR` writes the histories as CSV, `--report FILE` the calculation note.
 //! `chocmodal serve` runs the HTTP API and its workers, `chocmodal worker` workers alone
 //! (see [`crate::service`]).
 
@@ -53,6 +54,10 @@ pub struct RunArgs {
     /// Also write every history as `DIR/<name>.csv` at full output resolution.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Also write the run's calculation note as FILE: one printable HTML page (the
+    /// same page as `GET /jobs/{jobId}/report`).
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
     /// Print progress to stderr.
     #[arg(long)]
     pub progress: bool,
@@ -146,12 +151,68 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
     if let Some(dir) = &args.out {
         write_histories(dir, &output).map_err(CliFailure::Failed)?;
     }
-    let mut document = output.document_with_outputs(|name| match &args.out {
+    let href = |name: &str| match &args.out {
         Some(dir) => dir.join(format!("{name}.csv")).display().to_string(),
         None => format!("{name}.csv"),
-    });
+    };
+    // The plots are drawn from the histories before the document takes them.
+    let plots = args
+        .report
+        .as_ref()
+        .map(|_| plots(process.as_ref(), &output, &href));
+    let mut document = output.document_with_outputs(href);
     crate::provenance::Provenance::of(&inputs).stamp(&mut document);
+    if let (Some(path), Some(plots)) = (&args.report, plots) {
+        let note = calculation_note(process.as_ref(), &inputs, &document, plots);
+        std::fs::write(path, note)
+            .map_err(|e| CliFailure::Failed(format!("cannot write {}: {e}", path.display())))?;
+    }
     Ok(document)
+}
+
+/// The plots of the run's calculation note, each linked to its history's CSV file.
+fn plots(
+    process: &dyn crate::processes::Process,
+    output: &RunOutput,
+    href: &dyn Fn(&str) -> String,
+) -> Vec<crate::calculation_note::Plot> {
+    process
+        .note_facts(&output.document)
+        .plots
+        .iter()
+        .map(|request| {
+            let history = output.histories.iter().find(|h| h.name == request.output);
+            crate::calculation_note::Plot::of(request, history, href(&request.output))
+        })
+        .collect()
+}
+
+/// The run's calculation note ([`crate::calculation_note`]), with its `plots`.
+fn calculation_note(
+    process: &dyn crate::processes::Process,
+    inputs: &serde_json::Value,
+    document: &serde_json::Value,
+    plots: Vec<crate::calculation_note::Plot>,
+) -> String {
+    use crate::calculation_note::{Identification, Note, render};
+    let facts = process.note_facts(document);
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| i64::try_from(d.as_millis()).unwrap_or(i64::MAX));
+    let note = Note {
+        identification: Identification {
+            process_id: process.id().to_owned(),
+            process_title: process.title().to_owned(),
+            dates: vec![("Run (chocmodal run)".into(), crate::service::clock::rfc3339(now))],
+            ..Identification::default()
+        },
+        inputs,
+        document,
+        facts,
+        plots,
+        envelope_href: "#envelope".into(),
+    };
+    render(&note)
 }
 
 /// Where the record files a job names are looked for: the job file's directory (the

@@ -5,6 +5,8 @@
 
 /// Labels and a note attached to a job, checked (a leaf above the processes' errors).
 pub mod annotations;
+/// A run's calculation note: one printable HTML page (CLI and HTTP, one writer).
+pub mod calculation_note;
 /// The `chocmodal` command line (serve, run).
 pub mod cli;
 /// The per-contact statistics table of a results document (CLI and HTTP, one writer).

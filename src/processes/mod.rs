@@ -32,6 +32,9 @@ pub mod metrics;
 /// The member at fault when a tagged object fails to parse.
 pub mod misfit;
 pub mod model_check;
+/// What a calculation note reads of a results document (peaks, margins, worst contacts
+/// and pins, the bending envelope, the histories to plot).
+pub mod note_facts;
 /// The laws of random gaps the generators share.
 pub mod random_gaps;
 /// The shared parts of results documents (quality, energy) as serialized types.
@@ -306,6 +309,12 @@ pub trait Process: Send + Sync + std::fmt::Debug {
     /// of its arrays worth a column.
     fn summary_metrics(&self, document: &serde_json::Value) -> Vec<(String, serde_json::Value)> {
         metrics::flatten_scalars(document)
+    }
+    /// What a calculation note shows of one of its results documents (`GET
+    /// /jobs/{jobId}/report`, `chocmodal run --report`): nothing by default.
+    fn note_facts(&self, document: &serde_json::Value) -> note_facts::NoteFacts {
+        let _ = document;
+        note_facts::NoteFacts::default()
     }
     /// The OpenAPI schemas of its inputs and results documents, with every schema they
     /// reference, for the service's OpenAPI document (none by default).

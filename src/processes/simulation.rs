@@ -126,6 +126,13 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
         let _ = (output, name, document);
         None
     }
+    /// What a calculation note shows of one results `document`: its peaks, margins,
+    /// contacts, pins, envelope and plots, each with the pointer it comes from
+    /// ([`super::note_facts`]). None by default.
+    fn note(document: &serde_json::Value) -> super::note_facts::NoteFacts {
+        let _ = document;
+        super::note_facts::NoteFacts::default()
+    }
 }
 
 /// Parses, attaches the stored signals referenced, prepares, checks against the
@@ -267,6 +274,10 @@ impl<S: Simulation> Process for S {
                     .map(|name| S::column(output, name, document).unwrap_or_else(|| Column::unknown(name))),
             )
             .collect()
+    }
+
+    fn note_facts(&self, document: &serde_json::Value) -> super::note_facts::NoteFacts {
+        S::note(document)
     }
 
     fn schemas(&self, schemas: &mut Vec<(String, RefOr<Schema>)>) {

@@ -35,6 +35,7 @@ mod negotiation;
 mod physics;
 mod quality;
 mod recovery;
+mod report;
 mod response_spectra;
 mod responsiveness;
 mod resultants;

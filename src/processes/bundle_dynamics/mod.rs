@@ -308,6 +308,21 @@ impl Simulation for BundleDynamics {
         column_of(output, name, document)
     }
 
+    /// A row's pins keep their largest deflection at their top level (`LineExtremes`);
+    /// their tip columns are `p<pin>`.
+    fn note(document: &serde_json::Value) -> super::note_facts::NoteFacts {
+        super::note_facts::run_of_pins(
+            document,
+            &|k| contact_label(document, k),
+            super::note_facts::DeflectionMembers {
+                value: "/max_abs_deflection",
+                height: "/height",
+                time: "/time",
+            },
+            &|pin| vec![format!("p{pin}")],
+        )
+    }
+
     fn signals(inputs: &mut BundleInputs) -> Vec<super::signal_input::SignalSlot<'_>> {
         inputs.excitation.signal_references()
     }
@@ -631,6 +646,13 @@ fn column_of(output: &str, name: &str, document: &serde_json::Value) -> Option<s
         description.0,
         columns::of_output(output, description.1),
     ))
+}
+
+/// Contact k in words, as its force history's column describes it.
+fn contact_label(document: &serde_json::Value, k: usize) -> String {
+    column_of("contact_forces", &format!("c{k}"), document)
+        .and_then(|column| column.description)
+        .unwrap_or_else(|| format!("contact {k}"))
 }
 
 #[cfg(test)]

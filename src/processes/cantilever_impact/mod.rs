@@ -14,6 +14,7 @@ use super::contact_law::LawInput;
 use super::impact_report::{self, ContactImpacts, ImpactSummary, ImpactsInput};
 use super::margins::{self, StressUtilisation, TipAllowablesInput};
 use super::model_check::{self, StandIn};
+use super::note_facts::{Fact, NoteFacts, PlotRequest};
 use super::report::{EnergyReport, QualityReport};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
 use super::warnings::{Subject, WarningsInput};
@@ -511,6 +512,12 @@ impl Simulation for CantileverImpact {
         ))
     }
 
+    /// One contact (the tip spring) and one beam: the run's figures are under
+    /// `numerical`, checked against the reference's.
+    fn note(document: &serde_json::Value) -> NoteFacts {
+        note(document)
+    }
+
     fn prepare(inputs: CantileverInputs) -> Result<Plan, InvalidInputs> {
         let mut errors: Vec<FieldError> = at("/inputs/beam", inputs.beam.validate());
         let supports = inputs.beam.supports;
@@ -809,6 +816,121 @@ fn reference_peaks(
         k += count;
     }
     Ok(peaks)
+}
+
+/// The note of a cantilever run: its peaks (the contact force and the tip deflection,
+/// each beside the reference's), the agreement of the two, its one contact.
+fn note(document: &serde_json::Value) -> NoteFacts {
+    use super::note_facts::{
+        ContactRow, Figure, Unit, bending_peaks, envelope, fact, margin_facts, solution,
+    };
+    // The envelope's last node is the tip.
+    let tip = document
+        .pointer("/numerical/bending_envelope")
+        .and_then(serde_json::Value::as_array)
+        .and_then(|nodes| nodes.last()?["height"].as_f64())
+        .map_or_else(
+            || "the tip".to_owned(),
+            |l| format!("the tip, {}", columns::metres(l)),
+        );
+    let tip_contact = format!("tip spring at {tip}");
+    let mut peaks: Vec<Fact> = [
+        (
+            "largest contact force",
+            "/numerical/max_contact_force",
+            Unit::Newton,
+            Some("/numerical/max_contact_force_time"),
+        ),
+        (
+            "largest contact force, reference",
+            "/reference/max_contact_force",
+            Unit::Newton,
+            Some("/reference/max_contact_force_time"),
+        ),
+        (
+            "lowest tip deflection",
+            "/numerical/min_tip_displacement",
+            Unit::Deflection,
+            None,
+        ),
+        (
+            "lowest tip deflection, reference",
+            "/reference/min_tip_displacement",
+            Unit::Deflection,
+            None,
+        ),
+    ]
+    .into_iter()
+    .filter_map(|(quantity, pointer, unit, time)| fact(document, quantity, pointer, unit, time, tip.clone()))
+    .collect();
+    peaks.extend(bending_peaks(document, "/numerical/max_bending", false));
+    let checks = [
+        (
+            "f_err, numerical against reference tip spectra",
+            "/comparison/f_err",
+        ),
+        ("f_err threshold", "/comparison/threshold"),
+        ("impacts", "/numerical/impacts"),
+        ("impacts, reference", "/reference/impacts"),
+    ]
+    .into_iter()
+    .filter_map(|(quantity, pointer)| {
+        fact(
+            document,
+            quantity,
+            pointer,
+            Unit::Dimensionless,
+            None,
+            String::new(),
+        )
+    })
+    .collect();
+    // The one contact, from the members `numerical` has for it.
+    let at = |member: &str, unit| Figure::at(document, format!("/numerical/{member}"), unit);
+    let contacts = at("max_contact_force", Unit::Newton)
+        .map(|max_force| ContactRow {
+            contact: 0,
+            label: tip_contact.clone(),
+            max_force,
+            max_force_time: at("max_contact_force_time", Unit::Second),
+            impacts: at("impacts", Unit::Count),
+            impulse: at("impulse", Unit::NewtonSecond),
+            allowable_force: at("allowable_force", Unit::Newton),
+            utilisation: at("utilisation", Unit::Dimensionless),
+        })
+        .into_iter()
+        .collect();
+    let peak = Figure::at(document, "/numerical/max_contact_force_time", Unit::Second).zip(Figure::at(
+        document,
+        "/numerical/max_contact_force",
+        Unit::Newton,
+    ));
+    NoteFacts {
+        peaks,
+        margins: margin_facts(document, "/numerical", &|_| tip_contact.clone()),
+        checks,
+        solution: solution(document, "/numerical"),
+        contacts,
+        pins: Vec::new(),
+        envelope: envelope(document, "/numerical/bending_envelope"),
+        plots: vec![
+            PlotRequest {
+                title: "Tip contact force, numerical and reference: the extreme of each output interval"
+                    .into(),
+                output: "contact_force_peaks".into(),
+                series: vec!["numerical".into(), "reference".into()],
+                unit: Unit::Newton,
+                peak,
+            },
+            PlotRequest {
+                title: "Tip deflection, numerical and reference".into(),
+                output: "tip_displacement".into(),
+                series: vec!["numerical".into(), "reference".into()],
+                unit: Unit::Deflection,
+                peak: None,
+            },
+        ],
+    }
 }
 
 #[cfg(test)]

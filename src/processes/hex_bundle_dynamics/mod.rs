@@ -314,6 +314,21 @@ impl Simulation for HexBundleDynamics {
         column_of(output, name, document)
     }
 
+    /// A pin's largest deflection is the resultant of x and y (`deflection`); its tip
+    /// columns are `p<pin>x` and `p<pin>y`.
+    fn note(document: &serde_json::Value) -> super::note_facts::NoteFacts {
+        super::note_facts::run_of_pins(
+            document,
+            &|k| contact_label(document, k),
+            super::note_facts::DeflectionMembers {
+                value: "/deflection/max_deflection",
+                height: "/deflection/height",
+                time: "/deflection/time",
+            },
+            &|pin| vec![format!("p{pin}x"), format!("p{pin}y")],
+        )
+    }
+
     fn signals(inputs: &mut HexInputs) -> Vec<super::signal_input::SignalSlot<'_>> {
         inputs.excitation.signal_references()
     }
@@ -902,6 +917,13 @@ fn column_of(output: &str, name: &str, document: &serde_json::Value) -> Option<s
         description.0,
         columns::of_output(output, description.1),
     ))
+}
+
+/// Contact k in words, as its force history's column describes it.
+fn contact_label(document: &serde_json::Value, k: usize) -> String {
+    column_of("contact_forces", &format!("c{k}"), document)
+        .and_then(|column| column.description)
+        .unwrap_or_else(|| format!("contact {k}"))
 }
 
 #[cfg(test)]

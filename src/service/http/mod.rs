@@ -20,6 +20,7 @@ pub mod models;
 pub mod negotiation;
 pub mod openapi;
 pub mod processes;
+pub mod report;
 pub mod response_spectra;
 pub mod results;
 pub mod signal_models;
@@ -127,6 +128,7 @@ pub fn router(state: AppState, settings: &HttpSettings) -> Router {
         .route("/jobs/{jobId}", get(jobs::status).delete(jobs::dismiss))
         .route("/jobs/{jobId}/results", get(results::results))
         .route("/jobs/{jobId}/inputs", get(job_inputs::inputs))
+        .route("/jobs/{jobId}/report", get(report::report))
         .route("/jobs/{jobId}/results/impacts", get(impacts::impacts))
         .route("/jobs/{jobId}/results/contacts", get(contacts::contacts))
         .route("/jobs/{jobId}/results/pins", get(contacts::pins))

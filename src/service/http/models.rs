@@ -36,6 +36,9 @@ impl Link {
     }
 }
 
+/// The relation of a job's link to its calculation note (`/jobs/{jobId}/report`).
+pub const REPORT_RELATION: &str = "https://chocmodal.dev/rel/report";
+
 /// The state of one job (OGC `statusInfo`).
 #[derive(Debug, Clone, Serialize, ToSchema)]
 pub struct StatusInfo {
@@ -96,6 +99,12 @@ impl StatusInfo {
                     "application/json",
                 )
                 .titled("Job results"),
+            );
+        }
+        if job.status == JobStatus::Successful {
+            links.push(
+                Link::new(format!("{href}/report"), REPORT_RELATION, "text/html")
+                    .titled("Calculation note (printable HTML)"),
             );
         }
         links.push(Link::new(

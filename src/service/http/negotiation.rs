@@ -11,7 +11,8 @@
 //!   `text/*`, then `*/*`); the highest quality above zero wins, a tie goes to the range
 //!   listed first, then to the route's default. HTML is given only to a request that
 //!   names `text/html` (or `application/xhtml+xml`) itself: a wildcard never turns a
-//!   JSON client into a page reader. No `Accept` (or an empty one) is the default; an
+//!   JSON client into a page reader (on a route whose only format is HTML, the
+//!   calculation note, a wildcard selects it). No `Accept` (or an empty one) is the default; an
 //!   `Accept` that excludes every offer is a 406 `not-acceptable` naming them.
 //!
 //! The choice travels to the handler as a [`Format`] in the request's extensions (an
@@ -80,6 +81,7 @@ const JSON: &[Format] = &[Format::Json];
 const JSON_OR_HTML: &[Format] = &[Format::Json, Format::Html];
 const JSON_OR_CSV: &[Format] = &[Format::Json, Format::Csv];
 const PROMETHEUS: &[Format] = &[Format::Prometheus];
+const HTML: &[Format] = &[Format::Html];
 
 /// The formats a route template offers, its default first; `None` for the dashboard's
 /// own files (scripts, style, the submit form), served as they are.
@@ -103,6 +105,7 @@ pub fn offers(route: &str) -> Option<&'static [Format]> {
         | "/signals/{signalId}/samples"
         | "/signals/{signalId}/spectrum" => Some(JSON_OR_CSV),
         "/metrics" => Some(PROMETHEUS),
+        "/jobs/{jobId}/report" => Some(HTML),
         route if route.starts_with("/ui/") => None,
         _ => Some(JSON),
     }
@@ -182,8 +185,9 @@ fn parse_accept(accept: &str) -> Vec<MediaRange<'_>> {
         .collect()
 }
 
-/// Quality and position of the most specific range of `ranges` matching `format`.
-fn preference(ranges: &[MediaRange<'_>], format: Format) -> Option<(f64, usize)> {
+/// Quality and position of the most specific range of `ranges` matching `format`;
+/// wildcard ranges count only when `wildcards`.
+fn preference(ranges: &[MediaRange<'_>], format: Format, wildcards: bool) -> Option<(f64, usize)> {
     ranges
         .iter()
         .filter_map(|r| {
@@ -192,8 +196,8 @@ fn preference(ranges: &[MediaRange<'_>], format: Format) -> Option<(f64, usize)>
                 .iter()
                 .filter_map(|(kind, subtype)| match (r.kind, r.subtype) {
                     (k, s) if k.eq_ignore_ascii_case(kind) && s.eq_ignore_ascii_case(subtype) => Some(3),
-                    (k, "*") if k.eq_ignore_ascii_case(kind) && format.wildcards_select() => Some(2),
-                    ("*", "*") if format.wildcards_select() => Some(1),
+                    (k, "*") if k.eq_ignore_ascii_case(kind) && wildcards => Some(2),
+                    ("*", "*") if wildcards => Some(1),
                     _ => None,
                 })
                 .max()?;
@@ -216,11 +220,14 @@ pub fn preferred(accept: Option<&str>, offered: &[Format]) -> Option<Format> {
         return offered.first().copied();
     };
     let ranges = parse_accept(accept);
+    // A route whose only format is HTML (the calculation note) is what any client asks
+    // for with a wildcard: there is no JSON to keep it from.
+    let alone = offered.len() == 1;
     offered
         .iter()
         .enumerate()
         .filter_map(|(order, &format)| {
-            let (quality, position) = preference(&ranges, format)?;
+            let (quality, position) = preference(&ranges, format, alone || format.wildcards_select())?;
             (quality > 0.0).then_some((quality, position, order, format))
         })
         .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)).then(b.2.cmp(&a.2)))
@@ -440,6 +447,26 @@ mod tests {
         assert_eq!(preferred(Some("  "), JSON_OR_CSV), Some(Format::Json));
     }
 
+    #[test]
+    fn a_route_whose_only_format_is_html_serves_it_to_wildcards_but_not_to_json_clients() {
+        for accept in [
+            "*/*",
+            "text/*",
+            "text/html",
+            "",
+            "application/json;q=0.5, */*;q=0.1",
+        ] {
+            assert_eq!(preferred(Some(accept), HTML), Some(Format::Html), "{accept:?}");
+        }
+        assert_eq!(preferred(Some("application/json"), HTML), None);
+        let refused = choose(HTML, &HeaderMap::new(), Some("format=json")).unwrap_err();
+        assert!(
+            refused.problem().detail.contains("`html`"),
+            "{}",
+            refused.problem().detail
+        );
+    }
+
     fn headers(accept: &str) -> HeaderMap {
         let mut headers = HeaderMap::new();
         headers.insert(header::ACCEPT, accept.parse().unwrap());
@@ -508,6 +535,7 @@ mod tests {
             assert_eq!(offers(&route), Some(JSON_OR_CSV), "{route}");
         }
         assert_eq!(offers("/jobs/{jobId}/results"), Some(JSON));
+        assert_eq!(offers("/jobs/{jobId}/report"), Some(HTML));
         assert_eq!(offers("/ui/assets/{file}"), None);
     }
 }

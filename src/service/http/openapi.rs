@@ -18,7 +18,7 @@ use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
 use utoipa::{Modify, OpenApi};
 
 use super::{
-    contacts, impacts, job_inputs, jobs, landing, models, processes, response_spectra, results,
+    contacts, impacts, job_inputs, jobs, landing, models, processes, report, response_spectra, results,
     signal_models, signals, spectra, sweep_models, sweep_statistics, sweeps,
 };
 use crate::processes::Registry;
@@ -168,6 +168,7 @@ const LINKS: &[(&str, &str, &str, &str, &str, &str, &str)] = &[
     ("/processes/{processId}/execution", "post", "201", "spectrum", "getResultSpectrum", "jobId", "$response.body#/jobID"),
     ("/processes/{processId}/execution", "post", "201", "response_spectrum", "getResultResponseSpectrum", "jobId", "$response.body#/jobID"),
     ("/processes/{processId}/execution", "post", "201", "inputs", "getJobInputs", "jobId", "$response.body#/jobID"),
+    ("/processes/{processId}/execution", "post", "201", "report", "getReport", "jobId", "$response.body#/jobID"),
     ("/processes/{processId}/execution", "post", "201", "dismiss", "dismiss", "jobId", "$response.body#/jobID"),
     ("/sweeps", "post", "201", "status", "getSweep", "sweepId", "$response.body#/sweepID"),
     ("/sweeps", "post", "201", "results", "getSweepResults", "sweepId", "$response.body#/sweepID"),
@@ -237,6 +238,7 @@ impl Modify for ResourceLinks {
         contacts::contacts,
         contacts::pins,
         contacts::resultants,
+        report::report,
         spectra::spectrum,
         response_spectra::response_spectrum,
         sweeps::create,

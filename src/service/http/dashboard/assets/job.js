@@ -70,6 +70,8 @@ function statusTable(id, status) {
     h('p', {class: 'actions'},
       h('a', {href: `/jobs/${id}?f=json`}, 'status as JSON'),
       h('a', {href: `/ui/submit?from=${id}`}, 'edit and resubmit'),
+      status.status === 'successful'
+        ? h('a', {href: `/jobs/${id}/report`, 'data-report-link': ''}, 'calculation note (printable)') : null,
       running ? dismiss : null),
   ];
 }
