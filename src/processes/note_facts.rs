@@ -400,6 +400,24 @@ pub fn run_of_pins(
             peak: None,
         });
     }
+    if let Some(pin) = document
+        .pointer("/max_resultant_force/pin")
+        .and_then(Value::as_u64)
+    {
+        let height = (document
+            .pointer("/max_resultant_force/height")
+            .and_then(Value::as_f64))
+        .map(super::columns::metres)
+        .unwrap_or_default();
+        peaks.extend(fact(
+            document,
+            "largest resultant contact force on a pin",
+            "/max_resultant_force/max_force",
+            Unit::Newton,
+            Some("/max_resultant_force/time"),
+            format!("p{pin} at {height}"),
+        ));
+    }
     peaks.extend(bending_peaks(document, "/max_bending", true));
     NoteFacts {
         peaks,
