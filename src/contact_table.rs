@@ -120,7 +120,18 @@ impl ContactTable {
 impl PinTable {
     /// The table of a results document; `None` for a process without a pin list.
     pub fn of(document: &Value) -> Option<PinTable> {
-        let (columns, pins) = rows(list(document, "pins")?.iter().map(flatten_scalars));
+        let records = list(document, "pins")?.iter().enumerate().map(|(p, entry)| {
+            // `pin` first, as `contact` leads the contact table.
+            let pin = entry.get("pin").cloned().unwrap_or_else(|| Value::from(p));
+            let mut pairs = vec![("pin".to_owned(), pin)];
+            pairs.extend(
+                flatten_scalars(entry)
+                    .into_iter()
+                    .filter(|(name, _)| name != "pin"),
+            );
+            pairs
+        });
+        let (columns, pins) = rows(records);
         Some(PinTable { columns, pins })
     }
 
@@ -210,8 +221,8 @@ mod tests {
         ]});
         let pins = PinTable::of(&document).unwrap();
         // The per-height list is an array: not a column of the pin table.
-        assert_eq!(pins.columns, ["bending.stress", "pin"]);
-        assert_eq!(pins.to_csv(), "bending.stress,pin\n200,0\n100,1\n");
+        assert_eq!(pins.columns, ["pin", "bending.stress"]);
+        assert_eq!(pins.to_csv(), "pin,bending.stress\n0,200\n1,100\n");
         let resultants = ResultantTable::of(&document).unwrap();
         assert_eq!(
             resultants.columns,

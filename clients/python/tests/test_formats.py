@@ -114,6 +114,8 @@ def test_pandas_reads_every_csv_route_with_read_csv(client: chocmodal.Client, se
         f"{base}/contact_forces_peaks?format=csv": "time",
         f"{base}/impacts?format=csv": "contact",
         f"{base}/contacts?format=csv": "contact",
+        f"{base}/pins?format=csv": "pin",
+        f"{base}/resultants?format=csv": "pin",
         f"{base}/displacements/spectrum?format=csv": "frequency",
         f"{base}/displacements/response_spectrum?format=csv&damping=0.05": "frequency",
         f"{server.url}/sweeps/{sweep.id}/results?format=csv": "run",

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 import warnings
 
 import numpy as np
@@ -248,6 +249,18 @@ def test_resultant_contact_forces_are_a_frame_by_pin_and_height_bounded_by_the_c
     assert results["max_resultant_force"]["max_force"] == resultants["max_force"].max()
     # The per-pin frame keeps one row per pin; the per-height list is the frame above.
     assert "resultant_forces" not in bundle.pins().columns
+
+
+def test_the_calculation_note_is_written_where_asked(bundle: chocmodal.Job, tmp_path) -> None:
+    target = tmp_path / "note.html"
+    html = bundle.report(target)
+    assert target.read_text(encoding="utf-8") == html
+    assert html.startswith("<!doctype html>")
+    assert f"Calculation note: bundle-dynamics job {bundle.id}" in html
+    # Every figure carries the results member it comes from, with its exact value.
+    peak = bundle.results()["max_contact_force"]["force"]
+    shown = re.search(r'data-pointer="/max_contact_force/force" data-value="([^"]+)"', html)
+    assert shown is not None and float(shown.group(1)) == peak
 
 
 def test_the_impact_table_holds_every_impact_of_every_contact(bundle: chocmodal.Job) -> None:

@@ -3,6 +3,7 @@ objects and pandas DataFrames, and dismissal."""
 
 from __future__ import annotations
 
+import os
 import time
 import warnings
 from typing import TYPE_CHECKING, Any, Optional, Union
@@ -258,6 +259,18 @@ class Job:
         frame = frames.contact_table_frame(response.text)
         frame.attrs["job"] = self.id
         return frame
+
+    def report(self, path: Union[str, "os.PathLike[str]", None] = None) -> str:
+        """The job's calculation note (``/jobs/{jobId}/report``, docs/report.md): one
+        printable HTML page with the inputs, the verdict and its reasons, the peaks and
+        margins, the worst contacts and pins, the bending envelope and the key plots.
+        Written to ``path`` when given; the HTML is returned either way. A job without
+        results raises :class:`ChocmodalError` (404)."""
+        response = self._client._transport.request("GET", f"/jobs/{self.id}/report", headers={"Accept": "text/html"})
+        if path is not None:
+            with open(path, "w", encoding="utf-8") as out:
+                out.write(response.text)
+        return response.text
 
     def url(self, path: str = "") -> str:
         """The absolute URL of this job's resource ``path`` (``/results/contacts?format=csv``):
