@@ -73,26 +73,6 @@ fn rows(records: impl Iterator<Item = Vec<(String, Value)>>) -> Rows {
     (columns, rows)
 }
 
-/// CSV: the columns as header, a row per record; a member a record lacks is an empty
-/// cell. Numbers and quoting as [`csv_format`] writes them.
-fn csv(columns: &[String], records: &[Map<String, Value>]) -> String {
-    let header: Vec<String> = columns
-        .iter()
-        .map(|c| csv_format::quote(c).into_owned())
-        .collect();
-    let mut out = header.join(",");
-    out.push('\n');
-    for record in records {
-        let cells: Vec<String> = columns
-            .iter()
-            .map(|name| record.get(name).map_or_else(String::new, csv_format::cell))
-            .collect();
-        out.push_str(&cells.join(","));
-        out.push('\n');
-    }
-    out
-}
-
 /// The non-empty list `name` of a results document.
 fn list<'a>(document: &'a Value, name: &str) -> Option<&'a Vec<Value>> {
     document[name].as_array().filter(|entries| !entries.is_empty())
@@ -111,9 +91,9 @@ impl ContactTable {
         Some(ContactTable { columns, contacts })
     }
 
-    /// The table as CSV ([`csv`]).
+    /// The table as CSV ([`csv_format::records`]).
     pub fn to_csv(&self) -> String {
-        csv(&self.columns, &self.contacts)
+        csv_format::records(&self.columns, &self.contacts)
     }
 }
 
@@ -135,9 +115,9 @@ impl PinTable {
         Some(PinTable { columns, pins })
     }
 
-    /// The table as CSV ([`csv`]).
+    /// The table as CSV ([`csv_format::records`]).
     pub fn to_csv(&self) -> String {
-        csv(&self.columns, &self.pins)
+        csv_format::records(&self.columns, &self.pins)
     }
 }
 
@@ -158,9 +138,9 @@ impl ResultantTable {
         (!resultants.is_empty()).then_some(ResultantTable { columns, resultants })
     }
 
-    /// The table as CSV ([`csv`]).
+    /// The table as CSV ([`csv_format::records`]).
     pub fn to_csv(&self) -> String {
-        csv(&self.columns, &self.resultants)
+        csv_format::records(&self.columns, &self.resultants)
     }
 }
 

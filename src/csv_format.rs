@@ -55,6 +55,25 @@ pub fn cell(value: &serde_json::Value) -> String {
     }
 }
 
+/// A table of flat records as CSV: the columns as header, a row per record in the
+/// columns' order; a member a record lacks (or a null) is an empty cell, the rest as
+/// [`cell`] writes them. The one writer of every table of records (the job's contact,
+/// pin and resultant tables, the sweeps' results and statistics).
+pub fn records(columns: &[String], rows: &[serde_json::Map<String, serde_json::Value>]) -> String {
+    let header: Vec<Cow<'_, str>> = columns.iter().map(|c| quote(c)).collect();
+    let mut out = header.join(",");
+    out.push('\n');
+    for row in rows {
+        let cells: Vec<String> = columns
+            .iter()
+            .map(|name| row.get(name).map(cell).unwrap_or_default())
+            .collect();
+        out.push_str(&cells.join(","));
+        out.push('\n');
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -165,24 +165,7 @@ pub struct StatisticsTable {
 impl StatisticsTable {
     /// CSV with the columns as header; a null is an empty cell.
     pub fn to_csv(&self) -> String {
-        use crate::csv_format::{cell, quote};
-        let mut out = self
-            .columns
-            .iter()
-            .map(|c| quote(c).into_owned())
-            .collect::<Vec<_>>()
-            .join(",");
-        out.push('\n');
-        for row in &self.rows {
-            let cells: Vec<String> = self
-                .columns
-                .iter()
-                .map(|column| row.get(column).map(cell).unwrap_or_default())
-                .collect();
-            out.push_str(&cells.join(","));
-            out.push('\n');
-        }
-        out
+        crate::csv_format::records(&self.columns, &self.rows)
     }
 }
 

@@ -85,27 +85,7 @@ impl Table {
     /// CSV with a header of the column names; absent values are empty cells, the rest
     /// as [`crate::csv_format::cell`] writes them (numbers in full precision).
     pub fn to_csv(&self) -> String {
-        use crate::csv_format::{cell, quote};
-        let mut out = String::new();
-        out.push_str(
-            &self
-                .columns
-                .iter()
-                .map(|c| quote(c))
-                .collect::<Vec<_>>()
-                .join(","),
-        );
-        out.push('\n');
-        for row in &self.rows {
-            let cells: Vec<String> = self
-                .columns
-                .iter()
-                .map(|column| row.get(column).map(cell).unwrap_or_default())
-                .collect();
-            out.push_str(&cells.join(","));
-            out.push('\n');
-        }
-        out
+        crate::csv_format::records(&self.columns, &self.rows)
     }
 }
 

@@ -142,7 +142,7 @@ fn explicit_row() -> Value {
 /// base acceleration.
 pub fn bundle() -> Vec<Value> {
     let mut explicit = explicit_row();
-    explicit["initial"] = json!({"tip_displacements": [0.001, 0.0]});
+    explicit["initial"] = json!({"tip_displacements": [0.001, 0.0], "tip_velocities": [0.0, -0.05]});
     explicit["excitation"] = json!({
         "base_acceleration": {"type": "half_sine", "amplitude": 50.0, "duration": 0.005},
         "point_forces": [{"pin": 1, "height": 0.5, "time": [0.0, 0.002, 0.004], "force": [0.0, 5.0, 0.0]}]});
@@ -289,7 +289,8 @@ pub fn hex() -> Vec<Value> {
     // Moved by loads alone: the centre pin released along 45°, point forces along a
     // direction and along x (the default).
     let mut loaded = hex_example(gap_states[0].clone(), json!({}), selections[4].clone());
-    loaded["initial"] = json!({"tip_displacements": [{"pin": 0, "x": 2e-4, "y": 2e-4}]});
+    loaded["initial"] = json!({"tip_displacements": [{"pin": 0, "x": 2e-4, "y": 2e-4}],
+                               "tip_velocities": [{"pin": 2, "x": 0.01, "y": -0.02}]});
     loaded["excitation"] = json!({"point_forces": [
         {"pin": 1, "height": PIN_LENGTH, "direction": 120.0, "time": [0.0, 0.002, 0.004],
          "force": [0.0, 2.0, 0.0]},
