@@ -451,7 +451,7 @@ impl Recorder {
             curvatures: self.curvatures,
             curvature_envelope: self.curvature_envelope,
             pin_curvatures: self.pin_curvatures,
-            resultant_forces: self.resultants.finish(),
+            resultant_forces: self.resultants.finish(layout.dt),
             energy: self.energy,
             mechanical_energy: self.mechanical_energy,
         }

@@ -5,10 +5,10 @@
 //! vector sum, which neither contact's own peak gives.
 //!
 //! Each closed lane adds its force vector (−F n − T t on its left body, +F n + T t on
-//! its right one, [`force_vector`]) to the slot of each pin it touches at its height;
-//! the slots touched this step are then compared with their peaks (squares: one root
-//! for a new peak) and cleared. The work is a few additions per closed contact, beside
-//! the closed contact's own dot products.
+//! its right one, [`force_vector`]) to the slot of each pin it touches at its height; a
+//! slot's sum is compared with its peak (squares: one root for a new peak) when a later
+//! step first touches it, or at the end. The work is one cache line per side of a
+//! closed contact, beside the closed contact's own dot products.
 
 use super::layout::{ContactModel, Layout};
 use super::state::State;
@@ -18,16 +18,25 @@ use crate::contact::{Body, force_vector};
 /// No slot: a wall side or an empty lane.
 const NONE: u32 = u32::MAX;
 
-/// The running peaks of every (pin, contact height) slot, and the sums of the step.
+/// No step yet.
+const NO_STEP: u64 = u64::MAX;
+
+/// What a step touches of a slot, in one cache line: the sum of the step that last
+/// touched it (folded into the peak at its next touch, or at the end) and the peak's
+/// square.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(32))]
+struct Slot {
+    sum: [f64; 2],
+    step: u64,
+    peak_squared: f64,
+}
+
+/// The running peaks of every (pin, contact height) slot.
 pub(super) struct Resultants {
     /// Per lane: the slots of its left and right bodies.
-    slots: Vec<[u32; 2]>,
-    /// Per slot: the force (x, y) summed over the step's closed contacts so far.
-    sums: Vec<[f64; 2]>,
-    /// Per slot: the last step that touched it (`u64::MAX`: none yet).
-    touched_at: Vec<u64>,
-    /// The slots touched this step.
-    touched: Vec<u32>,
+    sides: Vec<[u32; 2]>,
+    slots: Vec<Slot>,
     peaks: Vec<ResultantPeak>,
 }
 
@@ -54,7 +63,7 @@ impl Resultants {
             Body::Pin(pin) => slot_of(pin, height),
             Body::Wall => NONE,
         };
-        let mut slots = vec![[NONE; 2]; layout.lane_contacts.len()];
+        let mut sides = vec![[NONE; 2]; layout.lane_contacts.len()];
         let mut peaks: Vec<ResultantPeak> = keys
             .iter()
             .map(|&(pin, height)| ResultantPeak {
@@ -71,19 +80,22 @@ impl Resultants {
             for slot in pair.into_iter().filter(|&s| s != NONE) {
                 peaks[slot as usize].contacts += 1;
             }
-            slots[lane as usize] = pair;
+            sides[lane as usize] = pair;
         }
+        let slot = Slot {
+            sum: [0.0; 2],
+            step: NO_STEP,
+            peak_squared: 0.0,
+        };
         Self {
-            slots,
-            sums: vec![[0.0; 2]; keys.len()],
-            touched_at: vec![u64::MAX; keys.len()],
-            touched: Vec::new(),
+            sides,
+            slots: vec![slot; keys.len()],
             peaks,
         }
     }
 
-    /// The resultants of step n (its closed lanes and their forces in `state`) against
-    /// their peaks.
+    /// Adds step n's closed lanes (their forces in `state`) to their slots; a slot's
+    /// sum of an earlier step is first compared with its peak.
     #[inline(always)]
     pub fn track(&mut self, layout: &Layout<'_>, state: &State, n: u64) {
         for &lane in &state.closed[..state.closed_count] {
@@ -102,36 +114,43 @@ impl Resultants {
                     force_vector(force, tangential, plane.lanes[lane].normal)
                 }
             };
-            let [left, right] = self.slots[lane];
+            let [left, right] = self.sides[lane];
             for (slot, sign) in [(left, -1.0), (right, 1.0)] {
                 if slot == NONE {
                     continue;
                 }
-                let slot = slot as usize;
-                if self.touched_at[slot] != n {
-                    self.touched_at[slot] = n;
-                    self.touched.push(slot as u32);
+                let at = slot as usize;
+                let slot = &mut self.slots[at];
+                if slot.step != n {
+                    fold(slot, &mut self.peaks[at], layout.dt);
+                    (slot.sum, slot.step) = ([0.0; 2], n);
                 }
-                let sum = &mut self.sums[slot];
-                sum[0] += sign * on_right[0];
-                sum[1] += sign * on_right[1];
+                slot.sum[0] += sign * on_right[0];
+                slot.sum[1] += sign * on_right[1];
             }
         }
-        for &slot in &self.touched {
-            let slot = slot as usize;
-            let [x, y] = std::mem::take(&mut self.sums[slot]);
-            let squared = x * x + y * y;
-            let peak = &mut self.peaks[slot];
-            if squared > peak.force * peak.force {
-                peak.force = squared.sqrt();
-                peak.time = sample_time(n, layout.dt);
-            }
-        }
-        self.touched.clear();
     }
 
-    /// The peaks, by pin then height.
-    pub fn finish(self) -> Vec<ResultantPeak> {
+    /// The peaks, by pin then height (every slot's last sum folded in).
+    pub fn finish(mut self, dt: f64) -> Vec<ResultantPeak> {
+        for (slot, peak) in self.slots.iter_mut().zip(&mut self.peaks) {
+            fold(slot, peak, dt);
+        }
         self.peaks
+    }
+}
+
+/// The sum a slot holds (of its step) against its peak: a new peak when larger.
+#[inline(always)]
+fn fold(slot: &mut Slot, peak: &mut ResultantPeak, dt: f64) {
+    if slot.step == NO_STEP {
+        return;
+    }
+    let [x, y] = slot.sum;
+    let squared = x * x + y * y;
+    if squared > slot.peak_squared {
+        slot.peak_squared = squared;
+        peak.force = squared.sqrt();
+        peak.time = sample_time(slot.step, dt);
     }
 }
