@@ -37,6 +37,8 @@ pub(super) struct Resultants {
     /// Per lane: the slots of its left and right bodies.
     sides: Vec<[u32; 2]>,
     slots: Vec<Slot>,
+    /// Per slot: the step of its peak (its time is written once, at the end).
+    peak_steps: Vec<u64>,
     peaks: Vec<ResultantPeak>,
 }
 
@@ -90,6 +92,7 @@ impl Resultants {
         Self {
             sides,
             slots: vec![slot; keys.len()],
+            peak_steps: vec![NO_STEP; keys.len()],
             peaks,
         }
     }
@@ -122,7 +125,7 @@ impl Resultants {
                 let at = slot as usize;
                 let slot = &mut self.slots[at];
                 if slot.step != n {
-                    fold(slot, &mut self.peaks[at], layout.dt);
+                    fold(slot, &mut self.peak_steps[at]);
                     (slot.sum, slot.step) = ([0.0; 2], n);
                 }
                 slot.sum[0] += sign * on_right[0];
@@ -133,16 +136,26 @@ impl Resultants {
 
     /// The peaks, by pin then height (every slot's last sum folded in).
     pub fn finish(mut self, dt: f64) -> Vec<ResultantPeak> {
-        for (slot, peak) in self.slots.iter_mut().zip(&mut self.peaks) {
-            fold(slot, peak, dt);
+        for ((slot, step), peak) in self
+            .slots
+            .iter_mut()
+            .zip(&mut self.peak_steps)
+            .zip(&mut self.peaks)
+        {
+            fold(slot, step);
+            if *step != NO_STEP {
+                peak.force = slot.peak_squared.sqrt();
+                peak.time = sample_time(*step, dt);
+            }
         }
         self.peaks
     }
 }
 
-/// The sum a slot holds (of its step) against its peak: a new peak when larger.
+/// The sum a slot holds (of its step) against its peak: a new peak when larger (its
+/// square, and its step in `peak_step`).
 #[inline(always)]
-fn fold(slot: &mut Slot, peak: &mut ResultantPeak, dt: f64) {
+fn fold(slot: &mut Slot, peak_step: &mut u64) {
     if slot.step == NO_STEP {
         return;
     }
@@ -150,7 +163,6 @@ fn fold(slot: &mut Slot, peak: &mut ResultantPeak, dt: f64) {
     let squared = x * x + y * y;
     if squared > slot.peak_squared {
         slot.peak_squared = squared;
-        peak.force = squared.sqrt();
-        peak.time = sample_time(slot.step, dt);
+        *peak_step = slot.step;
     }
 }
