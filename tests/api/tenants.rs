@@ -17,7 +17,8 @@ on_both_backends!(
     another_tenants_job_is_not_found_anywhere,
     identical_inputs_of_another_tenant_are_computed_not_reused,
     another_tenants_sweep_is_not_found_and_its_runs_are_not_listed,
-    one_tenants_300_queued_jobs_do_not_delay_another_tenants_single_job
+    one_tenants_300_queued_jobs_do_not_delay_another_tenants_single_job,
+    a_worker_freed_by_a_tenants_run_serves_the_tenant_that_waited
 );
 
 const ALPHA: &str = "alpha-token-0123456789";
@@ -318,4 +319,34 @@ async fn one_tenants_300_queued_jobs_do_not_delay_another_tenants_single_job(bac
         runs.len(),
         2 * workers
     );
+}
+
+/// Ties between tenants with no running job go to the one served least recently: alpha's
+/// run ends (alpha and beta both have nothing running, and alpha's next queued job is
+/// older than beta's), and the next claim serves beta. This is the moment two workers
+/// freed at once by alpha's runs meet; by queue age alone both would serve alpha again.
+async fn a_worker_freed_by_a_tenants_run_serves_the_tenant_that_waited(backend: Backend) {
+    let app = spawn_app_in(
+        TestStore::new(backend).await,
+        |config: &mut chocmodal::service::ServiceConfig| {
+            config.auth = Some(tokens());
+            config.workers = 0;
+        },
+    )
+    .await;
+    for k in 0..3 {
+        As::alpha(&app).submit(json!({"steps": 100 + k})).await;
+    }
+    let beta_job = As::beta(&app).submit(json!({"steps": 7})).await;
+    let lease = Duration::from_secs(30);
+    // Nobody served yet: the oldest queued job, alpha's first.
+    let first = app.queue.claim("w1", lease).await.unwrap().unwrap();
+    assert_eq!(first.tenant, "alpha");
+    let problem = chocmodal::problem::Problem::job_failed("ended");
+    assert!(app.queue.fail(&first.lease, &problem, None).await.unwrap());
+    let next = app.queue.claim("w2", lease).await.unwrap().unwrap();
+    assert_eq!(next.lease.job_id, beta_job, "beta waited; alpha was just served");
+    // Then alpha again: beta has a job running, alpha none.
+    let third = app.queue.claim("w3", lease).await.unwrap().unwrap();
+    assert_eq!(third.tenant, "alpha");
 }

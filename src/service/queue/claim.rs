@@ -11,7 +11,11 @@
 //! stored. Nothing is held once the claim returns.
 //!
 //! Order: fair share between tenants. The tenant whose turn it is has the fewest running
-//! jobs (across every process); ties go to the tenant whose oldest queued job is oldest.
+//! jobs (across every process); ties go to the tenant served least recently (the latest
+//! claim of any of its jobs; a tenant never served first), then to the tenant whose oldest
+//! queued job is oldest. The recency matters when several workers free up at once: a
+//! tenant whose runs just ended has no running job either, and its oldest queued job is
+//! older than a newcomer's, so without it every freed worker would serve it again.
 //! Within that tenant, its oldest single job, else its oldest sweep run (a sweep's runs
 //! count as their tenant's). So one tenant's 300 queued jobs delay another tenant's
 //! single job by one run at most, and a sweep of thousands of runs never makes its own
@@ -19,7 +23,8 @@
 //!
 //! Each step is an index probe (migration 0008): the distinct tenants with queued work
 //! come from a skip-scan of `jobs_ready_tenant` (one probe per tenant), their running
-//! counts from `jobs_running_tenant`, their oldest jobs from `jobs_ready_tenant` and
+//! counts from `jobs_running_tenant`, their latest claims from `jobs_tenant_started`
+//! (migration 0011), their oldest jobs from `jobs_ready_tenant` and
 //! `jobs_ready_tenant_single` (SQLite is told the index of the skip-scan: without
 //! statistics its planner would scan every queued job). The cost grows with the number of tenants that have
 //! queued work, not with the number of jobs.
@@ -51,6 +56,8 @@ const CLAIM_SQLITE: &str = "\
     turn(tenant) AS ( \
         SELECT tenant FROM queued WHERE tenant IS NOT NULL \
         ORDER BY (SELECT COUNT(*) FROM jobs r WHERE r.status = 'running' AND r.tenant = queued.tenant), \
+            COALESCE((SELECT MAX(started_at) FROM jobs s INDEXED BY jobs_tenant_started \
+                WHERE s.started_at IS NOT NULL AND s.tenant = queued.tenant), -1), \
             (SELECT MIN(seq) FROM jobs o WHERE o.status = 'accepted' AND o.tenant = queued.tenant) \
         LIMIT 1) \
     UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = $1, \
@@ -72,10 +79,12 @@ const CLAIM_POSTGRES: &str = "\
     tenants AS MATERIALIZED ( \
         SELECT tenant, \
             (SELECT COUNT(*) FROM jobs r WHERE r.status = 'running' AND r.tenant = queued.tenant) AS running, \
+            COALESCE((SELECT MAX(started_at) FROM jobs s WHERE s.started_at IS NOT NULL \
+                AND s.tenant = queued.tenant), -1) AS served, \
             (SELECT MIN(seq) FROM jobs o WHERE o.status = 'accepted' AND o.tenant = queued.tenant) AS oldest \
         FROM queued WHERE tenant IS NOT NULL), \
     candidates AS ( \
-        SELECT c.seq, c.sweep_run, t.running, t.oldest FROM tenants t CROSS JOIN LATERAL ( \
+        SELECT c.seq, c.sweep_run, t.running, t.served, t.oldest FROM tenants t CROSS JOIN LATERAL ( \
             (SELECT seq, FALSE AS sweep_run FROM jobs WHERE status = 'accepted' AND sweep_id IS NULL \
                 AND tenant = t.tenant ORDER BY seq LIMIT $4) \
             UNION ALL \
@@ -84,7 +93,7 @@ const CLAIM_POSTGRES: &str = "\
     next AS ( \
         SELECT jobs.seq FROM jobs JOIN candidates ON candidates.seq = jobs.seq \
         WHERE jobs.status = 'accepted' \
-        ORDER BY candidates.running, candidates.oldest, candidates.sweep_run, jobs.seq LIMIT 1 \
+        ORDER BY candidates.running, candidates.served, candidates.oldest, candidates.sweep_run, jobs.seq LIMIT 1 \
         FOR UPDATE OF jobs SKIP LOCKED) \
     UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = $1, \
         lease_expires_at = $2, started_at = $3, updated_at = $3, progress = 0, message = 'running' \
