@@ -169,7 +169,6 @@ impl Deliverer {
         let Some(uri) = uri else {
             return Outcome::Unsubscribed;
         };
-        let now = inner.outbox.now();
         let deadline = job.finished_at.unwrap_or(job.updated_at) + duration_ms(inner.settings.give_up_after);
         let outcome = match self.post(&due.tenant, uri, job).await {
             Ok(()) => {
@@ -179,7 +178,9 @@ impl Deliverer {
             Err(Refusal::Policy(error)) => Outcome::Abandoned { error },
             Err(Refusal::Failed(error)) => {
                 let failures = u32::try_from(due.attempts + 1).unwrap_or(u32::MAX);
-                let at = now + duration_ms(inner.settings.retry_delay(failures));
+                // The wait counts from the failure (after the request, not before it),
+                // from its millisecond rounded up: no wait is shorter than the delay.
+                let at = inner.outbox.now() + 1 + duration_ms(inner.settings.retry_delay(failures));
                 if at > deadline {
                     Outcome::Abandoned {
                         error: format!(
