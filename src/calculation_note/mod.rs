@@ -294,9 +294,10 @@ fn verdict(page: &mut String, note: &Note<'_>) {
             "/quality/step_halving/estimated_peak_displacement_error",
         ),
         (
-            "impact count change at half the step",
+            "impact count change at the check's step",
             "/quality/step_halving/impact_count_change",
         ),
+        ("time step of the check (s)", "/quality/step_halving/time_step"),
         (
             "estimated peak force error, modal basis",
             "/quality/modal_truncation/estimated_peak_force_error",
@@ -320,7 +321,14 @@ fn verdict(page: &mut String, note: &Note<'_>) {
     .chain(note.facts.checks.iter().cloned())
     .collect();
     if quality["step_halving"].is_null() {
-        page.push_str("<p>The step-halving check was not run (<code>solver.check: \"none\"</code>).</p>");
+        page.push_str("<p>The step check was not run (<code>solver.check: \"none\"</code>).</p>");
+    } else if let Some(why) = quality["step_halving"]["why_half_step"].as_str() {
+        page.push_str(&format!(
+            "<p>The step check repeated the run at half the step: {}.</p>",
+            escape(why)
+        ));
+    } else {
+        page.push_str("<p>The step check repeated the run at twice the step.</p>");
     }
     measure_table(page, &measures);
     page.push_str("</section>");

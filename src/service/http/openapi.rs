@@ -275,6 +275,7 @@ impl Modify for ResourceLinks {
         crate::processes::report::QualityReport,
         crate::provenance::Provenance,
         crate::processes::report::StepHalvingReport,
+        crate::physics::integrate::StepComparison,
         models::HistoryDocument,
         models::Series,
         ResultOutputSchema,

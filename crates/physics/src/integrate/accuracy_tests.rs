@@ -292,6 +292,145 @@ fn auto_peaks_are_within_one_percent_of_the_limit_and_the_check_estimates_the_er
     }
 }
 
+/// The check at 2Δt (`auto`, the default) estimates the error of the same run as the
+/// check at Δt/2, for a quarter of its cost: on every shock of the class where 2Δt is in
+/// range, its estimate (a third of the change, Richardson) is within a factor 3 of the
+/// true error against the Δt → 0 limit, its repeated run takes half the run's steps, and
+/// the step raises no reason. Where it is not in range the run is repeated at Δt/2 and
+/// says why.
+#[test]
+fn the_check_at_twice_the_step_estimates_the_error_for_a_quarter_of_the_cost() {
+    let mut doubled = 0;
+    for (name, row) in realistic_rows() {
+        let row = shock_window(row);
+        let basis = row.basis();
+        let model = row.model(&basis);
+        let assessed = run_at(&model, &row, TimeStep::Auto, Check::Auto);
+        let (force, _, _) = figures(&assessed.simulation);
+        let step = assessed.simulation.step;
+        let check = assessed.quality.step_halving.clone().expect("the check ran");
+        match check.compared_with {
+            StepComparison::DoubleStep => {
+                doubled += 1;
+                assert!(check.why_half_step.is_none(), "{name}: {check:?}");
+                assert_eq!(check.time_step, 2.0 * step.time_step, "{name}");
+                assert!(
+                    (check.relative_cost - 0.5).abs() <= 0.01,
+                    "{name}: relative cost {}",
+                    check.relative_cost
+                );
+                let (limit_force, _) = limit(&model, &row, step.time_step);
+                let error = (force / limit_force - 1.0).abs();
+                let estimate = check.estimated_peak_force_error;
+                if error > 1e-4 {
+                    assert!(
+                        estimate <= 3.0 * error && estimate >= error / 3.0,
+                        "{name}: estimated peak force error {estimate:.2e}, true {error:.2e}"
+                    );
+                } else {
+                    assert!(
+                        estimate < 3e-4,
+                        "{name}: estimate {estimate:.2e}, true {error:.2e}"
+                    );
+                }
+            }
+            StepComparison::HalfStep => {
+                let why = check.why_half_step.as_deref().unwrap_or_default();
+                assert!(!why.is_empty(), "{name}: a half-step check says why");
+                assert!((check.relative_cost - 2.0).abs() <= 0.51, "{name}: {check:?}");
+            }
+        }
+        let step_reasons: Vec<&String> = assessed
+            .quality
+            .reasons
+            .iter()
+            .filter(|r| !r.contains("modal basis") && !r.contains("element mesh"))
+            .collect();
+        assert!(step_reasons.is_empty(), "{name}: {step_reasons:?}");
+    }
+    assert!(doubled >= 4, "only {doubled} of the shocks were checked at 2Δt");
+}
+
+/// Where 2Δt would be out of range, or the comparison with it is not as strict as
+/// halving, the run is repeated at Δt/2, which decides, and the check says why: a given
+/// step with 30 steps per period of the fastest motion (15 at 2Δt); a table sampled
+/// more finely than 2Δt; a tolerance so tight that no change passes.
+#[test]
+fn the_check_falls_back_to_half_the_step_and_says_why() {
+    let (_, row) = realistic_rows().remove(0);
+    let row = shock_window(row);
+    let basis = row.basis();
+    let model = row.model(&basis);
+    let auto = *Plan::new(&model, &row.settings(TimeStep::Auto)).unwrap().step();
+    let coarse = std::f64::consts::TAU / (auto.max_angular_frequency * 30.0);
+    let check = |model: &Model<'_>, settings: Settings| {
+        Plan::new(model, &settings)
+            .and_then(|plan| plan.run(&mut |_| ControlFlow::Continue(())))
+            .expect("runs")
+            .quality
+            .step_halving
+            .expect("the check ran")
+    };
+    let given = check(
+        &model,
+        Settings {
+            check: Check::Auto,
+            ..row.settings(TimeStep::Fixed(coarse))
+        },
+    );
+    assert_eq!(given.compared_with, StepComparison::HalfStep);
+    let why = given.why_half_step.unwrap();
+    assert!(why.contains("steps per period") && why.contains("15.0"), "{why}");
+    assert!(
+        (given.relative_cost - 2.0).abs() <= 0.01,
+        "{}",
+        given.relative_cost
+    );
+
+    let mut sampled = model.clone();
+    let interval = 1.5 * auto.time_step;
+    sampled.base_acceleration = Some(BaseAcceleration::Table(Table {
+        time: (0..=2000).map(|k| k as f64 * interval).collect(),
+        values: (0..=2000).map(|k| 50.0 * (k as f64 * 0.01).sin()).collect(),
+    }));
+    let table = check(
+        &sampled,
+        Settings {
+            check: Check::Auto,
+            ..row.settings(TimeStep::Auto)
+        },
+    );
+    assert_eq!(table.compared_with, StepComparison::HalfStep);
+    assert!(table.why_half_step.unwrap().contains("samples of a table"));
+
+    let tight = check(
+        &model,
+        Settings {
+            check: Check::Auto,
+            tolerance: 1e-9,
+            ..row.settings(TimeStep::Fixed(auto.time_step))
+        },
+    );
+    assert_eq!(tight.compared_with, StepComparison::HalfStep);
+    assert!(tight.why_half_step.unwrap().contains("did not prove"));
+    // Both repetitions counted: half the run's steps, then twice.
+    assert!(
+        (tight.relative_cost - 2.5).abs() <= 0.01,
+        "{}",
+        tight.relative_cost
+    );
+
+    let asked = check(
+        &model,
+        Settings {
+            check: Check::StepHalving,
+            ..row.settings(TimeStep::Auto)
+        },
+    );
+    assert_eq!(asked.compared_with, StepComparison::HalfStep);
+    assert!(asked.why_half_step.unwrap().contains("asked for"));
+}
+
 /// Without the step-halving check the step's error is not measured: the same run is
 /// `unchecked` where the checked one is `good`, and never `good`.
 #[test]

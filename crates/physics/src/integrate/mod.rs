@@ -49,8 +49,10 @@ use crate::InputIssue;
 pub use crate::impacts::{ImpactCounting, ImpactHistogram, ImpactStatistics, ImpactTable};
 pub use model::{Model, NORMAL_LENGTH_TOLERANCE, Plane, Settings, TimeStep, WallMotion};
 pub use plan::Plan;
-pub use quality::{Check, Quality, StepHalving, Verdict};
-pub use step_size::{DEFAULT_TOLERANCE, StepLimit, StepSize, critical_time_step, sample_time};
+pub use quality::{Check, Quality, StepComparison, StepHalving, Verdict};
+pub use step_size::{
+    DEFAULT_TOLERANCE, ExcitationScales, StepLimit, StepSize, critical_time_step, sample_time,
+};
 
 /// Why a run produced no result.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -65,7 +65,7 @@ impl<'a> Plan<'a> {
     }
 
     /// Integrates the model and assesses the result: the check of `settings.check` (the
-    /// whole run again at Δt/2 for step halving), then the verdict. `progress` is called
+    /// whole run again at 2Δt or Δt/2, see [`super::quality`]), then the verdict. `progress` is called
     /// every few thousand steps with the fraction done (the check included);
     /// `ControlFlow::Break` stops the run with [`SimulationError::Cancelled`].
     pub fn run(&self, progress: &mut dyn FnMut(f64) -> ControlFlow<()>) -> Result<Assessed, SimulationError> {
@@ -80,32 +80,85 @@ impl<'a> Plan<'a> {
         progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
     ) -> Result<Assessed, SimulationError> {
         let (model, settings, step) = (self.model, self.settings, &self.step);
-        // The check takes twice the steps of the run: a third of the progress for the run.
-        let share = match settings.check {
-            Check::StepHalving => 1.0 / 3.0,
-            Check::None => 1.0,
+        // Shares of the progress: the run, then the check's repetitions (at 2Δt half the
+        // run's steps, at Δt/2 twice).
+        let doubled = match settings.check {
+            Check::Auto => Some(step.doubled()),
+            Check::StepHalving | Check::None => None,
+        };
+        let share = match (settings.check, &doubled) {
+            (Check::None, _) => 1.0,
+            (_, Some(Ok(_))) => 2.0 / 3.0,
+            _ => 1.0 / 3.0,
         };
         let simulation = stepper::integrate(arch, model, settings, step, &mut |f| progress(share * f))?;
-        let step_halving = match settings.check {
-            Check::None => None,
-            Check::StepHalving => {
-                let started = std::time::Instant::now();
-                let halved = step.halved();
-                // The same samples, so that the repeated run costs no more memory per step.
-                let settings = Settings {
-                    output_interval: Some(simulation.output_interval),
-                    ..settings.clone()
-                };
-                let check = stepper::integrate(arch, model, &settings, &halved, &mut |f| {
-                    progress(share + (1.0 - share) * f)
-                })?;
-                Some(quality::step_halving(
+        // The same samples, so that a repeated run costs no more memory per step.
+        let repeated_settings = Settings {
+            output_interval: Some(simulation.output_interval),
+            ..settings.clone()
+        };
+        let figures = quality::KeyFigures::of(&simulation);
+        let started = std::time::Instant::now();
+        let mut repeat = |at: &StepSize, (from, to): (f64, f64)| {
+            stepper::integrate(arch, model, &repeated_settings, at, &mut |f| {
+                progress(from + (to - from) * f)
+            })
+        };
+        let step_halving = match (settings.check, doubled) {
+            (Check::None, _) => None,
+            (_, Some(Ok(twice))) => {
+                let coarse = repeat(&twice, (share, 0.8))?;
+                let against_double = quality::compare(
                     settings.scheme,
-                    step,
-                    quality::KeyFigures::of(&simulation),
-                    quality::KeyFigures::of(&check),
-                    (check.steps, simulation.steps, started.elapsed().as_secs_f64()),
-                ))
+                    (quality::StepComparison::DoubleStep, &twice),
+                    figures,
+                    quality::KeyFigures::of(&coarse),
+                    (coarse.steps, simulation.steps, started.elapsed().as_secs_f64()),
+                );
+                if against_double.proves(settings.scheme, settings.tolerance) {
+                    Some(against_double)
+                } else {
+                    let half = step.halved();
+                    let fine = repeat(&half, (0.8, 1.0))?;
+                    Some(quality::StepHalving {
+                        why_half_step: Some(format!(
+                            "the comparison with 2Δt did not prove the result (peak contact force \
+                             change {:.2} %, peak deflection change {:.2} %, impact count change {:.2} %)",
+                            100.0 * against_double.peak_force_change,
+                            100.0 * against_double.peak_displacement_change,
+                            100.0 * against_double.impact_count_change
+                        )),
+                        ..quality::compare(
+                            settings.scheme,
+                            (quality::StepComparison::HalfStep, &half),
+                            figures,
+                            quality::KeyFigures::of(&fine),
+                            (
+                                coarse.steps + fine.steps,
+                                simulation.steps,
+                                started.elapsed().as_secs_f64(),
+                            ),
+                        )
+                    })
+                }
+            }
+            (check, doubled) => {
+                let half = step.halved();
+                let fine = repeat(&half, (share, 1.0))?;
+                let why = match (check, doubled) {
+                    (_, Some(Err(why))) => why,
+                    _ => "asked for (solver.check \"step_halving\")".to_owned(),
+                };
+                Some(quality::StepHalving {
+                    why_half_step: Some(why),
+                    ..quality::compare(
+                        settings.scheme,
+                        (quality::StepComparison::HalfStep, &half),
+                        figures,
+                        quality::KeyFigures::of(&fine),
+                        (fine.steps, simulation.steps, started.elapsed().as_secs_f64()),
+                    )
+                })
             }
         };
         let peaks: Vec<f64> = simulation

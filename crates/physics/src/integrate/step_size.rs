@@ -44,6 +44,11 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-3;
 pub const STABILITY_FRACTION: f64 = 0.8;
 /// Fewest steps per period `auto` ever uses, whatever the tolerance.
 const MIN_STEPS_PER_PERIOD: f64 = 8.0;
+/// Fewest steps per period of the fastest motion (and of the excitation) at 2Δt for the
+/// check to compare the run with a run at 2Δt ([`StepSize::doubled`]): 2.5 times the
+/// 8 below which a peak's error is no longer O(Δt²) (`quality`), so that the doubled run
+/// is still in the range where Richardson's estimate holds.
+pub const DOUBLED_STEPS_PER_PERIOD: f64 = 20.0;
 
 /// The step of a run and what it was measured against.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,6 +61,35 @@ pub struct StepSize {
     pub max_angular_frequency: f64,
     /// What bounded an `auto` step; `Given` for a fixed one.
     pub limited_by: StepLimit,
+    /// The time scales of the excitation the step must resolve.
+    pub excitation: ExcitationScales,
+}
+
+/// The time scales of a model's excitation: the shortest period to resolve with many
+/// steps (twice a half-sine's duration, a sine's period, a pulse's resolution period)
+/// and the shortest interval between two samples of a table (never stepped over).
+/// Infinite when the model has none.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExcitationScales {
+    /// Shortest period of the excitation (s).
+    pub period: f64,
+    /// Shortest sampling interval of an acceleration or force table (s).
+    pub interval: f64,
+}
+
+impl ExcitationScales {
+    /// No excitation with a time scale (free vibration, constant loads).
+    pub const NONE: Self = Self {
+        period: f64::INFINITY,
+        interval: f64::INFINITY,
+    };
+
+    /// The longest step that resolves each period with `steps_per_period` steps and
+    /// steps over no sample; `None` when nothing bounds it.
+    fn bound(&self, steps_per_period: f64) -> Option<f64> {
+        let bound = (self.period / steps_per_period).min(self.interval);
+        (bound.is_finite() && bound > 0.0).then_some(bound)
+    }
 }
 
 /// The constraint that set an `auto` step.
@@ -163,6 +197,44 @@ impl StepSize {
             ..*self
         }
     }
+
+    /// The step doubled, for a check that compares the run with a run at 2Δt: only
+    /// where 2Δt still resolves the fastest motion and the excitation with
+    /// [`DOUBLED_STEPS_PER_PERIOD`] steps per period, steps over no table sample and is
+    /// stable with margin ([`STABILITY_FRACTION`]); else why not, as a phrase.
+    pub fn doubled(&self) -> Result<Self, String> {
+        let doubled = Self {
+            time_step: 2.0 * self.time_step,
+            ..*self
+        };
+        let per_period = doubled.steps_per_fastest_period();
+        if per_period < DOUBLED_STEPS_PER_PERIOD {
+            return Err(format!(
+                "at 2Δt the fastest motion would get {per_period:.1} steps per period \
+                 (at least {DOUBLED_STEPS_PER_PERIOD} wanted)"
+            ));
+        }
+        if doubled.time_step > STABILITY_FRACTION * self.critical_time_step {
+            return Err(format!(
+                "2Δt would be {:.2} of the critical step (at most {STABILITY_FRACTION} wanted)",
+                doubled.over_critical()
+            ));
+        }
+        let per_excitation = self.excitation.period / doubled.time_step;
+        if per_excitation < DOUBLED_STEPS_PER_PERIOD {
+            return Err(format!(
+                "at 2Δt the excitation would get {per_excitation:.1} steps per period \
+                 (at least {DOUBLED_STEPS_PER_PERIOD} wanted)"
+            ));
+        }
+        if doubled.time_step > self.excitation.interval * (1.0 + 1e-9) {
+            return Err(format!(
+                "2Δt would step over samples of a table {} s apart",
+                crate::number(self.excitation.interval)
+            ));
+        }
+        Ok(doubled)
+    }
 }
 
 /// Steps per period of the fastest motion that `auto` uses for `tolerance`.
@@ -202,10 +274,9 @@ pub fn critical_time_step(model: &Model<'_>, scheme: Scheme) -> f64 {
     scheme.stability_limit() / max_frequency(model)
 }
 
-/// The shortest time (s) the excitation asks to resolve, and whether it is a period
-/// (resolved with N steps) or a table's sampling interval (one step).
-fn excitation_bound(model: &Model<'_>, steps_per_period: f64) -> Option<f64> {
-    let mut bound = f64::INFINITY;
+/// The time scales of the model's excitation.
+pub fn excitation_scales(model: &Model<'_>) -> ExcitationScales {
+    let mut scales = ExcitationScales::NONE;
     let base_y = model.plane.as_ref().and_then(|p| p.base_acceleration_y.as_ref());
     let walls = model
         .walls
@@ -213,23 +284,26 @@ fn excitation_bound(model: &Model<'_>, steps_per_period: f64) -> Option<f64> {
         .flat_map(|w| [&w.left_x, &w.right_x, &w.y])
         .flatten();
     for base in model.base_acceleration.iter().chain(base_y).chain(walls) {
-        bound = bound.min(match base {
-            BaseAcceleration::HalfSine { duration, .. } => 2.0 * duration / steps_per_period,
-            BaseAcceleration::Sine { frequency, .. } => 1.0 / (frequency * steps_per_period),
-            BaseAcceleration::Table(table) => table.shortest_interval(),
-            BaseAcceleration::Pulse(pulse) => pulse.resolution_period() / steps_per_period,
-        });
+        match base {
+            BaseAcceleration::HalfSine { duration, .. } => scales.period = scales.period.min(2.0 * duration),
+            BaseAcceleration::Sine { frequency, .. } => scales.period = scales.period.min(1.0 / frequency),
+            BaseAcceleration::Table(table) => {
+                scales.interval = scales.interval.min(table.shortest_interval())
+            }
+            BaseAcceleration::Pulse(pulse) => scales.period = scales.period.min(pulse.resolution_period()),
+        }
     }
     for force in &model.point_forces {
-        bound = bound.min(force.force.shortest_interval());
+        scales.interval = scales.interval.min(force.force.shortest_interval());
     }
-    (bound.is_finite() && bound > 0.0).then_some(bound)
+    scales
 }
 
 /// The step a run will use, or why it cannot run (a given step above the critical one).
 pub fn resolve(model: &Model<'_>, settings: &Settings) -> Result<StepSize, SimulationError> {
     let omega = max_frequency(model);
     let critical = settings.scheme.stability_limit() / omega;
+    let excitation = excitation_scales(model);
     match settings.time_step {
         TimeStep::Fixed(dt) if dt > critical * (1.0 + 1e-12) => Err(SimulationError::TimeStepAboveCritical {
             time_step: dt,
@@ -240,6 +314,7 @@ pub fn resolve(model: &Model<'_>, settings: &Settings) -> Result<StepSize, Simul
             critical_time_step: critical,
             max_angular_frequency: omega,
             limited_by: StepLimit::Given,
+            excitation,
         }),
         TimeStep::Auto => {
             let per_period = steps_per_period(settings.scheme, settings.tolerance);
@@ -250,8 +325,8 @@ pub fn resolve(model: &Model<'_>, settings: &Settings) -> Result<StepSize, Simul
                 ),
                 (STABILITY_FRACTION * critical, StepLimit::Stability),
             ];
-            if let Some(excitation) = excitation_bound(model, per_period) {
-                candidates.push((excitation, StepLimit::Excitation));
+            if let Some(bound) = excitation.bound(per_period) {
+                candidates.push((bound, StepLimit::Excitation));
             }
             let (mut dt, limited_by) = candidates
                 .into_iter()
@@ -272,6 +347,7 @@ pub fn resolve(model: &Model<'_>, settings: &Settings) -> Result<StepSize, Simul
                 critical_time_step: critical,
                 max_angular_frequency: omega,
                 limited_by,
+                excitation,
             })
         }
     }
