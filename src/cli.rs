@@ -58,7 +58,8 @@ pub struct RunArgs {
     /// same page as `GET /jobs/{jobId}/report`).
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
-    /// Print progress to stderr.
+    /// Print progress to stderr: the percent done, the time taken and, from 1 % on, the
+    /// time left at the pace so far.
     #[arg(long)]
     pub progress: bool,
 }
@@ -108,6 +109,37 @@ enum CliFailure {
     Failed(String),
 }
 
+/// `--progress`'s line: the percent done, the time taken, and from 1 % on the time left
+/// at the pace so far (padded, so that a shorter line overwrites a longer one).
+fn progress_line(fraction: f64, elapsed: f64) -> String {
+    let percent = (fraction * 100.0).floor();
+    let mut line = format!("{percent:3}% {}", duration_text(elapsed));
+    if (1.0..100.0).contains(&percent) {
+        let left = elapsed * (1.0 - fraction) / fraction;
+        line.push_str(&format!(", about {} left", duration_text(left)));
+    }
+    format!("{line:<40}")
+}
+
+/// Seconds as `12.3 s`, `4 min 05 s` or `1 h 02 min`.
+fn duration_text(seconds: f64) -> String {
+    if seconds < 60.0 {
+        format!("{seconds:.1} s")
+    } else if seconds < 3600.0 {
+        format!(
+            "{} min {:02} s",
+            (seconds / 60.0).floor(),
+            (seconds % 60.0).floor()
+        )
+    } else {
+        format!(
+            "{} h {:02} min",
+            (seconds / 3600.0).floor(),
+            ((seconds % 3600.0) / 60.0).floor()
+        )
+    }
+}
+
 fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, CliFailure> {
     let process = registry
         .get(&args.process_id)
@@ -119,11 +151,12 @@ fn execute(args: &RunArgs, registry: &Registry) -> Result<serde_json::Value, Cli
 
     let show_progress = args.progress;
     let mut last_percent = -1i64;
+    let started = std::time::Instant::now();
     let mut progress = |fraction: f64| {
         let percent = (fraction * 100.0).floor() as i64;
         if show_progress && percent != last_percent {
             last_percent = percent;
-            eprint!("\r{percent:3}%");
+            eprint!("\r{}", progress_line(fraction, started.elapsed().as_secs_f64()));
         }
         ControlFlow::Continue(())
     };
@@ -289,4 +322,29 @@ fn write_histories(dir: &Path, output: &RunOutput) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod progress_tests {
+    use super::progress_line;
+
+    /// A quarter done in 10 s leaves 30 s at that pace; nothing is extrapolated before
+    /// 1 %; long times read in minutes and hours.
+    #[test]
+    fn the_progress_line_extrapolates_the_pace_so_far() {
+        assert_eq!(
+            progress_line(0.25, 10.0).trim_end(),
+            " 25% 10.0 s, about 30.0 s left"
+        );
+        assert_eq!(progress_line(0.005, 2.0).trim_end(), "  0% 2.0 s");
+        assert_eq!(
+            progress_line(0.5, 245.0).trim_end(),
+            " 50% 4 min 05 s, about 4 min 05 s left"
+        );
+        assert_eq!(
+            progress_line(0.1, 1000.0).trim_end(),
+            " 10% 16 min 40 s, about 2 h 30 min left"
+        );
+        assert_eq!(progress_line(1.0, 3.0).trim_end(), "100% 3.0 s");
+    }
 }

@@ -261,6 +261,11 @@ async fn the_dashboard_draws_progress_curves_spectra_maps_and_field_errors_in_a_
         fraction >= progress && fraction < 1.0,
         "progress {fraction} drawn, {progress} before loading"
     );
+    // And the time left at its pace so far, from the status's estimated finish.
+    assert!(
+        row.contains("data-estimated-finish=\"") && row.contains(" left</span>"),
+        "{row}"
+    );
     let row = element(&dom, &format!("data-job=\"{cantilever}\""), "</tr>");
     assert!(row.contains("data-status=\"successful\""), "{row}");
 

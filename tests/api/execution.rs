@@ -37,16 +37,39 @@ async fn progress_is_reported_while_a_job_runs(backend: Backend) {
     let app = spawn_app_on(backend, |_| {}).await;
     let job = app.submit(json!({"steps": 100, "step_ms": 15})).await;
     let mut seen = Vec::new();
+    let mut estimated = 0;
     loop {
         let status = app.status(&job).await;
         let progress = status["progress"].as_u64().unwrap();
         if status["status"] == "successful" {
             assert_eq!(progress, 100);
+            assert!(status.get("estimatedFinish").is_none(), "{status}");
             break;
+        }
+        // While it runs with 1 to 99 % done, the estimated finish extrapolates the
+        // pace so far: the 100 steps sleep 15 ms each, so never before 1.5 s after the
+        // start (the stored percent is rounded down, the time taken is at least the
+        // sleeps, less a millisecond of each time's rounding), and not absurdly later.
+        if status["status"] == "running" && (1..100).contains(&progress) {
+            let at = |member: &str| {
+                let text = status[member]
+                    .as_str()
+                    .unwrap_or_else(|| panic!("no {member}: {status}"));
+                time::OffsetDateTime::parse(text, &time::format_description::well_known::Rfc3339).unwrap()
+            };
+            let ahead = (at("estimatedFinish") - at("started")).as_seconds_f64();
+            assert!(
+                (1.35..60.0).contains(&ahead),
+                "finish {ahead} s after the start: {status}"
+            );
+            estimated += 1;
+        } else {
+            assert!(status.get("estimatedFinish").is_none(), "{status}");
         }
         seen.push(progress);
         tokio::time::sleep(Duration::from_millis(50)).await;
     }
+    assert!(estimated > 0, "no estimated finish seen: {seen:?}");
     assert!(
         seen.iter().any(|p| (1..100).contains(p)),
         "no intermediate progress seen: {seen:?}"

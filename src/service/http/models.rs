@@ -39,6 +39,15 @@ impl Link {
 /// The relation of a job's link to its calculation note (`/jobs/{jobId}/report`).
 pub const REPORT_RELATION: &str = "https://chocmodal.dev/rel/report";
 
+/// When running `job` should finish (ms since the epoch), extrapolating its progress
+/// at the pace of its run so far: `None` unless running with 1 to 99 % done.
+fn estimated_finish(job: &JobRecord) -> Option<i64> {
+    let started = job.started_at?;
+    let done = i64::from(job.progress);
+    (job.status == JobStatus::Running && (1..100).contains(&done))
+        .then(|| started + (job.updated_at - started).max(0) * 100 / done)
+}
+
 /// The state of one job (OGC `statusInfo`).
 #[derive(Debug, Clone, Serialize, ToSchema)]
 pub struct StatusInfo {
@@ -71,6 +80,11 @@ pub struct StatusInfo {
     pub finished: Option<String>,
     /// Last change of status, progress or message (RFC 3339, UTC).
     pub updated: String,
+    /// When a running job should finish at the pace of its run so far (RFC 3339, UTC):
+    /// started + (updated − started) × 100 / progress, from its last progress report.
+    /// Absent until 1 % is done, and once it ends.
+    #[serde(rename = "estimatedFinish", skip_serializing_if = "Option::is_none")]
+    pub estimated_finish: Option<String>,
     /// Plausibility warnings about the inputs, found when the job was submitted: valid
     /// inputs that look like a mistake (a unit slip, nothing exciting the model, ...).
     /// Empty with `"warnings": "off"` among the inputs.
@@ -130,6 +144,7 @@ impl StatusInfo {
             started: job.started_at.map(rfc3339),
             finished: job.finished_at.map(rfc3339),
             updated: rfc3339(job.updated_at),
+            estimated_finish: estimated_finish(job).map(rfc3339),
             warnings: job.warnings.clone(),
             labels: job.labels.clone(),
             note: job.note.clone(),

@@ -245,6 +245,12 @@ export function progressBar(percent, status, prefix = '') {
 /** A job's progress: the bar while it is queued or running, and where a failed or
  *  dismissed run stopped. */
 export function progressCell(job) {
+  if (job.status === 'running' && job.estimatedFinish) {
+    // The time left at the pace of the run so far (the job's estimatedFinish).
+    const left = fmtElapsed(new Date().toISOString(), job.estimatedFinish) || '0 s';
+    return h('span', {'data-estimated-finish': job.estimatedFinish},
+      progressBar(job.progress, job.status), h('span', {class: 'muted'}, ` about ${left} left`));
+  }
   if (job.status === 'running' || job.status === 'accepted') return progressBar(job.progress, job.status);
   if (job.status === 'successful') return h('span', {class: 'muted'}, '100 %');
   if (job.progress > 0) return progressBar(job.progress, job.status, 'stopped at');
