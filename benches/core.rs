@@ -106,7 +106,8 @@ fn main() {
     );
 }
 
-/// Prints the cost of `time_step: auto` and of the step-halving check on `inputs` (a
+/// Prints the cost of `time_step: auto` and of the step check (`auto`, the default: at
+/// 2Δt where that proves the run, else Δt/2; and `step_halving`) on `inputs` (a
 /// fixed-step run with `check: none`) as ratios to that run, each variant timed as the
 /// best of `runs`, the variants interleaved run by run.
 fn accuracy_costs(name: &str, process: &dyn Process, inputs: &serde_json::Value, runs: usize) {
@@ -121,11 +122,13 @@ fn accuracy_costs(name: &str, process: &dyn Process, inputs: &serde_json::Value,
     let variants = [
         ("fixed step", variant(None, "none")),
         ("fixed step + step-halving check", variant(None, "step_halving")),
+        ("fixed step + auto check", variant(None, "auto")),
         ("auto", variant(Some("auto"), "none")),
         ("auto + step-halving check", variant(Some("auto"), "step_halving")),
+        ("auto + auto check (the default)", variant(Some("auto"), "auto")),
     ];
-    let mut best = [f64::INFINITY; 4];
-    let mut steps = [0.0; 4];
+    let mut best = [f64::INFINITY; 6];
+    let mut steps = [0.0; 6];
     for _ in 0..runs {
         for (k, (_, body)) in variants.iter().enumerate() {
             let start = Instant::now();

@@ -238,6 +238,33 @@ fn shock_window(row: Row) -> Row {
     Row { duration, ..row }
 }
 
+/// The check's estimate of the peak force error is within a factor 3 of the true
+/// `error`; below 1e-4 both are at the level of the extrapolation's own error.
+fn assert_estimates(name: &str, estimate: f64, error: f64) {
+    if error > 1e-4 {
+        assert!(
+            estimate <= 3.0 * error && estimate >= error / 3.0,
+            "{name}: estimated peak force error {estimate:.2e}, true {error:.2e}"
+        );
+    } else {
+        assert!(
+            estimate < 3e-4,
+            "{name}: estimate {estimate:.2e}, true {error:.2e}"
+        );
+    }
+}
+
+/// The step is judged good: no reason but the basis's and the mesh's (these rows' 10
+/// modes, no correction, 30 elements, which the impact probes judge, not the step).
+fn assert_no_step_reason(name: &str, quality: &Quality) {
+    let step_reasons: Vec<&String> = quality
+        .reasons
+        .iter()
+        .filter(|r| !r.contains("modal basis") && !r.contains("element mesh"))
+        .collect();
+    assert!(step_reasons.is_empty(), "{name}: {step_reasons:?}");
+}
+
 /// Shocks (the first impacts, where the row has not yet turned chaotic and a Δt → 0
 /// limit exists): the peak contact force of an `auto` run is within 1 % (10 × the
 /// tolerance) of the limit, and the step-halving estimate of its error is within a
@@ -262,30 +289,9 @@ fn auto_peaks_are_within_one_percent_of_the_limit_and_the_check_estimates_the_er
             displacement_error <= 10.0 * DEFAULT_TOLERANCE,
             "{name}: peak deflection {displacement:.6e} m vs limit {limit_displacement:.6e} m"
         );
-        let check = assessed.quality.step_halving.expect("the check ran");
-        let estimate = check.estimated_peak_force_error;
-        // Below 1e-4 both are at the level of the extrapolation's own error.
-        if error > 1e-4 {
-            assert!(
-                estimate <= 3.0 * error && estimate >= error / 3.0,
-                "{name}: estimated peak force error {estimate:.2e}, true {error:.2e}"
-            );
-        } else {
-            assert!(
-                estimate < 3e-4,
-                "{name}: estimate {estimate:.2e}, true {error:.2e}"
-            );
-        }
-        // The step is judged good; the verdict as a whole also covers the basis and the
-        // mesh of these rows (10 modes, no correction, 30 elements), which the impact
-        // probes judge (`crate::discretisation`), not the step.
-        let step_reasons: Vec<&String> = assessed
-            .quality
-            .reasons
-            .iter()
-            .filter(|r| !r.contains("modal basis") && !r.contains("element mesh"))
-            .collect();
-        assert!(step_reasons.is_empty(), "{name}: {step_reasons:?}");
+        let check = assessed.quality.step_halving.as_ref().expect("the check ran");
+        assert_estimates(name, check.estimated_peak_force_error, error);
+        assert_no_step_reason(name, &assessed.quality);
         if assessed.quality.reasons.is_empty() {
             assert_eq!(assessed.quality.verdict, Verdict::Good, "{name}");
         }
@@ -321,18 +327,7 @@ fn the_check_at_twice_the_step_estimates_the_error_for_a_quarter_of_the_cost() {
                 );
                 let (limit_force, _) = limit(&model, &row, step.time_step);
                 let error = (force / limit_force - 1.0).abs();
-                let estimate = check.estimated_peak_force_error;
-                if error > 1e-4 {
-                    assert!(
-                        estimate <= 3.0 * error && estimate >= error / 3.0,
-                        "{name}: estimated peak force error {estimate:.2e}, true {error:.2e}"
-                    );
-                } else {
-                    assert!(
-                        estimate < 3e-4,
-                        "{name}: estimate {estimate:.2e}, true {error:.2e}"
-                    );
-                }
+                assert_estimates(name, check.estimated_peak_force_error, error);
             }
             StepComparison::HalfStep => {
                 let why = check.why_half_step.as_deref().unwrap_or_default();
@@ -340,13 +335,7 @@ fn the_check_at_twice_the_step_estimates_the_error_for_a_quarter_of_the_cost() {
                 assert!((check.relative_cost - 2.0).abs() <= 0.51, "{name}: {check:?}");
             }
         }
-        let step_reasons: Vec<&String> = assessed
-            .quality
-            .reasons
-            .iter()
-            .filter(|r| !r.contains("modal basis") && !r.contains("element mesh"))
-            .collect();
-        assert!(step_reasons.is_empty(), "{name}: {step_reasons:?}");
+        assert_no_step_reason(name, &assessed.quality);
     }
     assert!(doubled >= 4, "only {doubled} of the shocks were checked at 2Δt");
 }
