@@ -340,6 +340,41 @@ fn the_check_at_twice_the_step_estimates_the_error_for_a_quarter_of_the_cost() {
     assert!(doubled >= 4, "only {doubled} of the shocks were checked at 2Δt");
 }
 
+/// A repeated run records one sample (its key figures are tracked at every step): the
+/// check's changes are those of the same run at Δt/2 sampled like the run itself.
+#[test]
+fn the_check_compares_the_figures_of_a_fully_sampled_repeat() {
+    let (_, row) = realistic_rows().remove(0);
+    let row = shock_window(row);
+    let basis = row.basis();
+    let model = row.model(&basis);
+    let assessed = run_at(&model, &row, TimeStep::Auto, Check::StepHalving);
+    let half = assessed.simulation.step.time_step / 2.0;
+    let sampled = run_at(&model, &row, TimeStep::Fixed(half), Check::None).simulation;
+    assert!(
+        sampled.time.len() > 10,
+        "the repeat sampled at the run's interval"
+    );
+    let (run, fine) = (
+        quality::KeyFigures::of(&assessed.simulation),
+        quality::KeyFigures::of(&sampled),
+    );
+    let check = assessed.quality.step_halving.expect("the check ran");
+    assert_eq!(
+        check.peak_force_change,
+        quality::relative_change(run.peak_force, fine.peak_force)
+    );
+    assert_eq!(
+        check.peak_displacement_change,
+        quality::relative_change(run.peak_displacement, fine.peak_displacement)
+    );
+    assert!(fine.impacts > 0);
+    assert_eq!(
+        check.impact_count_change,
+        (run.impacts as f64 - fine.impacts as f64).abs() / fine.impacts as f64
+    );
+}
+
 /// Where 2Δt would be out of range, or the comparison with it is not as strict as
 /// halving, the run is repeated at Δt/2, which decides, and the check says why: a given
 /// step with 30 steps per period of the fastest motion (15 at 2Δt); a table sampled

@@ -262,7 +262,7 @@ impl KeyFigures {
 }
 
 /// |coarse − fine| / |fine|; 0 when both are 0, 1 when only the fine one is.
-fn relative_change(coarse: f64, fine: f64) -> f64 {
+pub(super) fn relative_change(coarse: f64, fine: f64) -> f64 {
     if coarse == fine {
         0.0
     } else if fine == 0.0 {
