@@ -156,8 +156,7 @@ impl JobQueue {
 
     /// The runs of sweep `id` of `tenant` that ended (successful, failed, dismissed), in run order.
     pub async fn ended_sweep_runs(&self, tenant: &str, id: &str) -> Result<Vec<SweepRun>, sqlx::Error> {
-        type Row = (String, Option<i64>, String, String, Option<String>);
-        let rows: Vec<Row> = with_pool!(&self.db, pool => {
+        let rows: Vec<RunRow> = with_pool!(&self.db, pool => {
             sqlx::query_as(
                 "SELECT id, sweep_run, status, inputs, results FROM jobs \
                  WHERE sweep_id = $1 AND tenant = $2 AND status IN ('successful', 'failed', 'dismissed') \
@@ -168,16 +167,7 @@ impl JobQueue {
             .fetch_all(pool)
             .await?
         });
-        Ok(rows
-            .into_iter()
-            .map(|(job_id, run, status, inputs, results)| SweepRun {
-                run: run.unwrap_or(0),
-                job_id,
-                status: JobStatus::parse(&status).unwrap_or(JobStatus::Failed),
-                inputs,
-                results,
-            })
-            .collect())
+        Ok(rows.into_iter().map(sweep_run).collect())
     }
 
     /// The successful runs of sweep `id` numbered after `after` (−1: from the first), at
@@ -190,8 +180,7 @@ impl JobQueue {
         after: i64,
         limit: i64,
     ) -> Result<Vec<SweepRun>, sqlx::Error> {
-        type Row = (String, Option<i64>, String, String, Option<String>);
-        let rows: Vec<Row> = with_pool!(&self.db, pool => {
+        let rows: Vec<RunRow> = with_pool!(&self.db, pool => {
             sqlx::query_as(
                 "SELECT id, sweep_run, status, inputs, results FROM jobs \
                  WHERE sweep_id = $1 AND tenant = $2 AND status = 'successful' AND sweep_run > $3 \
@@ -204,15 +193,19 @@ impl JobQueue {
             .fetch_all(pool)
             .await?
         });
-        Ok(rows
-            .into_iter()
-            .map(|(job_id, run, status, inputs, results)| SweepRun {
-                run: run.unwrap_or(0),
-                job_id,
-                status: JobStatus::parse(&status).unwrap_or(JobStatus::Failed),
-                inputs,
-                results,
-            })
-            .collect())
+        Ok(rows.into_iter().map(sweep_run).collect())
+    }
+}
+
+/// A sweep run's row: id, run number, status, inputs, results.
+type RunRow = (String, Option<i64>, String, String, Option<String>);
+
+fn sweep_run((job_id, run, status, inputs, results): RunRow) -> SweepRun {
+    SweepRun {
+        run: run.unwrap_or(0),
+        job_id,
+        status: JobStatus::parse(&status).unwrap_or(JobStatus::Failed),
+        inputs,
+        results,
     }
 }
