@@ -24,6 +24,7 @@ pub mod contact_law;
 pub mod cost;
 /// The excitations the processes share (base accelerations, signals in the plane).
 pub mod excitation;
+pub mod excitation_record;
 pub mod impact_report;
 pub mod input_schema;
 /// Allowables and the utilisation ratios they give (docs/margins.md).

@@ -10,6 +10,7 @@ use utoipa::ToSchema;
 use super::basis_report::BasisReport;
 use super::bending::{self, BendingReport, Flexure};
 use super::contact_law;
+use super::excitation_record::{Excitations, GeneratedRecord};
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
 use super::margins::{self, RunMargins};
 use super::report::{EnergyReport, QualityReport};
@@ -166,12 +167,15 @@ pub struct RunSummary {
     pub basis: BasisReport,
     #[serde(flatten)]
     pub bending: BendingReport,
+    /// The synthetic earthquakes (`spectrum_compatible`) the run was given: what each
+    /// reached against its target; empty without one.
+    pub generated_records: Vec<GeneratedRecord>,
 }
 
 impl RunSummary {
     /// The summary of `run`, judged `quality`, counted as `settings` asks, with the
     /// allowable force of each contact and the allowable stress (Pa) of the pins, the
-    /// report of its basis, and its pins' flexure.
+    /// report of its basis, its pins' flexure and its excitations.
     pub fn of(
         run: &Simulation,
         quality: QualityReport,
@@ -179,6 +183,7 @@ impl RunSummary {
         (allowables, allowable_stress): (&[Option<f64>], Option<f64>),
         (basis, frequencies_hz): (BasisReport, Vec<f64>),
         flexure: &Flexure,
+        excitations: &Excitations,
     ) -> Self {
         let peaks: Vec<f64> = run.contact_statistics.iter().map(|s| s.max_force).collect();
         let bending = BendingReport::of(run, flexure);
@@ -210,6 +215,7 @@ impl RunSummary {
             frequencies_hz,
             basis,
             bending,
+            generated_records: excitations.generated_records(),
         }
     }
 }
@@ -245,14 +251,16 @@ pub const MOMENTS_OUTPUT: HistoryOutput = HistoryOutput {
 };
 
 /// The histories every run of pins gives: `contact_forces`, `displacements`, their
-/// `_peaks`, `bending_moments` and the impact table, with the columns named `contacts`
-/// (one per recorded contact) and `deflections` ([`deflection_names`]; the moments' as
-/// the deflections'), the moments of pins of `flexure`.
+/// `_peaks`, `bending_moments`, the impact table and the `excitation` of
+/// `excitations`, with the columns named `contacts` (one per recorded contact) and
+/// `deflections` ([`deflection_names`]; the moments' as the deflections'), the moments
+/// of pins of `flexure`.
 pub fn histories(
     run: Simulation,
     contacts: &[String],
     deflections: &[String],
     flexure: &Flexure,
+    excitations: &Excitations,
 ) -> Vec<History> {
     let moments = bending::moment_columns(&run, flexure);
     let named = |names: &[String], columns: Vec<Vec<f64>>| -> Vec<(String, Vec<f64>)> {
@@ -264,6 +272,7 @@ pub fn histories(
         series,
     };
     let table = impact_report::table_history(&run.impact_table);
+    let excitation = excitations.history(&run.time);
     vec![
         history("contact_forces", named(contacts, run.contact_forces)),
         history(
@@ -277,6 +286,7 @@ pub fn histories(
         ),
         history("bending_moments", named(deflections, moments)),
         table,
+        excitation,
     ]
 }
 

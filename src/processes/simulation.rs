@@ -45,6 +45,8 @@ pub enum HistoryKind {
     Force,
     /// Bending moments (N·m), sampled at each output time.
     Moment,
+    /// Accelerations (m/s²): the excitation a run was given.
+    Acceleration,
     /// The extreme of each output interval over all steps (a `_peaks` companion).
     Peaks,
     /// Not a time series: one row per event.
@@ -58,6 +60,7 @@ impl HistoryKind {
             Self::Displacement => "displacement",
             Self::Force => "force",
             Self::Moment => "moment",
+            Self::Acceleration => "acceleration",
             Self::Peaks => "peaks",
             Self::Table => "table",
         }

@@ -14,7 +14,7 @@ use utoipa::ToSchema;
 use super::input_schema::PositiveNumber;
 use crate::physics::InputIssue;
 use crate::physics::loads::Table;
-use crate::physics::synthetic::{self, SpectrumCompatible, TargetSpectrum};
+use crate::physics::synthetic::{self, Accelerogram, SpectrumCompatible, TargetSpectrum};
 
 /// A synthetic earthquake matching a target pseudo-acceleration spectrum: stationary
 /// random phases drawn from `seed`, a Jennings envelope (quadratic build-up, `strong_motion`
@@ -99,7 +99,7 @@ fn present<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(
 /// The generated record or why there is none, computed on first use. Shared by clones of
 /// the same input; it is derived data, so it takes no part in equality.
 #[derive(Debug, Clone, Default)]
-struct Record(Arc<OnceLock<Result<Table, Vec<InputIssue>>>>);
+struct Record(Arc<OnceLock<Result<Accelerogram, Vec<InputIssue>>>>);
 
 impl PartialEq for Record {
     fn eq(&self, _: &Self) -> bool {
@@ -126,10 +126,14 @@ impl SpectrumCompatibleInput {
         }
     }
 
-    fn record(&self) -> &Result<Table, Vec<InputIssue>> {
-        self.record
-            .0
-            .get_or_init(|| self.request().generate().map(|record| record.table()))
+    fn record(&self) -> &Result<Accelerogram, Vec<InputIssue>> {
+        self.record.0.get_or_init(|| self.request().generate())
+    }
+
+    /// The generated record (its samples, the rounds taken, the deviation reached);
+    /// `None` for a request that was refused.
+    pub fn generated(&self) -> Option<&Accelerogram> {
+        self.record().as_ref().ok()
     }
 
     /// Every problem with the request (fields relative to the excitation object), the
@@ -146,7 +150,7 @@ impl SpectrumCompatibleInput {
     /// table (no excitation).
     pub fn table(&self) -> Table {
         match self.record() {
-            Ok(table) => table.clone(),
+            Ok(record) => record.table(),
             Err(_) => Table {
                 time: Vec::new(),
                 values: Vec::new(),

@@ -364,6 +364,109 @@ async fn check_spectrum(browser: &mut Browser, figure: &str, api: &Value, peak: 
     );
 }
 
+/// A synthetic earthquake's record, picked in the job's spectrum card, is drawn at its
+/// target's damping and over its band, with the target dashed beside it and the largest
+/// deviation in the caption: the API's numbers.
+#[tokio::test]
+#[cfg_attr(
+    chocmodal_skip_browser_tests,
+    ignore = "needs headless Chromium: none found at build time, or CHOCMODAL_SKIP_BROWSER_TESTS=1 (build.rs)"
+)]
+async fn a_synthetic_earthquake_is_drawn_against_its_target() {
+    let chromium = chromium(concat!(
+        module_path!(),
+        "::a_synthetic_earthquake_is_drawn_against_its_target"
+    ));
+    let app = spawn_app_with_processes(vec![Arc::new(BundleDynamics)], |_| {}).await;
+    let mut earthquake = example("bundle-earthquake.json");
+    earthquake["inputs"]["bundle"]["pins"] = json!(2);
+    earthquake["inputs"]["solver"]["duration"] = json!(0.5);
+    let job = execute(&app, "bundle-dynamics", &earthquake).await;
+    assert_eq!(
+        app.wait_for(&job, &["successful"], Duration::from_secs(120))
+            .await["status"],
+        "successful"
+    );
+    let target = &earthquake["inputs"]["excitation"]["base_acceleration"]["target"];
+    let band = target["frequencies"].as_array().cloned().unwrap_or_default();
+
+    let mut browser = Browser::launch(&chromium, 1280, 1000).await;
+    browser.goto(&app.url(&format!("/jobs/{job}"))).await;
+    let card = "[data-card=\"response-spectrum\"]";
+    browser
+        .wait_for(
+            &format!("document.querySelector('{card} [data-control=\"output\"]') !== null"),
+            WITHIN,
+        )
+        .await;
+    browser
+        .eval(&format!(
+            "(() => {{ const output = document.querySelector('{card} [data-control=\"output\"]'); \
+             output.value = 'excitation'; output.dispatchEvent(new Event('change')); }})()"
+        ))
+        .await;
+    browser
+        .wait_for(
+            &format!(
+                "document.querySelector('{card} [data-control=\"series\"]').value === 'base_acceleration' \
+                 && Number(document.querySelector('{card} [data-control=\"f_min\"]').value) === {}",
+                band[0]
+            ),
+            WITHIN,
+        )
+        .await;
+    browser
+        .click(&format!("{card} [data-action=\"draw-spectrum\"]"))
+        .await;
+    let spectrum = "[data-plot=\"response-spectrum\"]";
+    browser
+        .wait_for(
+            &format!("document.querySelector('{spectrum} [data-series=\"target\"]') !== null"),
+            WITHIN,
+        )
+        .await;
+    let api = app
+        .get_json(&format!(
+            "/jobs/{job}/results/excitation/response_spectrum?series=base_acceleration&damping={}&f_min={}&f_max={}&points=200",
+            target["damping"],
+            band[0],
+            band[band.len() - 1]
+        ))
+        .await;
+    let wanted: Vec<f64> = api["target"]["pseudo_acceleration"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default()
+        .iter()
+        .map(|v| v.as_f64().unwrap_or(f64::NAN))
+        .collect();
+    let key = format!("{spectrum} [data-series=\"target\"]");
+    assert_eq!(
+        parsed(&attribute(&mut browser, &key, "data-points").await),
+        wanted.len() as f64
+    );
+    let max = wanted.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    assert!(same(
+        parsed(&attribute(&mut browser, &key, "data-max").await),
+        max
+    ));
+    let key = format!("{spectrum} [data-series=\"psa_{}\"]", target["damping"]);
+    assert_eq!(parsed(&attribute(&mut browser, &key, "data-points").await), 200.0);
+    let deviation = api["target"]["max_deviation"].as_f64().unwrap_or(f64::NAN);
+    assert!(deviation <= 0.1, "{}", api["target"]);
+    let shown = attribute(
+        &mut browser,
+        &format!("{card} [data-target-deviation]"),
+        "data-target-deviation",
+    )
+    .await;
+    assert!(same(parsed(&shown), deviation), "{shown} against {deviation}");
+    browser
+        .screenshot(&screenshot_dir().join("job-earthquake-spectrum.png"))
+        .await;
+    browser.assert_no_exceptions();
+}
+
 #[tokio::test]
 #[cfg_attr(
     chocmodal_skip_browser_tests,

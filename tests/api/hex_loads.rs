@@ -326,3 +326,106 @@ async fn bad_point_forces_and_releases_are_refused_at_their_pointers() {
         "{problem}"
     );
 }
+
+/// Two horizontal components at once: with gaps that never close, every pin's x motion
+/// is the lone pin's under the x component alone and its y motion the lone pin's under
+/// the y component (the directions are uncoupled), and the `excitation` history gives
+/// both components, as given, at every sample of the record and at the output times.
+#[tokio::test]
+async fn two_components_of_a_base_shock_move_the_pins_along_each_axis_as_the_row() {
+    let app = spawn().await;
+    let along_x = json!({"type": "half_sine", "amplitude": 30.0, "duration": 0.01});
+    // A record sampled every 0.7 ms, off the output grid (1 ms).
+    let times: Vec<f64> = (0..=40).map(|k| k as f64 * 7e-4).collect();
+    let values: Vec<f64> = times
+        .iter()
+        .map(|t| 20.0 * (t * 400.0_f64).sin() * (1.0 - t / 0.028))
+        .collect();
+    let along_y = json!({"type": "table", "time": times, "acceleration": values});
+    let mut inputs = open_bundle();
+    inputs["excitation"] = json!({"base_acceleration_x": along_x, "base_acceleration_y": along_y});
+    let response = app
+        .post_execution("hex-bundle-dynamics", &json!({"inputs": inputs}))
+        .await;
+    assert_eq!(response.status(), StatusCode::CREATED);
+    let id = response.json::<Value>().await.unwrap()["jobID"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    let status = app.wait_until_finished(&id).await;
+    assert_eq!(status["status"], "successful", "{status}");
+    let history = app.get_json(&format!("/jobs/{id}/results/displacements")).await;
+
+    for (axis, signal) in [("x", &along_x), ("y", &along_y)] {
+        let mut row = lone_pin();
+        row["excitation"] = json!({"base_acceleration": signal});
+        let (_, row_history) = run(&app, "bundle-dynamics", row).await;
+        let u = series(&row_history, "p0");
+        let scale = peak(&u);
+        assert!(scale > 1e-6, "{axis}: the lone pin must move ({scale:e} m)");
+        for pin in 0..7 {
+            let moved = series(&history, &format!("p{pin}{axis}"));
+            assert_eq!(moved.len(), u.len());
+            for (k, (m, e)) in moved.iter().zip(&u).enumerate() {
+                assert!(
+                    (m - e).abs() <= 1e-9 * scale,
+                    "pin {pin} along {axis}, sample {k}: {m:e} against the row's {e:e}"
+                );
+            }
+        }
+    }
+
+    let excitation = app.get_json(&format!("/jobs/{id}/results/excitation")).await;
+    let time: Vec<f64> = excitation["time"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_f64().unwrap())
+        .collect();
+    let (x, y) = (
+        series(&excitation, "base_acceleration_x"),
+        series(&excitation, "base_acceleration_y"),
+    );
+    for t in &times {
+        assert!(
+            time.iter().any(|s| (s - t).abs() < 1e-12),
+            "the record's sample at {t} s is missing"
+        );
+    }
+    for k in 0..=60 {
+        let t = k as f64 * 1e-3;
+        assert!(
+            time.iter().any(|s| (s - t).abs() < 1e-12),
+            "output time {t} s is missing"
+        );
+    }
+    for (k, t) in time.iter().enumerate() {
+        let exact_x = if *t <= 0.01 {
+            30.0 * (std::f64::consts::PI * t / 0.01).sin()
+        } else {
+            0.0
+        };
+        assert!((x[k] - exact_x).abs() <= 1e-12 * 30.0, "x at {t} s: {}", x[k]);
+        // Linear between the record's samples, 0 after the last.
+        let j = times.partition_point(|s| s <= t);
+        let exact_y = match j {
+            0 => 0.0,
+            j if j == times.len() => {
+                if (t - times[j - 1]).abs() < 1e-15 {
+                    values[j - 1]
+                } else {
+                    0.0
+                }
+            }
+            j => {
+                let w = (t - times[j - 1]) / (times[j] - times[j - 1]);
+                values[j - 1] + w * (values[j] - values[j - 1])
+            }
+        };
+        assert!(
+            (y[k] - exact_y).abs() <= 1e-12 * 20.0,
+            "y at {t} s: {} against {exact_y}",
+            y[k]
+        );
+    }
+}

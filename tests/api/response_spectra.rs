@@ -102,7 +102,7 @@ async fn a_displacement_column_has_the_spectrum_of_its_second_differences() {
 }
 
 #[tokio::test]
-async fn only_displacement_histories_have_a_response_spectrum() {
+async fn only_displacement_and_acceleration_histories_have_a_response_spectrum() {
     let app = spawn_with_cantilever().await;
     let (job, _) = cantilever_job(&app).await;
     for output in ["contact_force", "tip_displacement_peaks", "impacts"] {
@@ -117,7 +117,7 @@ async fn only_displacement_histories_have_a_response_spectrum() {
             problem["detail"]
                 .as_str()
                 .unwrap()
-                .contains("only displacement histories have a response spectrum"),
+                .contains("only displacement and acceleration histories have a response spectrum"),
             "{problem}"
         );
     }
@@ -166,7 +166,7 @@ async fn an_undeclared_or_unfinished_history_has_none() {
         problem["detail"]
             .as_str()
             .unwrap()
-            .contains("has no displacement history `signal`"),
+            .contains("has no displacement or acceleration history `signal`"),
         "{problem}"
     );
 

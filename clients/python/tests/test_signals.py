@@ -183,3 +183,34 @@ def test_a_record_in_g_from_an_at2_file_or_an_array_is_stored_in_metres_per_seco
     with pytest.raises(chocmodal.ChocmodalError) as refused:
         client.upload_signal(path, unit="m/s2")
     assert "/unit" in str(refused.value)
+
+
+def test_a_synthetic_earthquake_is_an_output_whose_spectrum_meets_its_target(client: chocmodal.Client) -> None:
+    target = {"frequencies": [1.0, 2.5, 6.67, 20.0], "accelerations": [3.0, 7.5, 7.5, 4.5], "damping": 0.05}
+    inputs = {
+        "pin": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
+                "section": {"type": "tube", "outer_diameter": 0.0097, "inner_diameter": 0.0085}},
+        "bundle": {"pins": 2, "levels": [1.0], "stiffness": 1e6, "damping": 20.0, "wall_gap": 1e-3, "pin_gap": 1e-3},
+        "excitation": {"base_acceleration": {"type": "spectrum_compatible", "target": target,
+                                             "duration": 8.0, "strong_motion": 4.0, "seed": 3}},
+        "solver": {"duration": 0.2, "check": "none"},
+    }
+    job = client.submit("bundle-dynamics", inputs)
+    with pytest.warns(chocmodal.QualityWarning):  # unchecked, and the run ends before the record
+        results = job.wait(progress=False, timeout=120)
+    (generated,) = results["generated_records"]
+    assert generated["member"] == "base_acceleration" and generated["seed"] == 3
+
+    record = job.history("excitation")
+    assert list(record.columns) == ["base_acceleration"]
+    assert record.attrs["units"]["base_acceleration"] == "m/s²"
+    # The whole record, past the run's 0.2 s: its samples and their peak.
+    assert record.index[-1] == pytest.approx(generated["duration"])
+    assert record["base_acceleration"].abs().max() == generated["peak_acceleration"]
+
+    spectrum = job.response_spectrum("excitation", series="base_acceleration")
+    assert list(spectrum.columns) == ["psa_0.05", "target"]
+    assert spectrum.index[0] == 1.0 and spectrum.index[-1] == 20.0
+    deviation = (spectrum["psa_0.05"] / spectrum["target"] - 1.0).abs()
+    assert deviation.max() == pytest.approx(spectrum.attrs["max_deviation"], rel=1e-12)
+    assert spectrum.attrs["max_deviation"] <= spectrum.attrs["tolerance"] == 0.1

@@ -467,6 +467,16 @@ pub struct ExcitationInput {
 
 impl ExcitationInput {
     /// The stored signals referenced, with their pointers.
+    /// The acceleration members (name, value), in the schema's order.
+    pub fn accelerations(&self) -> [(&'static str, &Option<BaseAccelerationInput>); 4] {
+        [
+            ("base_acceleration", &self.base_acceleration),
+            ("wall_acceleration", &self.wall_acceleration),
+            ("left_wall_acceleration", &self.left_wall_acceleration),
+            ("right_wall_acceleration", &self.right_wall_acceleration),
+        ]
+    }
+
     pub fn signal_references(&mut self) -> Vec<crate::processes::signal_input::SignalSlot<'_>> {
         crate::processes::excitation::signal_slots([
             ("base_acceleration", &mut self.base_acceleration),

@@ -15,6 +15,7 @@ use super::columns;
 use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::LawInput;
 use super::excitation::BaseAccelerationInput;
+use super::excitation_record::{self, Excitations};
 use super::impact_report;
 use super::margins::PinUtilisation;
 use super::model_check::{self, StandIn};
@@ -48,6 +49,11 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// The accelerations the run is given, member by member.
+    fn excitations(&self) -> Excitations {
+        Excitations::of(self.inputs.excitation.accelerations())
+    }
+
     fn flexure(&self) -> Flexure {
         Flexure::of(&self.inputs.pin, None)
     }
@@ -298,6 +304,7 @@ impl Simulation for BundleDynamics {
         },
         run_report::MOMENTS_OUTPUT,
         impact_report::TABLE_OUTPUT,
+        excitation_record::OUTPUT,
     ];
 
     type Inputs = BundleInputs;
@@ -554,6 +561,7 @@ impl Simulation for BundleDynamics {
                 (&allowables, allowable_stress),
                 (basis, plan.basis.frequencies_hz()),
                 &flexure,
+                &plan.excitations(),
             ),
             expansion: plan.inputs.bundle.is_some().then(|| Expansion {
                 pins: plan.pins,
@@ -609,7 +617,13 @@ fn histories(plan: &Plan, simulation: Run) -> Vec<History> {
         run_report::deflection_names(&plan.settings.output_heights, plan.pins, tips_only, |p| {
             format!("p{p}")
         });
-    run_report::histories(simulation, &contacts, &deflections, &plan.flexure())
+    run_report::histories(
+        simulation,
+        &contacts,
+        &deflections,
+        &plan.flexure(),
+        &plan.excitations(),
+    )
 }
 
 /// A column of `bundle-dynamics`: `c<k>` the force (N) of contact k of the results'
@@ -639,6 +653,7 @@ fn column_of(output: &str, name: &str, document: &serde_json::Value) -> Option<s
             let (pin, _, at) = columns::deflection(name, false)?;
             ("N·m", format!("bending moment EI w'' of p{pin} at {at}"))
         }
+        "excitation" => ("m/s²", excitation_record::column_description(name, document)),
         _ => return None,
     };
     Some(super::Column::new(

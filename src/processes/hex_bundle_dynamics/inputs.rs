@@ -335,6 +335,18 @@ pub struct HexExcitationInput {
 
 impl HexExcitationInput {
     /// The stored signals referenced, with their pointers.
+    /// The acceleration members (name, value), in the schema's order.
+    pub fn accelerations(&self) -> [(&'static str, &Option<BaseAccelerationInput>); 6] {
+        [
+            ("base_acceleration", &self.base_acceleration),
+            ("base_acceleration_x", &self.base_acceleration_x),
+            ("base_acceleration_y", &self.base_acceleration_y),
+            ("wrapper_acceleration", &self.wrapper_acceleration),
+            ("wrapper_acceleration_x", &self.wrapper_acceleration_x),
+            ("wrapper_acceleration_y", &self.wrapper_acceleration_y),
+        ]
+    }
+
     pub fn signal_references(&mut self) -> Vec<crate::processes::signal_input::SignalSlot<'_>> {
         crate::processes::excitation::signal_slots([
             ("base_acceleration", &mut self.base_acceleration),

@@ -20,6 +20,7 @@ use super::columns;
 use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::{FrictionReport, LawInput, WearDepth, WearReport};
 use super::excitation::{PlaneSignal, plane_signal};
+use super::excitation_record::{self, Excitations};
 use super::impact_report;
 use super::margins::PinUtilisation;
 use super::resultants::PinResultants;
@@ -59,6 +60,11 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// The accelerations the run is given, member by member.
+    fn excitations(&self) -> Excitations {
+        Excitations::of(self.inputs.excitation.accelerations())
+    }
+
     /// The pins' flexure: D may be given apart from an explicit section.
     fn flexure(&self) -> Flexure {
         Flexure::of(&self.inputs.pin, self.inputs.pin_diameter())
@@ -303,6 +309,7 @@ impl Simulation for HexBundleDynamics {
         },
         run_report::MOMENTS_OUTPUT,
         impact_report::TABLE_OUTPUT,
+        excitation_record::OUTPUT,
     ];
     const SHARES_STEPS: bool = true;
 
@@ -614,6 +621,7 @@ impl Simulation for HexBundleDynamics {
                 (&allowables, allowable_stress),
                 (basis, plan.basis.frequencies_hz()),
                 &flexure,
+                &plan.excitations(),
             ),
         };
         let histories = histories(&plan, simulation);
@@ -866,7 +874,13 @@ fn histories(plan: &Plan, simulation: integrate::Simulation) -> Vec<History> {
     let contacts: Vec<String> = (plan.settings.recorded_contacts.iter().flatten())
         .map(|k| format!("c{k}"))
         .collect();
-    run_report::histories(simulation, &contacts, &deflections, &plan.flexure())
+    run_report::histories(
+        simulation,
+        &contacts,
+        &deflections,
+        &plan.flexure(),
+        &plan.excitations(),
+    )
 }
 
 /// A column of `hex-bundle-dynamics`: `c<k>` the force (N, along the contact's normal) of
@@ -910,6 +924,7 @@ fn column_of(output: &str, name: &str, document: &serde_json::Value) -> Option<s
                 ),
             )
         }
+        "excitation" => ("m/s²", excitation_record::column_description(name, document)),
         _ => return None,
     };
     Some(super::Column::new(

@@ -15,7 +15,9 @@ use super::error::ApiError;
 use super::history_view::{Format, respond};
 use super::signal_models::DampedSpectrum;
 use crate::physics::acceleration::acceleration_of_displacement;
+use crate::physics::loads::Table;
 use crate::physics::response_spectrum::{self, log_spaced};
+use crate::physics::synthetic::TargetSpectrum;
 use crate::problem::Problem;
 use crate::processes::{HistoryKind, columns_csv};
 use crate::service::auth::Tenant;
@@ -156,14 +158,37 @@ pub(super) fn parse_spectrum_query(
 /// `frequency,psa_<damping>...`: one row per frequency (Hz), one column per damping ratio
 /// (m/s²).
 pub(super) fn spectra_csv(frequencies: &[f64], spectra: &[DampedSpectrum]) -> String {
-    let series: Vec<(String, Vec<f64>)> = spectra
-        .iter()
-        .map(|s| (format!("psa_{}", s.damping), s.values.clone()))
-        .collect();
-    columns_csv("frequency", frequencies, &series)
+    columns_csv("frequency", frequencies, &spectra_columns(spectra))
 }
 
-/// The pseudo-acceleration response spectrum of one column of a displacement history.
+/// The CSV columns `psa_<damping>` of `spectra`.
+fn spectra_columns(spectra: &[DampedSpectrum]) -> Vec<(String, Vec<f64>)> {
+    spectra
+        .iter()
+        .map(|s| (format!("psa_{}", s.damping), s.values.clone()))
+        .collect()
+}
+
+/// A synthetic earthquake's target beside the spectrum of its stored record.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct SpectrumTarget {
+    /// Damping ratio of the target (dimensionless).
+    pub damping: f64,
+    /// The target at each of `frequencies` (m/s², straight between its points on log–log
+    /// axes); null outside its band.
+    pub pseudo_acceleration: Vec<Option<f64>>,
+    /// Largest |PSA/target − 1| over the frequencies within the band, of the spectrum at
+    /// the target's damping (dimensionless); null when that damping was not asked for or
+    /// no frequency lies in the band.
+    pub max_deviation: Option<f64>,
+    /// Where it occurs (Hz).
+    pub deviation_frequency: Option<f64>,
+    /// The deviation the request allowed (dimensionless).
+    pub tolerance: f64,
+}
+
+/// The pseudo-acceleration response spectrum of one column of a displacement or
+/// acceleration history.
 #[derive(Debug, Serialize, ToSchema)]
 pub struct HistoryResponseSpectrum {
     /// Output name, e.g. `displacements`.
@@ -173,7 +198,8 @@ pub struct HistoryResponseSpectrum {
     /// Mean sample interval of the history (s); the acceleration is read well up to
     /// about a tenth of the sampling rate, 1/(10 × this).
     pub sample_interval: f64,
-    /// Samples of the acceleration record: the history's, but its first and last.
+    /// Samples of the acceleration record: a displacement history's but its first and
+    /// last; an acceleration history's, all.
     pub samples: usize,
     /// Largest |acceleration| of the record (m/s²): the spectrum tends to it at high
     /// frequency (the zero-period acceleration).
@@ -182,9 +208,13 @@ pub struct HistoryResponseSpectrum {
     pub frequencies: Vec<f64>,
     /// One spectrum per damping ratio asked for, in the order asked.
     pub pseudo_acceleration: Vec<DampedSpectrum>,
+    /// For a synthetic earthquake's column of `excitation`, its target (the results'
+    /// `generated_records`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub target: Option<SpectrumTarget>,
 }
 
-/// Response spectrum of a displacement history
+/// Response spectrum of a displacement or acceleration history
 ///
 /// The pseudo-acceleration response spectrum PSA(f, ξ) = ω² max|u| (m/s²) of the motion
 /// of one column of a displacement history: the acceleration at each interior sample by
@@ -192,19 +222,24 @@ pub struct HistoryResponseSpectrum {
 /// oscillators of `physics::response_spectrum` as for a signal (at rest at the first
 /// acceleration sample, followed one damped period after the last). The histories are in
 /// the frame of the pin feet: for a run with a base excitation this is the spectrum of
-/// the motion relative to the feet. Only displacement histories (`kind` `displacement` in
-/// the process description) have one: another output is a 404. `series`: the column
-/// (default the first); `damping`, `f_min`, `f_max`, `points`: as for a signal's
-/// spectrum; `format=csv` (or `Accept: text/csv`): `frequency,psa_<damping>...`.
+/// the motion relative to the feet. Of a column of an acceleration history (the
+/// `excitation` a run was given), the spectrum of the stored samples themselves; for a
+/// synthetic earthquake's column, `target` holds its target and the deviation from it,
+/// and the defaults are the target's damping and band. Only displacement and
+/// acceleration histories (`kind` in the process description) have one: another output
+/// is a 404. `series`: the column (default the first); `damping`, `f_min`, `f_max`,
+/// `points`: as for a signal's spectrum; `format=csv` (or `Accept: text/csv`):
+/// `frequency,psa_<damping>...`, then `target` when every frequency lies in the target's
+/// band.
 #[utoipa::path(get, path = "/jobs/{jobId}/results/{output}/response_spectrum", operation_id = "getResultResponseSpectrum",
     tag = "Results",
     params(
         ("jobId" = String, Path, description = "Job id"),
-        ("output" = String, Path, description = "A displacement history, e.g. `displacements`", example = "displacements"),
+        ("output" = String, Path, description = "A displacement or acceleration history, e.g. `displacements`, `excitation`", example = "displacements"),
         ("series" = Option<String>, Query, description = "The column, e.g. `p0` (default: the first)"),
-        ("damping" = Option<String>, Query, description = "Damping ratios in [0, 1), repeatable or comma-separated (default 0.05)"),
-        ("f_min" = Option<f64>, Query, description = "Lowest frequency (Hz, default 0.1)"),
-        ("f_max" = Option<f64>, Query, description = "Highest frequency (Hz, default 100)"),
+        ("damping" = Option<String>, Query, description = "Damping ratios in [0, 1), repeatable or comma-separated (default 0.05; a synthetic earthquake's: its target's)"),
+        ("f_min" = Option<f64>, Query, description = "Lowest frequency (Hz, default 0.1; a synthetic earthquake's: its target's lowest)"),
+        ("f_max" = Option<f64>, Query, description = "Highest frequency (Hz, default 100; a synthetic earthquake's: its target's highest)"),
         ("points" = Option<usize>, Query, description = "Number of log-spaced frequencies, 2 to 2000 (default 200)"),
         ("format" = Option<String>, Query, description = "`csv` or `json` (default from `Accept`, else JSON)"),
     ),
@@ -218,7 +253,7 @@ pub struct HistoryResponseSpectrum {
         (status = 304, description = "Unchanged since the `If-None-Match` tag"),
         (status = 400, description = "Invalid query parameter, an unknown column, or a grid too costly for this history",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
-        (status = 404, description = "No such job or displacement history, or results not ready",
+        (status = 404, description = "No such job or displacement or acceleration history, or results not ready",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json"),
         (status = 422, description = "The history is too short (fewer than 4 samples)",
             body = super::openapi::ProblemSchema, content_type = "application/problem+json")))]
@@ -232,6 +267,12 @@ pub async fn response_spectrum(
 ) -> Result<Response, ApiError> {
     let Query(pairs) = query.map_err(|e| Problem::invalid_query(e.body_text()))?;
     let SpectrumQuery { request, extra } = parse_spectrum_query(&pairs, &["series"])?;
+    let given = |name: &str| pairs.iter().any(|(key, _)| key == name);
+    let defaults = Defaults {
+        damping: !given("damping"),
+        f_min: !given("f_min"),
+        f_max: !given("f_max"),
+    };
     let series = match extra.as_slice() {
         [] => None,
         [(_, name)] if !name.is_empty() && !name.contains(',') => Some(name.clone()),
@@ -246,17 +287,22 @@ pub async fn response_spectrum(
         .registry
         .get(&job.process_id)
         .and_then(|process| process.history_kind(&output));
-    if kind != Some(HistoryKind::Displacement) {
-        let mut problem = Problem::no_such_output(&job_id, &format!("{output}/response_spectrum"));
-        problem.detail = match kind {
-            Some(kind) => format!(
-                "`{output}` of job `{job_id}` is a {} history: only displacement histories have a response spectrum",
-                kind.as_str()
-            ),
-            None => format!("job `{job_id}` has no displacement history `{output}`"),
-        };
-        return Err(problem.into());
-    }
+    let motion = match kind {
+        Some(HistoryKind::Displacement) => Motion::Displacement,
+        Some(HistoryKind::Acceleration) => Motion::Acceleration,
+        _ => {
+            let mut problem = Problem::no_such_output(&job_id, &format!("{output}/response_spectrum"));
+            problem.detail = match kind {
+                Some(kind) => format!(
+                    "`{output}` of job `{job_id}` is a {} history: only displacement and acceleration histories \
+                     have a response spectrum",
+                    kind.as_str()
+                ),
+                None => format!("job `{job_id}` has no displacement or acceleration history `{output}`"),
+            };
+            return Err(problem.into());
+        }
+    };
     respond(
         &state,
         &tenant,
@@ -265,15 +311,89 @@ pub async fn response_spectrum(
         &headers,
         format,
         "computing a response spectrum",
-        move |stored, _| render(stored, series.as_deref(), &request, format),
+        move |stored, outcome| {
+            render(
+                stored,
+                (series.as_deref(), motion),
+                (request, defaults),
+                outcome.results.as_deref(),
+                format,
+            )
+        },
     )
     .await
 }
 
+/// What the values of a history's column are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Motion {
+    Displacement,
+    Acceleration,
+}
+
+/// Which of the grid's parameters were left to their defaults (a synthetic
+/// earthquake's are its target's).
+#[derive(Debug, Clone, Copy)]
+struct Defaults {
+    damping: bool,
+    f_min: bool,
+    f_max: bool,
+}
+
+/// The target of the synthetic earthquake whose member is `series`, from a results
+/// document's `generated_records`.
+fn generated_target(results: Option<&str>, series: &str) -> Option<(TargetSpectrum, f64)> {
+    let document: serde_json::Value = serde_json::from_str(results?).ok()?;
+    let record = document["generated_records"]
+        .as_array()?
+        .iter()
+        .find(|record| record["member"] == series)?;
+    let numbers = |value: &serde_json::Value| -> Option<Vec<f64>> {
+        value.as_array()?.iter().map(serde_json::Value::as_f64).collect()
+    };
+    let target = &record["target"];
+    Some((
+        TargetSpectrum {
+            frequencies: numbers(&target["frequencies"])?,
+            accelerations: numbers(&target["accelerations"])?,
+            damping: target["damping"].as_f64()?,
+        },
+        record["tolerance"].as_f64()?,
+    ))
+}
+
+/// The target beside the spectra `spectra` at `frequencies`.
+fn compare(
+    (target, tolerance): &(TargetSpectrum, f64),
+    frequencies: &[f64],
+    spectra: &[DampedSpectrum],
+) -> SpectrumTarget {
+    let (low, high) = target.band();
+    let slack = 1e-12;
+    let values: Vec<Option<f64>> = frequencies
+        .iter()
+        .map(|&f| (f >= low * (1.0 - slack) && f <= high * (1.0 + slack)).then(|| target.at(f)))
+        .collect();
+    let at_damping = spectra.iter().find(|s| s.damping == target.damping);
+    let worst = at_damping.and_then(|spectrum| {
+        (spectrum.values.iter().zip(&values).zip(frequencies))
+            .filter_map(|((psa, wanted), f)| wanted.map(|w| ((psa / w - 1.0).abs(), *f)))
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+    });
+    SpectrumTarget {
+        damping: target.damping,
+        pseudo_acceleration: values,
+        max_deviation: worst.map(|w| w.0),
+        deviation_frequency: worst.map(|w| w.1),
+        tolerance: *tolerance,
+    }
+}
+
 fn render(
     stored: &store::StoredHistory,
-    series: Option<&str>,
-    request: &SpectrumRequest,
+    (series, motion): (Option<&str>, Motion),
+    (mut request, defaults): (SpectrumRequest, Defaults),
+    results: Option<&str>,
     format: Format,
 ) -> Result<Vec<u8>, ApiError> {
     let history = store::decode(stored).map_err(|e| ApiError::Internal(e.to_string()))?;
@@ -282,18 +402,55 @@ fn render(
         .or_else(|| history.series.first().map(|(name, _)| name.clone()))
         .unwrap_or_default();
     let history = thinning::pick_series(history, Some(&name)).map_err(Problem::invalid_query)?;
-    let (name, displacement) = history
+    let (name, values) = history
         .series
         .into_iter()
         .next()
         .ok_or_else(|| Problem::invalid_query(format!("`{}` has no column", history.name)))?;
-    let record = acceleration_of_displacement(&history.time, &displacement).map_err(|e| {
+    let too_short = |e: String| {
         Problem::from_status(
             422,
             "Unprocessable Content",
             format!("`{}` column `{name}`: {e}", history.name),
         )
-    })?;
+    };
+    let (record, target) = match motion {
+        Motion::Displacement => (
+            acceleration_of_displacement(&history.time, &values).map_err(|e| too_short(e.to_string()))?,
+            None,
+        ),
+        Motion::Acceleration => {
+            if history.time.len() < 2 {
+                return Err(too_short("fewer than 2 samples".to_owned()).into());
+            }
+            let target = generated_target(results, &name);
+            if let Some((target, _)) = &target {
+                let (low, high) = target.band();
+                if defaults.damping {
+                    request.dampings = vec![target.damping];
+                }
+                if defaults.f_min {
+                    request.f_min = low;
+                }
+                if defaults.f_max {
+                    request.f_max = high;
+                }
+                if request.f_min >= request.f_max {
+                    return Err(Problem::invalid_query(format!(
+                        "the frequency grid needs f_min < f_max (got f_min {} Hz, f_max {} Hz; the target's band \
+                         is {low} to {high} Hz)",
+                        request.f_min, request.f_max
+                    ))
+                    .into());
+                }
+            }
+            let record = Table {
+                time: history.time.clone(),
+                values,
+            };
+            (record, target)
+        }
+    };
     let duration = record.time.last().unwrap_or(&0.0) - record.time.first().unwrap_or(&0.0);
     let frequencies = log_spaced(request.f_min, request.f_max, request.points);
     request.check_cost(&frequencies, record.time.len(), duration)?;
@@ -310,8 +467,18 @@ fn render(
             values: s.pseudo_acceleration,
         })
         .collect();
+    let target = target.map(|target| compare(&target, &frequencies, &spectra));
     if format == Format::Csv {
-        return Ok(spectra_csv(&frequencies, &spectra).into_bytes());
+        let mut series = spectra_columns(&spectra);
+        if let Some(values) = target.as_ref().and_then(|t| {
+            t.pseudo_acceleration
+                .iter()
+                .copied()
+                .collect::<Option<Vec<f64>>>()
+        }) {
+            series.push(("target".to_owned(), values));
+        }
+        return Ok(columns_csv("frequency", &frequencies, &series).into_bytes());
     }
     let document = HistoryResponseSpectrum {
         output: history.name,
@@ -322,6 +489,7 @@ fn render(
         peak_acceleration: record.values.iter().fold(0.0, |peak: f64, a| peak.max(a.abs())),
         frequencies,
         pseudo_acceleration: spectra,
+        target,
     };
     serde_json::to_vec(&document).map_err(|e| ApiError::Internal(e.to_string()))
 }

@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from typing import TYPE_CHECKING, Any, Optional, Union
+from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
 
 import pandas as pd
 
@@ -190,6 +190,42 @@ class Job:
             "GET", f"/jobs/{self.id}/results/{output}", params=params, headers={"Accept": "text/csv"}
         )
         return frames.history_frame(response.text, output=output, job_id=self.id)
+
+    def response_spectrum(
+        self,
+        output: str,
+        *,
+        series: Optional[str] = None,
+        damping: Union[float, Sequence[float], None] = None,
+        f_min: Optional[float] = None,
+        f_max: Optional[float] = None,
+        points: Optional[int] = None,
+    ) -> pd.DataFrame:
+        """Pseudo-acceleration response spectrum PSA(f, ξ) (m/s²) of one column of a
+        displacement history (``displacements``: the point's motion, relative to the pin
+        feet) or of the ``excitation`` (the accelerations the run was given), indexed by
+        ``frequency`` (Hz), one column per damping ratio (``psa_0.05``).
+
+        Of a synthetic earthquake's column the defaults are its target's damping and
+        band, and the frame gains ``target`` (the target spectrum, NaN outside its band)
+        with ``attrs["max_deviation"]``, ``attrs["deviation_frequency"]`` and
+        ``attrs["tolerance"]``: the stored record's spectrum against its target, computed
+        apart from the generator. ``attrs["peak_acceleration"]`` is the largest |a|."""
+        ratios = None if damping is None else ([damping] if isinstance(damping, (int, float)) else list(damping))
+        params = {"series": series, "damping": ratios, "f_min": f_min, "f_max": f_max, "points": points, "format": "json"}
+        document = self._client._transport.get_json(f"/jobs/{self.id}/results/{output}/response_spectrum", params=params)
+        frame = frames.spectrum_frame(document["frequencies"], document["pseudo_acceleration"])
+        frame.attrs["job"] = self.id
+        frame.attrs["output"] = document.get("output", output)
+        frame.attrs["series"] = document.get("series")
+        frame.attrs["peak_acceleration"] = document.get("peak_acceleration")
+        target = document.get("target")
+        if target is not None:
+            frame["target"] = [float("nan") if value is None else float(value) for value in target["pseudo_acceleration"]]
+            frame.attrs["units"]["target"] = "m/s²"
+            for key in ("max_deviation", "deviation_frequency", "tolerance"):
+                frame.attrs[key] = target.get(key)
+        return frame
 
     def histories(self, *, peaks: bool = True) -> dict[str, pd.DataFrame]:
         """Every history of the job (tables aside) by output name; without the
