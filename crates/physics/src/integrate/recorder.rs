@@ -76,7 +76,11 @@ pub(super) struct Recorder {
     output_curvatures: Vec<f64>,
     curvatures: Vec<Vec<Vec<f64>>>,
     curvature_envelope: Vec<CurvaturePeak>,
+    /// The square of each node's envelope curvature (the comparisons' operand).
+    envelope_squares: Vec<f64>,
     pin_curvatures: Vec<CurvaturePeak>,
+    /// Scratch: every line's deflection or curvature at every node, line after line.
+    node_columns: Vec<f64>,
     /// The height of every mesh node (m), as the decimal it stands for: computed once,
     /// not at every sample.
     node_heights: Vec<f64>,
@@ -148,6 +152,8 @@ impl Recorder {
                     ..CurvaturePeak::default()
                 })
                 .collect(),
+            envelope_squares: vec![0.0; node_heights.len()],
+            node_columns: vec![0.0; lines * node_heights.len()],
             node_heights,
             resultants: Resultants::new(layout),
             pin_curvatures: (0..layout.model.pins)
@@ -277,60 +283,74 @@ impl Recorder {
             });
         }
         let (lanes, stride, pins, lines) = (layout.lanes, layout.stride, layout.model.pins, layout.lines);
-        // The transport's curvature by a moving top support, per channel of the line.
-        let transport = |curvature: &[f64], at: usize, line: usize| match &state.wall {
-            Some(wall) if !curvature.is_empty() => {
-                curvature[at] * wall.transport()[usize::from(line >= pins)]
-            }
-            _ => 0.0,
-        };
-        let no_transport: &[f64] = &[];
+        // The transport's curvature by a moving top support (per output height or node),
+        // and the support's displacement per channel of the line (x, y): once a sample.
+        fn transport_of(curvature: &[f64], moving: Option<[f64; 2]>) -> Option<(&[f64], [f64; 2])> {
+            moving.filter(|_| !curvature.is_empty()).map(|by| (curvature, by))
+        }
+        let moving = state.wall.as_ref().map(|wall| wall.transport());
         let (output_transport, node_transport) = match &layout.walls {
             Some(walls) => (
-                walls.output_transport_curvature.as_slice(),
-                walls.node_transport_curvature.as_slice(),
+                transport_of(&walls.output_transport_curvature, moving),
+                transport_of(&walls.node_transport_curvature, moving),
             ),
-            None => (no_transport, no_transport),
+            None => (None, None),
         };
-        let value = |values: &[f64], level: usize, line: usize| {
+        let moved = |transport: Option<(&[f64], [f64; 2])>, at: usize, line: usize| {
+            transport.map_or(0.0, |(curvature, by)| {
+                curvature[at] * by[usize::from(line >= pins)]
+            })
+        };
+        // Level `level` of `line` in a block-of-lanes layout ([`LevelsOp`]).
+        let index = |level: usize, line: usize| {
             let (block, lane) = (level / lanes, level % lanes);
-            values[(block * stride + 1 + line) * lanes + lane]
+            (block * stride + 1 + line) * lanes + lane
         };
         for (h, per_line) in self.curvatures.iter_mut().enumerate() {
             for (line, history) in per_line.iter_mut().enumerate() {
-                history.push(value(&self.output_curvatures, h, line) + transport(output_transport, h, line));
+                history.push(self.output_curvatures[index(h, line)] + moved(output_transport, h, line));
             }
         }
-        for (node, envelope) in self.curvature_envelope.iter_mut().enumerate() {
-            for (pin, extreme) in self.pin_curvatures.iter_mut().enumerate() {
-                let along = |line: usize| {
-                    value(&self.node_curvatures, node, line) + transport(node_transport, node, line)
-                };
-                // Squares compared, one root for a new extreme: no hypot per node and pin.
-                let squared = match lines > pins {
-                    true => along(pin).powi(2) + along(pins + pin).powi(2),
-                    false => along(pin).powi(2),
-                };
-                if squared <= envelope.curvature.powi(2) && squared <= extreme.curvature.powi(2) {
-                    continue;
+        // Every line's curvature at every node, line after line, then each pin's (its
+        // resultant in the plane) node by node: squares compared, one root for a new
+        // extreme.
+        let nodes = self.curvature_envelope.len();
+        gather_columns(
+            &self.node_curvatures,
+            (lanes, stride),
+            lines,
+            &mut self.node_columns,
+        );
+        if let Some((curvature, by)) = node_transport {
+            add_transport(&mut self.node_columns, curvature, by, pins);
+        }
+        for (pin, extreme) in self.pin_curvatures.iter_mut().enumerate() {
+            let x = &self.node_columns[pin * nodes..(pin + 1) * nodes];
+            let y =
+                (lines > pins).then(|| &self.node_columns[(pins + pin) * nodes..(pins + pin + 1) * nodes]);
+            let mut largest = (extreme.curvature * extreme.curvature, None);
+            for node in 0..nodes {
+                let squared = x[node] * x[node] + y.map_or(0.0, |y| y[node] * y[node]);
+                if squared > largest.0 {
+                    largest = (squared, Some(node));
                 }
-                let curvature = squared.sqrt();
-                if curvature > envelope.curvature {
-                    *envelope = CurvaturePeak {
-                        curvature,
+                if squared > self.envelope_squares[node] {
+                    self.envelope_squares[node] = squared;
+                    self.curvature_envelope[node] = CurvaturePeak {
+                        curvature: squared.sqrt(),
                         pin,
                         time: t,
-                        ..*envelope
+                        ..self.curvature_envelope[node]
                     };
                 }
-                if curvature > extreme.curvature {
-                    *extreme = CurvaturePeak {
-                        curvature,
-                        height: envelope.height,
-                        pin,
-                        time: t,
-                    };
-                }
+            }
+            if let (squared, Some(node)) = largest {
+                *extreme = CurvaturePeak {
+                    curvature: squared.sqrt(),
+                    height: self.node_heights[node],
+                    pin,
+                    time: t,
+                };
             }
         }
     }
@@ -343,40 +363,58 @@ impl Recorder {
             q: &state.q,
             out: &mut self.node_deflections,
         });
-        let (lanes, stride, pins) = (layout.lanes, layout.stride, layout.model.pins);
+        let (lanes, stride, pins, lines) = (layout.lanes, layout.stride, layout.model.pins, layout.lines);
+        let nodes = self.node_heights.len();
+        gather_columns(
+            &self.node_deflections,
+            (lanes, stride),
+            lines,
+            &mut self.node_columns,
+        );
         // The transport by the top support, with walls that move (0 without).
-        let transport = |node: usize, line: usize| match (&layout.walls, &state.wall) {
-            (Some(walls), Some(wall)) if !walls.node_transport.is_empty() => {
-                walls.node_transport[node] * wall.transport()[usize::from(line >= pins)]
-            }
-            _ => 0.0,
-        };
-        for node in 0..=layout.model.basis.model().elements {
-            let (block, lane) = (node / lanes, node % lanes);
-            let w = |line: usize| {
-                self.node_deflections[(block * stride + 1 + line) * lanes + lane] + transport(node, line)
-            };
-            let height = self.node_heights[node];
-            for (p, extreme) in self.pin_extremes.iter_mut().enumerate() {
-                let w = w(p);
-                if w.abs() > extreme.max_abs_deflection {
-                    *extreme = PinExtreme {
-                        max_abs_deflection: w.abs(),
-                        height,
-                        time: t,
-                    };
+        if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall)
+            && !walls.node_transport.is_empty()
+        {
+            add_transport(
+                &mut self.node_columns,
+                &walls.node_transport,
+                wall.transport(),
+                pins,
+            );
+        }
+        let columns = &self.node_columns;
+        let column = |line: usize| &columns[line * nodes..(line + 1) * nodes];
+        for (line, extreme) in self.pin_extremes.iter_mut().enumerate() {
+            let mut largest = (extreme.max_abs_deflection, None);
+            for (node, w) in column(line).iter().enumerate() {
+                if w.abs() > largest.0 {
+                    largest = (w.abs(), Some(node));
                 }
             }
-            // In the plane, each pin's resultant √(wx² + wy²).
-            for (p, extreme) in self.resultant_extremes.iter_mut().enumerate() {
-                let squared = w(p).powi(2) + w(pins + p).powi(2);
-                if squared > extreme.max_abs_deflection.powi(2) {
-                    *extreme = PinExtreme {
-                        max_abs_deflection: squared.sqrt(),
-                        height,
-                        time: t,
-                    };
+            if let (max_abs_deflection, Some(node)) = largest {
+                *extreme = PinExtreme {
+                    max_abs_deflection,
+                    height: self.node_heights[node],
+                    time: t,
+                };
+            }
+        }
+        // In the plane, each pin's resultant √(wx² + wy²).
+        for (p, extreme) in self.resultant_extremes.iter_mut().enumerate() {
+            let (x, y) = (column(p), column(pins + p));
+            let mut largest = (extreme.max_abs_deflection.powi(2), None);
+            for node in 0..nodes {
+                let squared = x[node] * x[node] + y[node] * y[node];
+                if squared > largest.0 {
+                    largest = (squared, Some(node));
                 }
+            }
+            if let (squared, Some(node)) = largest {
+                *extreme = PinExtreme {
+                    max_abs_deflection: squared.sqrt(),
+                    height: self.node_heights[node],
+                    time: t,
+                };
             }
         }
     }
@@ -538,5 +576,30 @@ impl pulp::WithSimd for LevelsOp<'_> {
             S::as_mut_simd_f64s(self.out).0,
             layout.stride,
         );
+    }
+}
+
+/// Every line's values at the mesh nodes of a block-of-lanes layout ([`LevelsOp`]:
+/// level n of line l at `(n / lanes · stride + 1 + l) · lanes + n % lanes`), gathered
+/// line after line into `columns` (lines × nodes).
+fn gather_columns(values: &[f64], (lanes, stride): (usize, usize), lines: usize, columns: &mut [f64]) {
+    let nodes = columns.len() / lines.max(1);
+    for (line, column) in columns.chunks_mut(nodes.max(1)).enumerate().take(lines) {
+        for (block, chunk) in column.chunks_mut(lanes).enumerate() {
+            let at = (block * stride + 1 + line) * lanes;
+            chunk.copy_from_slice(&values[at..at + chunk.len()]);
+        }
+    }
+}
+
+/// Adds a moving top support's transport to gathered node columns: `shape` at every
+/// node times the support's displacement `by` along x (the first `pins` lines) or y.
+fn add_transport(columns: &mut [f64], shape: &[f64], by: [f64; 2], pins: usize) {
+    let nodes = shape.len();
+    for (line, column) in columns.chunks_mut(nodes.max(1)).enumerate() {
+        let factor = by[usize::from(line >= pins)];
+        for (value, s) in column.iter_mut().zip(shape) {
+            *value += s * factor;
+        }
     }
 }
