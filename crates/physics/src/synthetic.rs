@@ -36,6 +36,7 @@ mod baseline;
 mod envelope;
 mod fft;
 mod target;
+mod wavelets;
 
 pub use baseline::end_motion;
 pub use envelope::Envelope;
@@ -60,6 +61,11 @@ pub const CHECK_POINTS_PER_DECADE: f64 = 100.0;
 /// The iteration stops once the deviation is below this fraction of the tolerance (or
 /// after `max_iterations` rounds): a margin for the spectrum between check frequencies.
 const GOAL: f64 = 0.8;
+
+/// The Fourier rounds lower the record's largest excursions (step 6b) once its peak
+/// acceleration is more than this fraction of the tolerance above the target's value at
+/// its highest frequency.
+const PEAK_GATE: f64 = 0.4;
 
 /// What to generate.
 #[derive(Debug, Clone, PartialEq)]
@@ -280,11 +286,6 @@ impl SpectrumCompatible {
             let spectrum = pseudo_acceleration_uniform(&samples, step, &check, self.target.damping)
                 .map_err(|e| InputIssue::new("", format!("the generated record has no spectrum: {e}")))?
                 .pseudo_acceleration;
-            let ratios = wanted
-                .iter()
-                .zip(&spectrum)
-                .map(|(w, s)| if *s > 0.0 { w / s } else { 1.0 })
-                .collect();
             let (max_deviation, deviation_frequency) = spectrum
                 .iter()
                 .zip(&wanted)
@@ -298,19 +299,56 @@ impl SpectrumCompatible {
                 max_deviation,
                 deviation_frequency,
             };
-            Ok((record, ratios))
+            Ok((record, spectrum))
         };
 
-        let (mut best, mut ratios) = evaluate(synthesize(&amplitudes, &phases, size, &shape, step), 1)?;
+        let (mut best, mut spectrum) = evaluate(synthesize(&amplitudes, &phases, size, &shape, step), 1)?;
         let mut current = best.samples.clone();
+        // Rounds 2 … ⌊max/2⌋ + 1 are Fourier rounds; after them every other round is a
+        // wavelet round (step 7), beginning with one.
+        let last_fourier_round = self.max_iterations / 2 + 1;
         for round in 2..=self.max_iterations {
             if best.max_deviation <= GOAL * self.tolerance {
                 break;
             }
-            let next = reshape(&current, step, &shape, |f| interpolate_log(&check, &ratios, f));
+            let wavelet_round = if round > last_fourier_round && (round - last_fourier_round) % 2 == 1 {
+                wavelets::Matching {
+                    frequencies: &check,
+                    wanted: &wanted,
+                    spectrum: &spectrum,
+                    damping: self.target.damping,
+                    step,
+                    envelope: &shape,
+                }
+                .round(&current)
+            } else {
+                None
+            };
+            let next = match wavelet_round {
+                Some(mut next) => {
+                    baseline::correct(&mut next, step, &shape);
+                    next
+                }
+                None => {
+                    let ratios: Vec<f64> = wanted
+                        .iter()
+                        .zip(&spectrum)
+                        .map(|(w, s)| if *s > 0.0 { w / s } else { 1.0 })
+                        .collect();
+                    let mut next = reshape(&current, step, &shape, |f| interpolate_log(&check, &ratios, f));
+                    // Step 6b: the peak acceleration held to the target's top value.
+                    let zero_period = wanted[wanted.len() - 1];
+                    let peak = next.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+                    if peak > zero_period * (1.0 + PEAK_GATE * self.tolerance) {
+                        limit_excursions(&mut next, zero_period);
+                        baseline::correct(&mut next, step, &shape);
+                    }
+                    next
+                }
+            };
             current.clone_from(&next);
-            let (record, next_ratios) = evaluate(next, round)?;
-            ratios = next_ratios;
+            let (record, next_spectrum) = evaluate(next, round)?;
+            spectrum = next_spectrum;
             if record.max_deviation < best.max_deviation {
                 best = record;
             }
@@ -344,6 +382,30 @@ fn interpolate_log(at: &[f64], values: &[f64], f: f64) -> f64 {
     let upper = at.partition_point(|&g| g <= f);
     let weight = portable::ln(f / at[upper - 1]) / portable::ln(at[upper] / at[upper - 1]);
     values[upper - 1] + weight * (values[upper] - values[upper - 1])
+}
+
+/// Step 6b of the module doc: every excursion of `samples` (a run of samples of one
+/// sign, between zero crossings) that peaks above `level` scaled down to peak at it.
+fn limit_excursions(samples: &mut [f64], level: f64) {
+    let mut start = 0;
+    while start < samples.len() {
+        let positive = samples[start] > 0.0;
+        let negative = samples[start] < 0.0;
+        let end = start
+            + samples[start..]
+                .iter()
+                .position(|x| !((positive && *x > 0.0) || (negative && *x < 0.0)))
+                .unwrap_or(samples.len() - start)
+                .max(1);
+        let peak = samples[start..end].iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        if peak > level {
+            let scale = level / peak;
+            for x in &mut samples[start..end] {
+                *x *= scale;
+            }
+        }
+        start = end;
+    }
 }
 
 /// Step 4 of the module doc: the first `shape.len()` samples of the stationary signal
