@@ -88,7 +88,7 @@ pub fn log_spaced(low: f64, high: f64, count: usize) -> Vec<f64> {
 
 /// The exact step of the module doc for one oscillator and one step length.
 #[derive(Debug, Clone, Copy)]
-struct Step {
+pub(crate) struct Step {
     h: f64,
     omega_squared: f64,
     two_xi_omega: f64,
@@ -99,7 +99,7 @@ struct Step {
 }
 
 impl Step {
-    fn new(omega: f64, xi: f64, h: f64) -> Self {
+    pub(crate) fn new(omega: f64, xi: f64, h: f64) -> Self {
         let omega_d = omega * (1.0 - xi * xi).sqrt();
         let decay = portable::exp(-xi * omega * h);
         let (s, c) = portable::sin_cos(omega_d * h);
@@ -116,7 +116,7 @@ impl Step {
     }
 
     /// (u, u̇) after one step under the forcing f = −a going linearly from `f0` to `f1`.
-    fn advance(&self, u: f64, v: f64, f0: f64, f1: f64) -> (f64, f64) {
+    pub(crate) fn advance(&self, u: f64, v: f64, f0: f64, f1: f64) -> (f64, f64) {
         let beta = (f1 - f0) / (self.omega_squared * self.h);
         let alpha = (f0 - self.two_xi_omega * beta) / self.omega_squared;
         let (du, dv) = (u - alpha, v - beta);

@@ -118,7 +118,7 @@ fn a_seed_determines_every_bit() {
     );
 }
 
-const PINNED_CHECKSUM: u64 = 12_652_852_335_179_759_811;
+const PINNED_CHECKSUM: u64 = 5_894_428_964_103_173_744;
 
 #[test]
 fn bad_requests_name_their_field() {
@@ -189,5 +189,257 @@ fn an_unreachable_tolerance_is_refused_with_the_deviation_reached() {
         issues[0].reason.contains("after 1 rounds"),
         "{}",
         issues[0].reason
+    );
+}
+
+const G: f64 = 9.80665;
+
+/// US NRC RG 1.60, horizontal, 5 % damping, scaled to a PGA of 0.3 g: amplifications
+/// (Sa/PGA) 0.59 at 0.25 Hz, 3.13 at 2.5 Hz, 2.61 at 9 Hz, 1 at 33 Hz (the zero-period
+/// acceleration, flat above), straight between on log–log axes; from `lowest` Hz (the
+/// curve's value there).
+fn rg_1_60(lowest: f64) -> TargetSpectrum {
+    let pga = 0.3 * G;
+    let full = TargetSpectrum {
+        frequencies: vec![0.25, 2.5, 9.0, 33.0],
+        accelerations: vec![0.59 * pga, 3.13 * pga, 2.61 * pga, pga],
+        damping: 0.05,
+    };
+    TargetSpectrum {
+        frequencies: vec![lowest, 2.5, 9.0, 33.0],
+        accelerations: vec![full.at(lowest), 3.13 * pga, 2.61 * pga, pga],
+        damping: 0.05,
+    }
+}
+
+/// Eurocode 8 type 1 elastic spectrum, ground type C (S = 1.15, T_B = 0.2 s, T_C = 0.6 s,
+/// T_D = 2 s), a_g = 0.3 g, 5 % damping (η = 1), from 0.5 to 33 Hz: Se(T) as a function
+/// of the period, sampled at the corners 1/T_D, 1/T_C, 1/T_B and eight frequencies
+/// between 1/T_B and 33 Hz, where the rising branch a_g S (1 + 1.5 T/T_B) is curved on
+/// log–log axes (the plateau and the 1/T branch are straight: no points needed).
+fn eurocode_8_type_1_ground_c() -> TargetSpectrum {
+    let (ag, s, tb, tc, td) = (0.3 * G, 1.15, 0.2, 0.6, 2.0);
+    let se = |t: f64| {
+        if t <= tb {
+            ag * s * (1.0 + t / tb * 1.5)
+        } else if t <= tc {
+            2.5 * ag * s
+        } else if t <= td {
+            2.5 * ag * s * tc / t
+        } else {
+            2.5 * ag * s * tc * td / (t * t)
+        }
+    };
+    let frequencies = vec![
+        0.5,
+        1.0 / tc,
+        1.0 / tb,
+        6.0,
+        8.0,
+        10.0,
+        13.0,
+        17.0,
+        22.0,
+        27.0,
+        33.0,
+    ];
+    TargetSpectrum {
+        accelerations: frequencies.iter().map(|f| se(1.0 / f)).collect(),
+        frequencies,
+        damping: 0.05,
+    }
+}
+
+/// The issue's target through 0.5, 2, 8, 20 and 33 Hz: a plateau of 7.5 m/s² from 2 to
+/// 8 Hz, 3.9 m/s² at 33 Hz (a little above the peak ground acceleration a design
+/// spectrum would have there).
+fn issue_target() -> TargetSpectrum {
+    TargetSpectrum {
+        frequencies: vec![0.5, 2.0, 8.0, 20.0, 33.0],
+        accelerations: vec![3.0, 7.5, 7.5, 5.0, 3.9],
+        damping: 0.05,
+    }
+}
+
+/// Generates and checks one design-spectrum case against its specification: generated
+/// within the default tolerance and rounds; its spectrum recomputed independently from
+/// the table at 1000 frequencies per decade (the generator checks 100) within the
+/// tolerance over the band; at rest at both ends with velocity and displacement back to
+/// 0; a peak acceleration no more than the tolerance above the target's top value (a
+/// stiff oscillator follows the ground: its Sa is at least the PGA) and, when
+/// `zero_period` says the top value is the zero-period acceleration, no more than the
+/// tolerance below it either. Every problem is pushed to `failures`.
+fn check_design_case(
+    label: &str,
+    target: &TargetSpectrum,
+    (duration, strong_motion): (f64, f64),
+    seed: u64,
+    zero_period: bool,
+    failures: &mut Vec<String>,
+) {
+    let request = SpectrumCompatible {
+        target: target.clone(),
+        duration,
+        strong_motion,
+        ..request(seed)
+    };
+    let clock = std::time::Instant::now();
+    let record = match request.generate() {
+        Ok(record) => record,
+        Err(issues) => {
+            failures.push(format!(
+                "{label} {duration}/{strong_motion} s, seed {seed}: refused, {issues:?}"
+            ));
+            return;
+        }
+    };
+    let seconds = clock.elapsed().as_secs_f64();
+    let mut fail = |problem: String| {
+        failures.push(format!(
+            "{label} {duration}/{strong_motion} s, seed {seed}: {problem}"
+        ))
+    };
+    if record.iterations > DEFAULT_MAX_ITERATIONS {
+        fail(format!("{} rounds", record.iterations));
+    }
+    let (lowest, highest) = target.band();
+    let decades = (highest / lowest).log10();
+    let grid = log_spaced(lowest, highest, (1000.0 * decades).ceil() as usize + 1);
+    let spectrum =
+        pseudo_acceleration(&record.table(), &grid, target.damping).unwrap_or_else(|e| panic!("{e}"));
+    let (mut worst, mut worst_at) = (0.0_f64, lowest);
+    for (f, psa) in grid.iter().zip(&spectrum.pseudo_acceleration) {
+        let deviation = (psa / target.at(*f) - 1.0).abs();
+        if deviation > worst {
+            (worst, worst_at) = (deviation, *f);
+        }
+    }
+    if worst > DEFAULT_TOLERANCE {
+        fail(format!(
+            "PSA({worst_at:.3} Hz) off the target by {:.1} %",
+            100.0 * worst
+        ));
+    }
+    let (v, d) = end_motion(&record.samples, record.time_step);
+    let pga = record.samples.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    if !(v.abs() < 1e-9 * pga * duration && d.abs() < 1e-9 * pga * duration * duration) {
+        fail(format!("ends at {v:e} m/s, {d:e} m"));
+    }
+    if record.samples[0] != 0.0 || record.samples[record.samples.len() - 1] != 0.0 {
+        fail("does not start and end at 0".into());
+    }
+    let top = target.at(highest);
+    if pga > (1.0 + DEFAULT_TOLERANCE) * top || (zero_period && pga < (1.0 - DEFAULT_TOLERANCE) * top) {
+        fail(format!("PGA {pga:.3} m/s², the target's top value {top:.3}"));
+    }
+    eprintln!(
+        "{label} {duration}/{strong_motion} s, seed {seed}: generator {:.1} % at {:.2} Hz after {} rounds, \
+         independent {:.1} % at {worst_at:.2} Hz, PGA {:.3} of the top value, {seconds:.2} s",
+        100.0 * record.max_deviation,
+        record.deviation_frequency,
+        record.iterations,
+        100.0 * worst,
+        pga / top
+    );
+}
+
+// The issue's acceptance: design spectra to 33 Hz reach the default tolerance for every
+// seed, checked independently, in a realistic request (20 s, 10 s of strong motion) and
+// a shorter one (12 s, 6 s: RG 1.60 then starts at 0.5 Hz, two periods in the strong
+// motion). Not met yet: 10 of these 30 cases fail (2 refused at 10.1 and 11.3 %, 8 whose
+// spectrum between the generator's check frequencies, mostly below 2 Hz, is 10.0–13.0 %
+// off); run with --ignored --nocapture for the figures of each case.
+#[test]
+#[ignore = "not met yet: 10 of 30 cases (the low-frequency spectrum between check frequencies)"]
+fn design_spectra_up_to_33_hz_reach_the_tolerance_for_every_seed() {
+    let mut failures = Vec::new();
+    for (duration, strong_motion) in [(20.0, 10.0), (12.0, 6.0)] {
+        let lowest = if strong_motion >= 8.0 { 0.25 } else { 0.5 };
+        let cases = [
+            ("RG 1.60", rg_1_60(lowest), true),
+            ("EC8 type 1 C", eurocode_8_type_1_ground_c(), false),
+            ("issue target", issue_target(), false),
+        ];
+        for (label, target, zero_period) in &cases {
+            for seed in 1..=5 {
+                check_design_case(
+                    label,
+                    target,
+                    (duration, strong_motion),
+                    seed,
+                    *zero_period,
+                    &mut failures,
+                );
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+// The issue's cause, fixed: RG 1.60 ends at its zero-period acceleration at 33 Hz, where
+// a nearly rigid oscillator peaks with the record's PGA (41 % off with Fourier rounds
+// alone). The generator's closest record for each seed, its spectrum recomputed
+// independently at 1000 frequencies per decade, is within the tolerance from 9 Hz to
+// 33 Hz, its PGA within the tolerance of the zero-period acceleration, and it ends at
+// rest.
+#[test]
+fn rg_1_60_is_matched_at_its_zero_period_end_with_the_pga_it_implies() {
+    for (duration, strong_motion, lowest) in [(20.0, 10.0, 0.25), (12.0, 6.0, 0.5)] {
+        let target = rg_1_60(lowest);
+        for seed in 1..=5 {
+            let request = SpectrumCompatible {
+                target: target.clone(),
+                duration,
+                strong_motion,
+                ..request(seed)
+            };
+            let record = request.iterate().unwrap_or_else(|issue| panic!("{issue:?}"));
+            let grid = log_spaced(9.0, 33.0, (1000.0 * (33.0_f64 / 9.0).log10()).ceil() as usize + 1);
+            let spectrum =
+                pseudo_acceleration(&record.table(), &grid, 0.05).unwrap_or_else(|e| panic!("{e}"));
+            for (f, psa) in grid.iter().zip(&spectrum.pseudo_acceleration) {
+                let deviation = (psa / target.at(*f) - 1.0).abs();
+                assert!(
+                    deviation <= DEFAULT_TOLERANCE,
+                    "{duration} s, seed {seed}: PSA({f:.2} Hz) = {psa:.3} m/s², target {:.3} ({:.1} %)",
+                    target.at(*f),
+                    100.0 * deviation
+                );
+            }
+            let pga = record.samples.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            let zero_period = 0.3 * G;
+            assert!(
+                (pga / zero_period - 1.0).abs() <= DEFAULT_TOLERANCE,
+                "{duration} s, seed {seed}: PGA {pga:.3} m/s², zero-period acceleration {zero_period:.3}"
+            );
+            let (v, d) = end_motion(&record.samples, record.time_step);
+            assert!(
+                v.abs() < 1e-9 && d.abs() < 1e-9,
+                "{duration} s, seed {seed}: ends at {v:e} m/s, {d:e} m"
+            );
+            assert_eq!(record.samples[0], 0.0);
+            assert_eq!(record.samples[record.samples.len() - 1], 0.0);
+        }
+    }
+}
+
+// The longest record allowed (MAX_SAMPLES at the default 200 samples per second) through
+// every round: what the worst request costs. Run with --ignored.
+#[test]
+#[ignore]
+fn the_longest_request_costs_seconds() {
+    let request = SpectrumCompatible {
+        target: rg_1_60(0.25),
+        duration: 320.0,
+        strong_motion: 200.0,
+        tolerance: 0.01,
+        ..request(1)
+    };
+    let clock = std::time::Instant::now();
+    let issues = request.generate().err().unwrap_or_default();
+    eprintln!(
+        "{} samples, 40 rounds: {:.1} s, {issues:?}",
+        (320.0 / 0.005) as usize + 1,
+        clock.elapsed().as_secs_f64()
     );
 }

@@ -1,0 +1,374 @@
+//! Time-domain corrections with wavelets (Lilhanand & Tseng 1988; the tapered cosine
+//! wavelet of Al Atik & Abrahamson 2010, as in RspMatch) for what the Fourier rounds of
+//! [`super`] leave: a spectrum of a record a few periods long is jagged at its low
+//! frequencies (neighbouring oscillators 2 % apart peak at different times, 5–10 % apart
+//! in value), finer than a Fourier ratio on a record of that length can shape. A wavelet
+//! placed at an oscillator's peak moves that peak.
+//!
+//! # A round
+//! 1. Which frequencies: the check frequencies whose deviation |Sa/Sa_target − 1| is the
+//!    largest within a ratio [`NEIGHBOURHOOD`] on each side (the local extremes
+//!    of the deviation, small or large: one wavelet per bump, so that a bump already
+//!    within the tolerance is held there while its neighbours move).
+//! 2. For each, fᵢ: the oscillator's relative displacement uᵢ(t) over the record and one
+//!    period of the lowest check frequency after it, stepped exactly as
+//!    [`crate::response_spectrum`] does (linear between samples, sub-steps of at most a
+//!    1/64 period); its peak, signed, at tᵢ; the change it needs
+//!    Δᵢ = sign(uᵢ(tᵢ)) (Sa_target(fᵢ)/ωᵢ² − |uᵢ(tᵢ)|).
+//! 3. One wavelet per frequency, placed for its oscillator's peak at tⱼ (the lag Δtⱼ
+//!    puts its response at tⱼ in phase; it keeps building for about a period after):
+//!    wⱼ(t) = cos(ω'ⱼ τ) e^{−(τ/γⱼ)²}, τ = t − tⱼ + Δtⱼ, ω'ⱼ = ωⱼ √(1 − ξ²),
+//!    Δtⱼ = atan(√(1 − ξ²)/ξ)/ω'ⱼ, γⱼ = 1.178 fⱼ^−0.93 s, cut at |τ| > 4γⱼ and where the
+//!    envelope is 0 (the record's ends).
+//! 4. Cᵢⱼ = the response of oscillator i at tᵢ to wⱼ alone, from rest; solve C b = Δ
+//!    (Gaussian elimination, partial pivoting) and add [`RELAXATION`] × Σ bⱼ wⱼ (the
+//!    caller then corrects the baseline).
+//!
+//! Unconstrained neighbours move too (the wavelets are a few periods long, hence broad in
+//! frequency); the relaxation keeps a round from overshooting them, the next round sees
+//! them. Every operation is IEEE `+ − × ÷ √` or [`crate::portable`]'s.
+
+use crate::portable;
+use crate::response_spectrum::{STEPS_PER_PERIOD, Step};
+
+/// Fraction of the solved wavelet weights added in a round (1 would meet every selected
+/// peak exactly if nothing else moved).
+pub const RELAXATION: f64 = 0.5;
+
+/// A selected frequency has the largest deviation among the check frequencies within
+/// this ratio of it on either side (±7 %: three check frequencies at 100 per decade).
+pub const NEIGHBOURHOOD: f64 = 1.072;
+
+/// The wavelets are cut where their taper is below e^(−TAPER_CUT²) ≈ 1e-7.
+const TAPER_CUT: f64 = 4.0;
+
+/// One oscillator on the record's grid: its exact sub-step.
+struct Oscillator {
+    omega: f64,
+    substeps: usize,
+    step: Step,
+}
+
+/// A point of an oscillator's history: sample interval `interval` (from sample
+/// `interval` to `interval` + 1), sub-step `substep` (1-based) within it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Instant {
+    interval: usize,
+    substep: usize,
+}
+
+impl Oscillator {
+    fn new(frequency: f64, damping: f64, h: f64) -> Self {
+        let omega = std::f64::consts::TAU * frequency;
+        let substeps = (h * STEPS_PER_PERIOD * frequency).ceil().max(1.0) as usize;
+        Self {
+            omega,
+            substeps,
+            step: Step::new(omega, damping, h / substeps as f64),
+        }
+    }
+
+    /// Steps over `samples` (linear between them) from rest at sample `from`, calling
+    /// `visit` with the instant (intervals counted from sample 0) and u after every
+    /// sub-step, until it returns false.
+    fn run(&self, samples: &[f64], from: usize, mut visit: impl FnMut(Instant, f64) -> bool) {
+        let (mut u, mut v) = (0.0, 0.0);
+        for (k, pair) in samples.windows(2).enumerate().skip(from) {
+            let (a0, a1) = (pair[0], pair[1]);
+            let mut f0 = -a0;
+            for substep in 1..=self.substeps {
+                let f1 = if substep == self.substeps {
+                    -a1
+                } else {
+                    -(a0 + (a1 - a0) * substep as f64 / self.substeps as f64)
+                };
+                (u, v) = self.step.advance(u, v, f0, f1);
+                if !visit(Instant { interval: k, substep }, u) {
+                    return;
+                }
+                f0 = f1;
+            }
+        }
+    }
+
+    /// The largest |u| over `samples`, signed, and when.
+    fn peak(&self, samples: &[f64]) -> (Instant, f64) {
+        let mut peak = (
+            Instant {
+                interval: 0,
+                substep: 1,
+            },
+            0.0_f64,
+        );
+        self.run(samples, 0, |at, u| {
+            if u.abs() > peak.1.abs() {
+                peak = (at, u);
+            }
+            true
+        });
+        peak
+    }
+
+    /// u at `at` under `samples` alone, at rest before sample `from` (where they are 0).
+    fn response_at(&self, samples: &[f64], from: usize, at: Instant) -> f64 {
+        if at.interval < from {
+            return 0.0;
+        }
+        let mut value = 0.0;
+        self.run(samples, from, |now, u| {
+            if now == at {
+                value = u;
+                return false;
+            }
+            true
+        });
+        value
+    }
+}
+
+/// atan(y) for y ≥ 0 from `+ − × ÷ √` only: the argument halved three times
+/// (atan y = 2 atan(y / (1 + √(1 + y²)))), then the alternating series.
+fn atan(y: f64) -> f64 {
+    let mut x = y;
+    for _ in 0..3 {
+        x /= 1.0 + (1.0 + x * x).sqrt();
+    }
+    // |x| ≤ tan(π/16) < 0.2: 30 terms leave < 0.2⁶¹.
+    let (mut sum, mut power) = (0.0, x);
+    for k in 0..30 {
+        let term = power / (2 * k + 1) as f64;
+        sum += if k % 2 == 0 { term } else { -term };
+        power *= x * x;
+    }
+    8.0 * sum
+}
+
+/// Wavelet j of the module doc on `count` samples every `h`, for a peak of its oscillator
+/// at `peak_time`, 0 where `envelope` is 0 or beyond it: (first non-zero index, values
+/// from there).
+fn wavelet(
+    frequency: f64,
+    damping: f64,
+    peak_time: f64,
+    h: f64,
+    envelope: &[f64],
+    count: usize,
+) -> (usize, Vec<f64>) {
+    let root = (1.0 - damping * damping).sqrt();
+    let omega_d = std::f64::consts::TAU * frequency * root;
+    let lag = atan(root / damping) / omega_d;
+    let width = 1.178 * portable::powf(frequency, -0.93);
+    let centre = peak_time - lag;
+    let first = ((centre - TAPER_CUT * width) / h).ceil().max(0.0) as usize;
+    let last = (((centre + TAPER_CUT * width) / h).floor().max(0.0) as usize).min(count - 1);
+    let values = (first..=last.max(first))
+        .map(|k| {
+            let tau = k as f64 * h - centre;
+            if envelope.get(k).is_none_or(|e| *e <= 0.0) || tau.abs() > TAPER_CUT * width {
+                return 0.0;
+            }
+            let (_, cos) = portable::sin_cos(omega_d * tau);
+            cos * portable::exp(-(tau / width) * (tau / width))
+        })
+        .collect();
+    (first, values)
+}
+
+/// Solves `matrix` · x = `rhs` (n × n, row-major) by Gaussian elimination with partial
+/// pivoting; `None` if a pivot vanishes.
+fn solve(mut matrix: Vec<f64>, mut rhs: Vec<f64>) -> Option<Vec<f64>> {
+    let n = rhs.len();
+    let scale = matrix.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    for col in 0..n {
+        let pivot =
+            (col..n).max_by(|&a, &b| matrix[a * n + col].abs().total_cmp(&matrix[b * n + col].abs()))?;
+        let size = matrix[pivot * n + col].abs();
+        if size.is_nan() || size <= 1e-13 * scale {
+            return None;
+        }
+        if pivot != col {
+            for k in 0..n {
+                matrix.swap(col * n + k, pivot * n + k);
+            }
+            rhs.swap(col, pivot);
+        }
+        for row in col + 1..n {
+            let factor = matrix[row * n + col] / matrix[col * n + col];
+            if factor != 0.0 {
+                for k in col..n {
+                    matrix[row * n + k] -= factor * matrix[col * n + k];
+                }
+                rhs[row] -= factor * rhs[col];
+            }
+        }
+    }
+    let mut x = vec![0.0; n];
+    for row in (0..n).rev() {
+        let tail: f64 = (row + 1..n).map(|k| matrix[row * n + k] * x[k]).sum();
+        x[row] = (rhs[row] - tail) / matrix[row * n + row];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+/// Step 1 of the module doc: indices of the local extremes of |`deviation`| at the
+/// increasing `frequencies`, each the largest within a ratio [`NEIGHBOURHOOD`].
+fn select(frequencies: &[f64], deviation: &[f64]) -> Vec<usize> {
+    (0..deviation.len())
+        .filter(|&i| {
+            let here = deviation[i].abs();
+            let (low, high) = (frequencies[i] / NEIGHBOURHOOD, frequencies[i] * NEIGHBOURHOOD);
+            let from = frequencies.partition_point(|&f| f < low);
+            let to = frequencies.partition_point(|&f| f <= high);
+            here > 0.0 && deviation[from..to].iter().all(|d| d.abs() <= here)
+        })
+        .collect()
+}
+
+/// What a round works on.
+pub struct Matching<'a> {
+    /// The check frequencies (Hz), increasing.
+    pub frequencies: &'a [f64],
+    /// Sa_target at each (m/s²).
+    pub wanted: &'a [f64],
+    /// The record's Sa at each (m/s²).
+    pub spectrum: &'a [f64],
+    pub damping: f64,
+    /// Sampling interval (s).
+    pub step: f64,
+    /// The record's envelope: the wavelets are 0 where it is 0.
+    pub envelope: &'a [f64],
+}
+
+impl Matching<'_> {
+    /// `samples` after one round of the module doc (before the baseline correction), or
+    /// `None` when no frequency is selected or C is singular.
+    pub fn round(&self, samples: &[f64]) -> Option<Vec<f64>> {
+        let h = self.step;
+        let deviation: Vec<f64> = self
+            .spectrum
+            .iter()
+            .zip(self.wanted)
+            .map(|(s, w)| s / w - 1.0)
+            .collect();
+        let selected = select(self.frequencies, &deviation);
+        if selected.is_empty() {
+            return None;
+        }
+        let tail = (1.0 / (self.frequencies[0] * h)).ceil() as usize;
+        let mut record = samples.to_vec();
+        record.resize(samples.len() + tail, 0.0);
+        let oscillators: Vec<Oscillator> = selected
+            .iter()
+            .map(|&i| Oscillator::new(self.frequencies[i], self.damping, h))
+            .collect();
+        let mut peaks = Vec::with_capacity(selected.len());
+        let mut change = Vec::with_capacity(selected.len());
+        for (&i, oscillator) in selected.iter().zip(&oscillators) {
+            let (at, value) = oscillator.peak(&record);
+            let wanted = self.wanted[i] / (oscillator.omega * oscillator.omega);
+            peaks.push(at);
+            change.push(value.signum() * (wanted - value.abs()));
+        }
+        let wavelets: Vec<(usize, Vec<f64>)> = selected
+            .iter()
+            .zip(&oscillators)
+            .zip(&peaks)
+            .map(|((&i, oscillator), at)| {
+                let time = (at.interval as f64 + at.substep as f64 / oscillator.substeps as f64) * h;
+                wavelet(
+                    self.frequencies[i],
+                    self.damping,
+                    time,
+                    h,
+                    self.envelope,
+                    record.len(),
+                )
+            })
+            .collect();
+        let n = selected.len();
+        let mut matrix = vec![0.0; n * n];
+        let mut alone = vec![0.0; record.len()];
+        for (j, (first, values)) in wavelets.iter().enumerate() {
+            alone.fill(0.0);
+            alone[*first..*first + values.len()].copy_from_slice(values);
+            // At rest one sample before the wavelet's first (0 there: the step from it is
+            // the wavelet's linear rise).
+            let from = first.saturating_sub(1);
+            for (row, (oscillator, at)) in oscillators.iter().zip(&peaks).enumerate() {
+                matrix[row * n + j] = oscillator.response_at(&alone, from, *at);
+            }
+        }
+        let weights = solve(matrix, change)?;
+        let mut out = samples.to_vec();
+        for (weight, (first, values)) in weights.iter().zip(&wavelets) {
+            for (x, w) in out.iter_mut().skip(*first).zip(values) {
+                *x += RELAXATION * weight * w;
+            }
+        }
+        Some(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atan_from_square_roots_matches_the_library() {
+        for y in [0.0, 1e-3, 0.2, 1.0, 3.0, 19.97, 1e3] {
+            assert!((atan(y) - y.atan()).abs() < 1e-14, "atan({y}) = {}", atan(y));
+        }
+    }
+
+    #[test]
+    fn gaussian_elimination_solves_a_system_that_needs_pivoting() {
+        let x = solve(
+            vec![0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 3.0, 0.0, 1.0],
+            vec![5.0, 3.0, 4.0],
+        );
+        let x = x.unwrap_or_else(|| panic!("singular"));
+        for (got, want) in x.iter().zip([1.0, 2.0, 1.0]) {
+            assert!((got - want).abs() < 1e-14, "{x:?}");
+        }
+        assert_eq!(solve(vec![1.0, 2.0, 2.0, 4.0], vec![1.0, 2.0]), None);
+    }
+
+    // The local extremes of |deviation|, one per bump.
+    #[test]
+    fn one_frequency_per_bump_of_the_deviation() {
+        let deviation = [
+            0.0, 0.05, 0.12, 0.06, 0.0, 0.0, 0.0, 0.0, -0.03, -0.2, -0.1, 0.01, 0.08,
+        ];
+        // 100 per decade: three on each side are within the neighbourhood, four are not.
+        let frequencies: Vec<f64> = (0..deviation.len())
+            .map(|k| 10f64.powf(k as f64 / 100.0))
+            .collect();
+        assert_eq!(select(&frequencies, &deviation), [2, 9]);
+        assert!(select(&frequencies[..5], &[0.0; 5]).is_empty());
+    }
+
+    // A wavelet alone drives its own oscillator hard at the time it was placed for (the
+    // response keeps building for about a period after it: 0.79 of its peak there).
+    #[test]
+    fn a_wavelet_drives_its_oscillator_where_it_was_placed() {
+        let (h, xi) = (0.005, 0.05);
+        let count = 4001;
+        let envelope = vec![1.0; count];
+        for f in [0.5, 2.0, 10.0, 33.0] {
+            let (first, values) = wavelet(f, xi, 10.0, h, &envelope, count);
+            let mut samples = vec![0.0; count];
+            samples[first..first + values.len()].copy_from_slice(&values);
+            let oscillator = Oscillator::new(f, xi, h);
+            let (_, peak) = oscillator.peak(&samples);
+            let at = Instant {
+                interval: 2000 - 1,
+                substep: oscillator.substeps,
+            };
+            let there = oscillator.response_at(&samples, first.saturating_sub(1), at);
+            assert!(
+                there.abs() > 0.75 * peak.abs(),
+                "{f} Hz: u(10 s) = {there:e}, peak {peak:e}"
+            );
+        }
+    }
+}
