@@ -274,6 +274,10 @@ impl Simulation for BundleDynamics {
             file: "sdnl104c.json",
             body: include_str!("../../../examples/sdnl104c.json"),
         },
+        Example {
+            file: "sdnl301a.json",
+            body: include_str!("../../../examples/sdnl301a.json"),
+        },
     ];
     const HISTORIES: &'static [HistoryOutput] = &[
         HistoryOutput {
