@@ -114,13 +114,7 @@ fn closed_contact_terms(omega: &[f64], psi: &[f64], k: f64) -> Option<Vec<(f64, 
         .collect();
     parts.sort_by(|a, b| a.0.total_cmp(&b.0));
     let d0 = omega[0] * omega[0];
-    // The secular function and its derivative (positive: it increases between poles).
-    let secular = |mu: f64| {
-        parts.iter().fold((1.0, 0.0), |(f, df), &(d, p2)| {
-            let r = 1.0 / (d - mu);
-            (f + k * p2 * r, df + k * p2 * r * r)
-        })
-    };
+    let secular = |mu: f64| 1.0 + k * parts.iter().map(|&(d, p2)| p2 / (d - mu)).sum::<f64>();
     let total: f64 = parts.iter().map(|&(_, p2)| p2).sum();
     let mut terms = Vec::with_capacity(parts.len());
     for (j, &(d, _)) in parts.iter().enumerate() {
@@ -131,27 +125,18 @@ fn closed_contact_terms(omega: &[f64], psi: &[f64], k: f64) -> Option<Vec<(f64, 
             // Two modes at the same frequency: the root sits on it (no weight).
             continue;
         }
-        // Newton's steps kept inside the bracket, bisection where one would leave it:
-        // to full precision in a few passes over the terms instead of 64 halvings.
-        let mut mu = 0.5 * (lo + hi);
-        for _ in 0..128 {
-            let (f, df) = secular(mu);
-            if f < 0.0 {
-                lo = mu;
-            } else {
-                hi = mu;
-            }
-            let newton = mu - f / df;
-            let next = match newton > lo && newton < hi {
-                true => newton,
-                false => 0.5 * (lo + hi),
-            };
-            let settled = next == mu || (next - mu).abs() <= 2.0 * f64::EPSILON * mu.abs();
-            mu = next;
-            if settled || next <= lo || next >= hi {
+        for _ in 0..64 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
                 break;
             }
+            if secular(mid) < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
         }
+        let mu = 0.5 * (lo + hi);
         let norm2: f64 = parts.iter().map(|&(d, p2)| p2 / ((d - mu) * (d - mu))).sum();
         let c = 1.0 / (k * (mu - d0) * norm2);
         if mu > 0.0 && c.is_finite() {
