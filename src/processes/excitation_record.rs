@@ -175,6 +175,13 @@ pub fn column_description(name: &str, document: &serde_json::Value) -> String {
     }
 }
 
+/// The histories of a run but its `excitation`: what the model did, for tests that give
+/// the same motion by different members.
+#[cfg(test)]
+pub fn responses(histories: &[History]) -> Vec<&History> {
+    histories.iter().filter(|h| h.name != OUTPUT.name).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

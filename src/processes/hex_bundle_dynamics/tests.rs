@@ -181,7 +181,8 @@ fn a_direction_and_its_components_are_the_same_excitation() {
     );
     let split = run(&components);
     assert_eq!(along.document["contacts"], split.document["contacts"]);
-    assert_eq!(along.histories, split.histories);
+    let responses = crate::processes::excitation_record::responses;
+    assert_eq!(responses(&along.histories), responses(&split.histories));
 }
 
 #[test]
@@ -319,7 +320,9 @@ fn excitation_forms_are_exclusive() {
 fn the_impact_table_adds_up_to_every_contacts_impulse() {
     let output = run(&inputs());
     let doc = &output.document;
-    let table = output.histories.last().expect("the impacts table");
+    let table = (output.histories.iter())
+        .find(|h| h.name == "impacts")
+        .expect("the impacts table");
     let rows = crate::processes::impact_report::read_table(table)
         .expect("a table")
         .rows;
@@ -377,7 +380,8 @@ fn a_wrapper_given_the_feet_motion_moves_with_them() {
     );
     let moving = run(&along);
     assert_eq!(still.document["contacts"], moving.document["contacts"]);
-    assert_eq!(still.histories, moving.histories);
+    let responses = crate::processes::excitation_record::responses;
+    assert_eq!(responses(&still.histories), responses(&moving.histories));
 }
 
 /// A wrapper on its own motion changes the contacts (here the wrapper shaken across
