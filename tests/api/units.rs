@@ -128,7 +128,15 @@ async fn every_number_input_states_its_unit_and_every_history_its_kind() {
         for (name, output) in description["outputs"].as_object().unwrap() {
             let kind = output["kind"].as_str().unwrap_or_default();
             assert!(
-                ["displacement", "acceleration", "force", "moment", "peaks", "table"].contains(&kind),
+                [
+                    "displacement",
+                    "acceleration",
+                    "force",
+                    "moment",
+                    "peaks",
+                    "table"
+                ]
+                .contains(&kind),
                 "{process} output {name}: kind {kind:?}"
             );
         }
