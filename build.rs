@@ -62,6 +62,14 @@ fn main() {
     }
 }
 
+/// The package's directory, as cargo gives it to this run of the script: not `env!`,
+/// which would be the directory of whichever checkout compiled the script (cargo reuses
+/// one compiled script for every checkout of the same sources sharing a target
+/// directory, and a removed worktree then left every build without its commit).
+fn manifest_dir() -> PathBuf {
+    PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").unwrap_or_else(|| ".".into()))
+}
+
 /// Sets `CHOCMODAL_BUILD_COMMIT` for the compiler (see the module documentation).
 fn record_build_commit() {
     if let Some(commit) = std::env::var("CHOCMODAL_BUILD_COMMIT")
@@ -74,7 +82,7 @@ fn record_build_commit() {
     let git = |args: &[&str]| -> Option<String> {
         let output = std::process::Command::new("git")
             .args(args)
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .current_dir(manifest_dir())
             .output()
             .ok()?;
         let text = String::from_utf8(output.stdout).ok()?;
@@ -82,7 +90,7 @@ fn record_build_commit() {
     };
     // Only for the package's own checkout (not a parent repository it was unpacked in).
     let toplevel = git(&["rev-parse", "--show-toplevel"]).map(PathBuf::from);
-    let here = Path::new(env!("CARGO_MANIFEST_DIR")).canonicalize().ok();
+    let here = manifest_dir().canonicalize().ok();
     if toplevel.and_then(|t| t.canonicalize().ok()) != here || here.is_none() {
         return;
     }
@@ -107,7 +115,7 @@ fn record_build_commit() {
 /// file that exists is watched: cargo reruns a script whose watched file is missing on
 /// every build.
 fn watch(path: &str) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    let path = manifest_dir().join(path);
     if path.exists() {
         println!("cargo::rerun-if-changed={}", path.display());
     }
