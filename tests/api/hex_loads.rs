@@ -73,8 +73,8 @@ fn push() -> Value {
     json!({"height": 0.4, "time": [0.0, 0.01, 0.02, 0.03], "force": [0.0, 0.5, -0.2, 0.0]})
 }
 
-/// Runs a job to success; its results document and `displacements` history.
-async fn run(app: &TestApp, process: &str, inputs: Value) -> (Value, Value) {
+/// Runs a job to success; its id.
+async fn succeed(app: &TestApp, process: &str, inputs: Value) -> String {
     let response = app.post_execution(process, &json!({"inputs": inputs})).await;
     assert_eq!(response.status(), StatusCode::CREATED, "{process}");
     let id = response.json::<Value>().await.unwrap()["jobID"]
@@ -83,6 +83,12 @@ async fn run(app: &TestApp, process: &str, inputs: Value) -> (Value, Value) {
         .to_owned();
     let status = app.wait_until_finished(&id).await;
     assert_eq!(status["status"], "successful", "{status}");
+    id
+}
+
+/// Runs a job to success; its results document and `displacements` history.
+async fn run(app: &TestApp, process: &str, inputs: Value) -> (Value, Value) {
+    let id = succeed(app, process, inputs).await;
     (
         app.get_json(&format!("/jobs/{id}/results")).await,
         app.get_json(&format!("/jobs/{id}/results/displacements")).await,
@@ -344,16 +350,7 @@ async fn two_components_of_a_base_shock_move_the_pins_along_each_axis_as_the_row
     let along_y = json!({"type": "table", "time": times, "acceleration": values});
     let mut inputs = open_bundle();
     inputs["excitation"] = json!({"base_acceleration_x": along_x, "base_acceleration_y": along_y});
-    let response = app
-        .post_execution("hex-bundle-dynamics", &json!({"inputs": inputs}))
-        .await;
-    assert_eq!(response.status(), StatusCode::CREATED);
-    let id = response.json::<Value>().await.unwrap()["jobID"]
-        .as_str()
-        .unwrap()
-        .to_owned();
-    let status = app.wait_until_finished(&id).await;
-    assert_eq!(status["status"], "successful", "{status}");
+    let id = succeed(&app, "hex-bundle-dynamics", inputs).await;
     let history = app.get_json(&format!("/jobs/{id}/results/displacements")).await;
 
     for (axis, signal) in [("x", &along_x), ("y", &along_y)] {

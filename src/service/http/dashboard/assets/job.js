@@ -124,7 +124,7 @@ async function showResults(box, id, status) {
   } else {
     await generic(sections, id, results);
   }
-  replace(spectrumBox, await responseSpectrumCard(id, status.processID));
+  replace(spectrumBox, await responseSpectrumCard(id, status.processID, results));
 }
 
 function downloadsCard(id, results) {

@@ -85,13 +85,13 @@ function spectrumCaption(doc, kind) {
 /**
  * A job's response spectra: pick a displacement history (a pin, a height, numerical or
  * reference) or the excitation (a synthetic earthquake drawn against its target), its
- * column and damping ratios; null when the process has neither.
+ * column and damping ratios; null when the process has neither. `results`: the job's
+ * results document, which the page has already read (its `generated_records`).
  */
-export async function responseSpectrumCard(id, processID) {
+export async function responseSpectrumCard(id, processID, results) {
   const outputs = await spectrumOutputs(processID).catch(() => []);
   if (!outputs.length) return null;
-  const results = await api(`/jobs/${id}/results`).catch(() => ({}));
-  const generated = results.generated_records || [];
+  const generated = (results && results.generated_records) || [];
   const drawn = h('div');
   const output = h('select', {'aria-label': 'history', 'data-control': 'output', onchange: () => columns()},
     outputs.map(({name}) => h('option', {value: name}, name)));
