@@ -505,6 +505,22 @@ pub fn requested_threads(inputs: &serde_json::Value) -> usize {
         })
 }
 
+/// The threads a run of `inputs` can use: those it asks for where it shares its steps
+/// (`shares_steps`); otherwise at most two where its step check repeats the run (the run
+/// and the repetition compute at once), one with `check: "none"`.
+pub fn usable_threads(inputs: &serde_json::Value, shares_steps: bool) -> usize {
+    let asked = requested_threads(inputs);
+    let checked = inputs
+        .pointer("/solver/check")
+        .and_then(serde_json::Value::as_str)
+        != Some("none");
+    match (shares_steps, checked) {
+        (true, _) => asked,
+        (false, true) => asked.min(2),
+        (false, false) => 1,
+    }
+}
+
 /// Explicit integration settings (every process's `solver` block; each process states
 /// its own defaults for `time_step` and `duration`).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, ToSchema)]
@@ -540,11 +556,14 @@ pub struct SolverInput {
     #[serde(default)]
     #[schema(default = "auto")]
     pub check: CheckInput,
-    /// Threads (count, 1 to 64) the run may use: `hex-bundle-dynamics` shares each step
-    /// between them (its level deflections, closed contacts, and x and y modal updates);
-    /// the row processes' steps are too short to share and run on one. A worker grants
-    /// at most the cores it has free, so a run may get fewer. Results are the same, bit
-    /// for bit, whatever the count. It pays on cores nobody else uses.
+    /// Threads (count, 1 to 64) the run may use: with two or more, the run and its step
+    /// check's repetition compute at once (one thread for the repetition, the others for
+    /// the run); `hex-bundle-dynamics` also shares each step of the run between its
+    /// threads (level deflections, closed contacts, x and y modal updates), while the row
+    /// processes' steps are too short to share (they use two at most, none past one
+    /// with `check: "none"`). A worker grants at most the cores it has free, so a run may
+    /// get fewer. Results are the same, bit for bit, whatever the count. It pays on
+    /// cores nobody else uses.
     #[serde(default = "one_thread")]
     #[schema(default = 1, minimum = 1, maximum = 64)]
     pub threads: usize,

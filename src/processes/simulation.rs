@@ -87,7 +87,8 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
     /// The histories a run writes.
     const HISTORIES: &'static [HistoryOutput];
     /// Whether a run shares its steps between the threads `solver.threads` asks for
-    /// (a worker then grants it up to that many cores; otherwise one).
+    /// (a worker then grants it up to that many cores; otherwise two at most, for the run
+    /// and its check's repetition at once: [`super::common_inputs::usable_threads`]).
     const SHARES_STEPS: bool = false;
     /// Its shipped examples (`examples/`): the dashboard's templates, checked by the tests
     /// that go through every example.
@@ -174,11 +175,7 @@ impl<S: Simulation> Process for S {
     }
 
     fn threads(&self, inputs: &serde_json::Value) -> usize {
-        if S::SHARES_STEPS {
-            super::common_inputs::requested_threads(inputs)
-        } else {
-            1
-        }
+        super::common_inputs::usable_threads(inputs, S::SHARES_STEPS)
     }
 
     fn examples(&self) -> &'static [super::Example] {

@@ -110,14 +110,17 @@ fn bundle(threads: usize) -> Value {
     }})
 }
 
-/// The hex bundle on one and on two threads: the same results document (but for the
-/// links to its histories) and histories, byte for byte.
-#[tokio::test]
-async fn a_hex_bundle_gives_the_same_results_on_one_and_two_threads() {
-    let app = spawn_app_with_processes(vec![Arc::new(HexBundleDynamics)], |config| config.workers = 2).await;
+/// The results document of `process` run with `inputs` on one and on two threads (but
+/// for the links to its histories, its provenance and the check's wall time) and its
+/// contact forces, byte for byte.
+async fn on_one_and_two_threads(
+    app: &TestApp,
+    process: &str,
+    inputs: impl Fn(usize) -> Value,
+) -> Vec<(Value, String)> {
     let mut documents = Vec::new();
     for threads in [1, 2] {
-        let job = execute(&app, "hex-bundle-dynamics", &bundle(threads)).await;
+        let job = execute(app, process, &inputs(threads)).await;
         let status = app.wait_until_finished(&job).await;
         assert_eq!(status["status"], "successful", "{status}");
         let mut results = app.get_json(&format!("/jobs/{job}/results")).await;
@@ -125,6 +128,9 @@ async fn a_hex_bundle_gives_the_same_results_on_one_and_two_threads() {
         // hence their hash.
         results.as_object_mut().unwrap().remove("outputs");
         results.as_object_mut().unwrap().remove("provenance");
+        if let Some(check) = results.pointer_mut("/quality/step_halving") {
+            check["seconds"] = json!(0.0);
+        }
         let forces = app
             .get(&format!("/jobs/{job}/results/contact_forces"))
             .await
@@ -133,21 +139,67 @@ async fn a_hex_bundle_gives_the_same_results_on_one_and_two_threads() {
             .unwrap();
         documents.push((results, forces));
     }
-    let impacts = documents[0].0["impacts"].as_u64().unwrap();
-    assert!(impacts > 0, "the bundle rattles");
-    assert!(documents[0] == documents[1], "one and two threads differ");
+    assert!(
+        documents[0] == documents[1],
+        "{process}: one and two threads differ"
+    );
+    documents
 }
 
-/// Only the hex bundle shares its steps: a row process asking for threads is granted one
-/// core, not cores it would leave idle.
+/// The hex bundle on one and on two threads (its steps shared): the same results.
+#[tokio::test]
+async fn a_hex_bundle_gives_the_same_results_on_one_and_two_threads() {
+    let app = spawn_app_with_processes(vec![Arc::new(HexBundleDynamics)], |config| config.workers = 2).await;
+    let documents = on_one_and_two_threads(&app, "hex-bundle-dynamics", bundle).await;
+    let impacts = documents[0].0["impacts"].as_u64().unwrap();
+    assert!(impacts > 0, "the bundle rattles");
+}
+
+/// A row with its step check on one and on two threads (the run and the check's
+/// repetition at once): the same results, the same verdict.
+#[tokio::test]
+async fn a_checked_row_gives_the_same_results_on_one_and_two_threads() {
+    use chocmodal::processes::bundle_dynamics::BundleDynamics;
+    let app = spawn_app_with_processes(vec![Arc::new(BundleDynamics)], |config| config.workers = 2).await;
+    let row = |threads: usize| {
+        json!({"inputs": {
+            "pin": {"length": 1.0, "young_modulus": 2.1e11, "density": 7800.0,
+                    "section": {"type": "tube", "outer_diameter": 0.0097, "inner_diameter": 0.0085}},
+            "bundle": {"pins": 3, "levels": [1.0], "stiffness": 1e6, "damping": 20.0,
+                       "wall_gap": 1e-4, "pin_gap": 1e-4},
+            "excitation": {"base_acceleration": {"type": "half_sine", "amplitude": 50.0, "duration": 0.01}},
+            "solver": {"duration": 0.05, "threads": threads}
+        }})
+    };
+    let documents = on_one_and_two_threads(&app, "bundle-dynamics", row).await;
+    let results = &documents[0].0;
+    assert!(
+        results["impacts"].as_u64().unwrap() > 0,
+        "the row rattles: {results}"
+    );
+    assert!(
+        results["quality"]["step_halving"].is_object(),
+        "checked: {}",
+        results["quality"]
+    );
+}
+
+/// Only the hex bundle shares its steps: a row process asking for threads is granted two
+/// cores where its check repeats the run (the run and the repetition at once), one
+/// without a check: not cores it would leave idle.
 #[test]
-fn only_processes_that_share_their_steps_are_granted_threads() {
+fn processes_are_granted_the_threads_they_can_use() {
     use chocmodal::processes::Process;
     use chocmodal::processes::bundle_dynamics::BundleDynamics;
     use chocmodal::processes::cantilever_impact::CantileverImpact;
     let asking = |threads: u64| json!({"solver": {"threads": threads}});
     assert_eq!(HexBundleDynamics.threads(&asking(4)), 4);
     assert_eq!(HexBundleDynamics.threads(&json!({})), 1);
-    assert_eq!(BundleDynamics.threads(&asking(4)), 1);
-    assert_eq!(CantileverImpact.threads(&asking(4)), 1);
+    assert_eq!(BundleDynamics.threads(&asking(4)), 2);
+    assert_eq!(CantileverImpact.threads(&asking(4)), 2);
+    assert_eq!(BundleDynamics.threads(&json!({})), 1);
+    let unchecked = json!({"solver": {"threads": 4, "check": "none"}});
+    assert_eq!(BundleDynamics.threads(&unchecked), 1);
+    assert_eq!(CantileverImpact.threads(&unchecked), 1);
+    assert_eq!(HexBundleDynamics.threads(&unchecked), 4);
 }

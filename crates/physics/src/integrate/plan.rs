@@ -80,56 +80,114 @@ impl<'a> Plan<'a> {
         progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
     ) -> Result<Assessed, SimulationError> {
         let (model, settings, step) = (self.model, self.settings, &self.step);
+        // The check's first repetition: at 2Δt where it is valid (`auto`), else at Δt/2
+        // with the reason.
+        let first = match (
+            settings.check,
+            (settings.check == Check::Auto).then(|| step.doubled()),
+        ) {
+            (Check::None, _) => None,
+            (_, Some(Ok(twice))) => Some((quality::StepComparison::DoubleStep, twice, None)),
+            (check, doubled) => Some((
+                quality::StepComparison::HalfStep,
+                step.halved(),
+                Some(match (check, doubled) {
+                    (_, Some(Err(why))) => why,
+                    _ => "asked for (solver.check \"step_halving\")".to_owned(),
+                }),
+            )),
+        };
         // Shares of the progress: the run, then the check's repetitions (at 2Δt half the
-        // run's steps, at Δt/2 twice).
-        let doubled = match settings.check {
-            Check::Auto => Some(step.doubled()),
-            Check::StepHalving | Check::None => None,
+        // run's steps, at Δt/2 twice); a fallback to Δt/2 after 2Δt takes the last 20 %.
+        let (weight, first_ends) = match &first {
+            None => (0.0, 1.0),
+            Some((quality::StepComparison::DoubleStep, ..)) => (0.5, 0.8),
+            Some((quality::StepComparison::HalfStep, ..)) => (2.0, 1.0),
         };
-        let share = match (settings.check, &doubled) {
-            (Check::None, _) => 1.0,
-            (_, Some(Ok(_))) => 2.0 / 3.0,
-            _ => 1.0 / 3.0,
-        };
-        let simulation = stepper::integrate(arch, model, settings, step, &mut |f| progress(share * f))?;
-        let figures = quality::KeyFigures::of(&simulation);
-        let started = std::time::Instant::now();
+        let threads = settings.threads.clamp(1, rayon::current_num_threads().max(1));
         // A repeated run is only compared by its key figures, which the step tracks at
         // every step (peaks, impacts, wear): one sample at its last step keeps them whole
         // and records nothing else (no histories, envelopes or extremes per sample, which
         // cost as much as the step itself where every step is a sample).
-        let mut repeat = |at: &StepSize, (from, to): (f64, f64)| {
+        let repeat = |at: &StepSize, threads: usize, progress: &mut dyn FnMut(f64) -> ControlFlow<()>| {
             let settings = Settings {
                 output_interval: Some(at.steps(settings.duration) as f64 * at.time_step),
+                threads,
                 ..settings.clone()
             };
-            stepper::integrate(arch, model, &settings, at, &mut |f| {
-                progress(from + (to - from) * f)
-            })
+            let started = std::time::Instant::now();
+            stepper::integrate(arch, model, &settings, at, progress).map(|run| (run, started.elapsed()))
         };
-        let step_halving = match (settings.check, doubled) {
-            (Check::None, _) => None,
-            (_, Some(Ok(twice))) => {
-                let coarse = repeat(&twice, (share, 0.8))?;
-                let against_double = quality::compare(
+        let run = |threads: usize, progress: &mut dyn FnMut(f64) -> ControlFlow<()>| {
+            let settings = Settings {
+                threads,
+                ..settings.clone()
+            };
+            stepper::integrate(arch, model, &settings, step, progress)
+        };
+        let scale = |from: f64, to: f64, progress: &mut dyn FnMut(f64) -> ControlFlow<()>, f: f64| {
+            progress(from + (to - from) * f)
+        };
+        // The run and the check's first repetition are independent: given two threads or
+        // more, they run at once (the repetition on one thread, the run on the others),
+        // each computing exactly what it computes alone.
+        let (simulation, first_run) = match &first {
+            None => (run(threads, &mut |f| progress(f))?, None),
+            Some((comparison, at, _)) if threads >= 2 => {
+                let (simulation, repeated) = match comparison {
+                    // The longer run reports the progress: it runs here.
+                    quality::StepComparison::DoubleStep => at_once(
+                        [1.0, weight],
+                        &mut |f| scale(0.0, first_ends, progress, f),
+                        |p| run(threads - 1, p),
+                        |p| repeat(at, 1, p),
+                    )?,
+                    quality::StepComparison::HalfStep => {
+                        let (repeated, simulation) = at_once(
+                            [weight, 1.0],
+                            &mut |f| scale(0.0, first_ends, progress, f),
+                            |p| repeat(at, threads - 1, p),
+                            |p| run(1, p),
+                        )?;
+                        (simulation, repeated)
+                    }
+                };
+                (simulation, Some(repeated))
+            }
+            Some((_, at, _)) => {
+                let share = first_ends / (1.0 + weight);
+                let simulation = run(threads, &mut |f| scale(0.0, share, progress, f))?;
+                let repeated = repeat(at, threads, &mut |f| scale(share, first_ends, progress, f))?;
+                (simulation, Some(repeated))
+            }
+        };
+        let figures = quality::KeyFigures::of(&simulation);
+        let step_halving = match (first, first_run) {
+            (Some((comparison, at, why)), Some((repeated, took))) => {
+                let compared = quality::compare(
                     settings.scheme,
-                    (quality::StepComparison::DoubleStep, &twice),
+                    (comparison, &at),
                     figures,
-                    quality::KeyFigures::of(&coarse),
-                    (coarse.steps, simulation.steps, started.elapsed().as_secs_f64()),
+                    quality::KeyFigures::of(&repeated),
+                    (repeated.steps, simulation.steps, took.as_secs_f64()),
                 );
-                if against_double.proves(settings.scheme, settings.tolerance) {
-                    Some(against_double)
+                if comparison == quality::StepComparison::HalfStep {
+                    Some(quality::StepHalving {
+                        why_half_step: why,
+                        ..compared
+                    })
+                } else if compared.proves(settings.scheme, settings.tolerance) {
+                    Some(compared)
                 } else {
                     let half = step.halved();
-                    let fine = repeat(&half, (0.8, 1.0))?;
+                    let (fine, also) = repeat(&half, threads, &mut |f| scale(first_ends, 1.0, progress, f))?;
                     Some(quality::StepHalving {
                         why_half_step: Some(format!(
                             "the comparison with 2Δt did not prove the result (peak contact force \
                              change {:.2} %, peak deflection change {:.2} %, impact count change {:.2} %)",
-                            100.0 * against_double.peak_force_change,
-                            100.0 * against_double.peak_displacement_change,
-                            100.0 * against_double.impact_count_change
+                            100.0 * compared.peak_force_change,
+                            100.0 * compared.peak_displacement_change,
+                            100.0 * compared.impact_count_change
                         )),
                         ..quality::compare(
                             settings.scheme,
@@ -137,32 +195,15 @@ impl<'a> Plan<'a> {
                             figures,
                             quality::KeyFigures::of(&fine),
                             (
-                                coarse.steps + fine.steps,
+                                repeated.steps + fine.steps,
                                 simulation.steps,
-                                started.elapsed().as_secs_f64(),
+                                (took + also).as_secs_f64(),
                             ),
                         )
                     })
                 }
             }
-            (check, doubled) => {
-                let half = step.halved();
-                let fine = repeat(&half, (share, 1.0))?;
-                let why = match (check, doubled) {
-                    (_, Some(Err(why))) => why,
-                    _ => "asked for (solver.check \"step_halving\")".to_owned(),
-                };
-                Some(quality::StepHalving {
-                    why_half_step: Some(why),
-                    ..quality::compare(
-                        settings.scheme,
-                        (quality::StepComparison::HalfStep, &half),
-                        figures,
-                        quality::KeyFigures::of(&fine),
-                        (fine.steps, simulation.steps, started.elapsed().as_secs_f64()),
-                    )
-                })
-            }
+            _ => None,
         };
         let peaks: Vec<f64> = simulation
             .contact_statistics
@@ -216,6 +257,64 @@ impl<'a> Plan<'a> {
             settings,
             step,
         })
+    }
+}
+
+/// Progress reports of a run: `ControlFlow::Break` stops it.
+pub(super) type Progress<'p> = &'p mut dyn FnMut(f64) -> ControlFlow<()>;
+
+/// Two independent runs at once: `here` on this thread, `there` on another thread of the
+/// pool the caller runs in (or after `here` on this one, when no thread is free).
+/// `progress` hears, from this thread, the fractions of both weighted by `weights` (the
+/// other thread's through an atomic). A cancellation or an error of either stops the
+/// other at its next report; the first real error wins over the cancellation it caused.
+pub(super) fn at_once<A: Send, B: Send>(
+    weights: [f64; 2],
+    progress: Progress<'_>,
+    here: impl FnOnce(Progress<'_>) -> Result<A, SimulationError>,
+    there: impl FnOnce(Progress<'_>) -> Result<B, SimulationError> + Send,
+) -> Result<(A, B), SimulationError> {
+    use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+    let stop = AtomicBool::new(false);
+    let done_there = AtomicU64::new(0f64.to_bits());
+    let total = weights[0] + weights[1];
+    let mut from_there = None;
+    let from_here = rayon::in_place_scope(|scope| {
+        let (stop, done_there, from_there) = (&stop, &done_there, &mut from_there);
+        scope.spawn(move |_| {
+            let result = there(&mut |f| {
+                done_there.store(f.to_bits(), Ordering::Relaxed);
+                if stop.load(Ordering::Relaxed) {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            });
+            if result.is_err() {
+                stop.store(true, Ordering::Relaxed);
+            }
+            *from_there = Some(result);
+        });
+        let result = here(&mut |f| {
+            let other = f64::from_bits(done_there.load(Ordering::Relaxed));
+            if stop.load(Ordering::Relaxed) {
+                return ControlFlow::Break(());
+            }
+            let flow = progress((weights[0] * f + weights[1] * other) / total);
+            if flow.is_break() {
+                stop.store(true, Ordering::Relaxed);
+            }
+            flow
+        });
+        if result.is_err() {
+            stop.store(true, Ordering::Relaxed);
+        }
+        result
+    });
+    let from_there = from_there.expect("the scope waits for its spawned run");
+    match (from_here, from_there) {
+        (Ok(a), Ok(b)) => Ok((a, b)),
+        (Err(SimulationError::Cancelled), Err(error)) | (Err(error), _) | (_, Err(error)) => Err(error),
     }
 }
 

@@ -1,7 +1,8 @@
 //! Threads inside one run ([`Settings::threads`]): the plane's step shared by 2 or 3
 //! threads gives the run of one thread bit for bit (histories, statistics, impacts,
 //! wear, energy), with many contacts closed at once (several chunks of the contact
-//! pass), walls that move on their own and a point force.
+//! pass), walls that move on their own and a point force. Given two threads, the run
+//! and its step check run at once and give what they give one after the other.
 
 use std::ops::ControlFlow;
 
@@ -138,4 +139,134 @@ fn results_are_the_same_bit_for_bit_for_every_thread_count() {
             "{threads} threads in a pool of {pool} differ from one thread"
         );
     }
+}
+
+/// The run and its check's verdict with `settings`, in a pool of `pool` threads; the
+/// check's wall time (the only thing that may differ) set to zero.
+fn assess(model: &Model<'_>, settings: &Settings, pool: usize) -> Assessed {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(pool)
+        .build()
+        .expect("a thread pool");
+    let mut assessed = pool.install(|| {
+        Plan::new(model, settings)
+            .expect("a valid model")
+            .run(&mut |_| ControlFlow::Continue(()))
+            .expect("runs")
+    });
+    if let Some(check) = assessed.quality.step_halving.as_mut() {
+        check.seconds = 0.0;
+    }
+    assessed
+}
+
+#[test]
+fn a_run_and_its_check_at_once_give_what_they_give_one_after_the_other() {
+    let basis = ModalBasis::compute(&default_tube(20), 6).expect("valid beam");
+    let model = bundle(&basis);
+    for (check, compared_with) in [
+        (Check::Auto, quality::StepComparison::DoubleStep),
+        (Check::StepHalving, quality::StepComparison::HalfStep),
+    ] {
+        let settings = |threads| Settings {
+            check,
+            duration: 0.004,
+            ..settings(threads)
+        };
+        let one = assess(&model, &settings(1), 1);
+        let halving = one.quality.step_halving.as_ref().expect("a check ran");
+        assert_eq!(halving.compared_with, compared_with, "{check:?}");
+        for (threads, pool) in [(2, 2), (3, 3), (2, 1)] {
+            let shared = assess(&model, &settings(threads), pool);
+            assert!(
+                shared == one,
+                "{check:?}: {threads} threads in a pool of {pool} differ from one thread"
+            );
+        }
+    }
+}
+
+/// Each of two runs given to [`plan::at_once`] waits for the other to start: they can
+/// only both finish if they run at the same time.
+#[test]
+fn two_runs_at_once_run_on_two_threads_of_the_pool() {
+    use std::sync::mpsc;
+    use std::time::Duration;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .expect("a thread pool");
+    let wait = Duration::from_secs(60);
+    let (to_there, from_here) = mpsc::channel();
+    let (to_here, from_there) = mpsc::channel();
+    let (result, reported) = pool.install(move || {
+        let mut reported = Vec::new();
+        let result = plan::at_once(
+            [1.0, 3.0],
+            &mut |f| {
+                reported.push(f);
+                ControlFlow::Continue(())
+            },
+            |progress| {
+                to_there.send(()).expect("the other run listens");
+                from_there
+                    .recv_timeout(wait)
+                    .expect("the other run started while this one ran");
+                let _ = progress(1.0);
+                Ok("here")
+            },
+            move |progress| {
+                from_here
+                    .recv_timeout(wait)
+                    .expect("this run started while the other one ran");
+                let _ = progress(1.0);
+                to_here.send(()).expect("the other run listens");
+                Ok("there")
+            },
+        );
+        (result, reported)
+    });
+    assert_eq!(result, Ok(("here", "there")));
+    // Reported from here once, when the other run had reported its end.
+    assert_eq!(reported, vec![1.0]);
+}
+
+/// A cancellation stops both runs; an error of the other run stops this one and is the
+/// error reported.
+#[test]
+fn runs_at_once_stop_together() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .expect("a thread pool");
+    // Calls `progress` until it says stop (within a minute).
+    let until_stopped = |progress: plan::Progress<'_>| -> Result<(), SimulationError> {
+        let started = std::time::Instant::now();
+        while started.elapsed().as_secs() < 60 {
+            if progress(0.5).is_break() {
+                return Err(SimulationError::Cancelled);
+            }
+            std::thread::yield_now();
+        }
+        panic!("never told to stop");
+    };
+    let cancelled = pool.install(|| {
+        plan::at_once(
+            [1.0, 1.0],
+            &mut |_| ControlFlow::Break(()),
+            until_stopped,
+            until_stopped,
+        )
+    });
+    assert_eq!(cancelled, Err(SimulationError::Cancelled));
+    let failure = SimulationError::InvalidModel(vec![crate::InputIssue::new("pins", "none")]);
+    let failed = pool.install(|| {
+        plan::at_once(
+            [1.0, 1.0],
+            &mut |_| ControlFlow::Continue(()),
+            until_stopped,
+            |_| Err::<(), _>(failure.clone()),
+        )
+    });
+    assert_eq!(failed, Err(failure));
 }
