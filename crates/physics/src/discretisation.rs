@@ -394,25 +394,62 @@ pub fn assess(model: &Model<'_>, peaks: &[f64]) -> Result<BasisErrors, ModalErro
     } else {
         probe(model.basis.spec(), model.basis, &contacts)?
     };
-    let worst = |error: fn(&Probe) -> f64| {
-        probes.iter().max_by(|a, b| error(a).total_cmp(&error(b))).map_or(
-            ProbeError {
-                estimated_peak_force_error: 0.0,
-                height: None,
-                probed_stiffness: None,
-            },
-            |p| ProbeError {
-                estimated_peak_force_error: SAFETY_FACTOR * error(p),
-                height: Some(p.contact.height),
-                probed_stiffness: Some(p.contact.stiffness),
-            },
-        )
-    };
-    Ok(BasisErrors {
-        modal_truncation: worst(|p| p.basis_error),
-        mesh: worst(|p| p.mesh_error),
-        probed_contacts: probes.len(),
+    Ok(BasisErrors::of(&probes))
+}
+
+/// The probes of every contact of `model` that could push, computed before its run says
+/// which did (on a thread the run leaves free), when there are at most [`MAX_PROBES`]
+/// of them (then the run's probes are among them); `None` otherwise.
+pub fn prepare(model: &Model<'_>) -> Option<Result<Vec<Probe>, ModalError>> {
+    let mut contacts: Vec<ProbeContact> = Vec::new();
+    for contact in (0..model.contacts.len()).filter_map(|c| probe_contact(model, c)) {
+        if !contacts.contains(&contact) {
+            if contacts.len() == MAX_PROBES {
+                return None;
+            }
+            contacts.push(contact);
+        }
+    }
+    Some(if contacts.is_empty() {
+        Ok(Vec::new())
+    } else {
+        probe(model.basis.spec(), model.basis, &contacts)
     })
+}
+
+/// [`assess`] from the probes [`prepare`] computed: the same figures, bit for bit (each
+/// probe is computed alone, and they are taken in the order [`assess`] takes them).
+pub fn assess_prepared(model: &Model<'_>, peaks: &[f64], prepared: &[Probe]) -> BasisErrors {
+    let probes: Vec<Probe> = probe_contacts(model, peaks)
+        .iter()
+        .filter_map(|contact| prepared.iter().find(|p| p.contact == *contact).copied())
+        .collect();
+    BasisErrors::of(&probes)
+}
+
+impl BasisErrors {
+    /// The worst of `probes`, each estimate [`SAFETY_FACTOR`] times its probe's.
+    fn of(probes: &[Probe]) -> Self {
+        let worst = |error: fn(&Probe) -> f64| {
+            probes.iter().max_by(|a, b| error(a).total_cmp(&error(b))).map_or(
+                ProbeError {
+                    estimated_peak_force_error: 0.0,
+                    height: None,
+                    probed_stiffness: None,
+                },
+                |p| ProbeError {
+                    estimated_peak_force_error: SAFETY_FACTOR * error(p),
+                    height: Some(p.contact.height),
+                    probed_stiffness: Some(p.contact.stiffness),
+                },
+            )
+        };
+        Self {
+            modal_truncation: worst(|p| p.basis_error),
+            mesh: worst(|p| p.mesh_error),
+            probed_contacts: probes.len(),
+        }
+    }
 }
 
 fn relative(value: f64, reference: f64) -> f64 {

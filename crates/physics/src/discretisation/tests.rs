@@ -353,3 +353,88 @@ fn the_complete_basis_of_a_fine_mesh_keeps_its_lowest_modes() {
         assert!(first_impact_peak(&basis, contact(1.5, 3e6)).is_some());
     }
 }
+
+/// A row of 3 pins with contacts at 4 heights, pin to pin and pin to wall (each probed
+/// with its own spring: 2 Kc between pins, 3 Kc at the walls here): 8 distinct probes.
+fn row_model(basis: &ModalBasis) -> Model<'_> {
+    use crate::contact::{Body, Contact, Law};
+    let mut contacts = Vec::new();
+    for (level, height) in [0.4, 0.8, 1.2, 1.5].into_iter().enumerate() {
+        let stiffness = if level % 2 == 0 { 1e6 } else { 4e6 };
+        for (left, right) in [
+            (Body::Wall, Body::Pin(0)),
+            (Body::Pin(0), Body::Pin(1)),
+            (Body::Pin(1), Body::Pin(2)),
+            (Body::Pin(2), Body::Wall),
+        ] {
+            let stiffness = if matches!((left, right), (Body::Wall, _) | (_, Body::Wall)) {
+                3.0 * stiffness
+            } else {
+                stiffness
+            };
+            contacts.push(Contact {
+                left,
+                right,
+                height,
+                gap: 1e-4,
+                stiffness,
+                damping: 0.0,
+                law: Law::LINEAR,
+            });
+        }
+    }
+    Model {
+        basis,
+        pins: 3,
+        damping_ratios: vec![0.0; basis.modes()],
+        contacts,
+        initial_tip_displacements: vec![],
+        initial_tip_velocities: vec![],
+        base_acceleration: None,
+        point_forces: vec![],
+        plane: None,
+        walls: None,
+    }
+}
+
+// The probes computed before the run (of every contact that could push) give what the
+// run's own probes give, bit for bit, whichever contacts pushed; a model with more
+// distinct probes than a run probes is not prepared.
+#[test]
+fn probes_prepared_before_the_run_give_the_runs_own() {
+    let basis = ModalBasis::compute(&pin(20), 6).expect("valid beam");
+    let model = row_model(&basis);
+    let prepared = prepare(&model).expect("8 distinct probes").expect("probes");
+    assert_eq!(prepared.len(), 8);
+    let contacts = model.contacts.len();
+    for pushed in [vec![], vec![3], vec![0, 5, 6, 13], (0..contacts).collect()] {
+        // Distinct peaks, the contacts given first largest.
+        let peaks: Vec<f64> = (0..contacts)
+            .map(|c| match pushed.iter().position(|&p| p == c) {
+                Some(rank) => 100.0 - rank as f64,
+                None => 0.0,
+            })
+            .collect();
+        let own = assess(&model, &peaks).expect("probes");
+        assert_eq!(assess_prepared(&model, &peaks, &prepared), own, "{pushed:?}");
+        assert_eq!(own.probed_contacts, {
+            let mut distinct: Vec<ProbeContact> = Vec::new();
+            for &c in &pushed {
+                let probe = ProbeContact::of(&model.contacts[c], 1.5).expect("pushes");
+                if !distinct.contains(&probe) {
+                    distinct.push(probe);
+                }
+            }
+            distinct.len()
+        });
+    }
+    // More distinct probes than MAX_PROBES: the run's peaks choose them.
+    let mut crowded = model.clone();
+    crowded.contacts = (0..=MAX_PROBES)
+        .map(|k| crate::contact::Contact {
+            height: 0.3 + 0.04 * k as f64,
+            ..model.contacts[0]
+        })
+        .collect();
+    assert!(prepare(&crowded).is_none());
+}

@@ -130,35 +130,40 @@ impl<'a> Plan<'a> {
         };
         // The run and the check's first repetition are independent: given two threads or
         // more, they run at once (the repetition on one thread, the run on the others),
-        // each computing exactly what it computes alone.
-        let (simulation, first_run) = match &first {
-            None => (run(threads, &mut |f| progress(f))?, None),
+        // each computing exactly what it computes alone. The shorter of the two then
+        // computes the impact probes of every contact that could push, on its thread.
+        let (simulation, first_run, prepared) = match &first {
+            None => (run(threads, &mut |f| progress(f))?, None, None),
             Some((comparison, at, _)) if threads >= 2 => {
-                let (simulation, repeated) = match comparison {
+                let prepare = || crate::discretisation::prepare(model);
+                let (simulation, repeated, prepared) = match comparison {
                     // The longer run reports the progress: it runs here.
-                    quality::StepComparison::DoubleStep => at_once(
-                        [1.0, weight],
-                        &mut |f| scale(0.0, first_ends, progress, f),
-                        |p| run(threads - 1, p),
-                        |p| repeat(at, 1, p),
-                    )?,
+                    quality::StepComparison::DoubleStep => {
+                        let (simulation, (repeated, prepared)) = at_once(
+                            [1.0, weight],
+                            &mut |f| scale(0.0, first_ends, progress, f),
+                            |p| run(threads - 1, p),
+                            |p| Ok((repeat(at, 1, p)?, prepare())),
+                        )?;
+                        (simulation, repeated, prepared)
+                    }
                     quality::StepComparison::HalfStep => {
-                        let (repeated, simulation) = at_once(
+                        let (repeated, (simulation, prepared)) = at_once(
                             [weight, 1.0],
                             &mut |f| scale(0.0, first_ends, progress, f),
                             |p| repeat(at, threads - 1, p),
-                            |p| run(1, p),
+                            |p| Ok((run(1, p)?, prepare())),
                         )?;
-                        (simulation, repeated)
+                        (simulation, repeated, prepared)
                     }
                 };
-                (simulation, Some(repeated))
+                (simulation, Some(repeated), prepared)
             }
             Some((_, at, _)) => {
                 let share = first_ends / (1.0 + weight);
                 let simulation = run(threads, &mut |f| scale(0.0, share, progress, f))?;
                 let repeated = repeat(at, threads, &mut |f| scale(share, first_ends, progress, f))?;
-                (simulation, Some(repeated))
+                (simulation, Some(repeated), None)
             }
         };
         let figures = quality::KeyFigures::of(&simulation);
@@ -214,7 +219,13 @@ impl<'a> Plan<'a> {
         // A probe that cannot be computed (the complete basis of a mesh that neither form
         // of the eigenproblem solves) leaves the basis and the mesh unmeasured: the run
         // stands, its verdict cannot be `good`.
-        let basis = crate::discretisation::assess(model, &peaks).unwrap_or_else(|e| {
+        let basis = match prepared {
+            Some(Ok(probes)) => Ok(crate::discretisation::assess_prepared(model, &peaks, &probes)),
+            // Computed again from the run's peaks (an error where no contact pushed is
+            // none), or for the first time.
+            Some(Err(_)) | None => crate::discretisation::assess(model, &peaks),
+        };
+        let basis = basis.unwrap_or_else(|e| {
             findings.push(quality::Finding {
                 poor: false,
                 reason: format!(
