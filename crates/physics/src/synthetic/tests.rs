@@ -367,13 +367,13 @@ fn design_cases(strong_motion: f64) -> [(&'static str, TargetSpectrum, bool); 3]
 // The acceptance: design spectra to 33 Hz reach the default tolerance for every
 // seed, checked independently at 1000 frequencies per decade, in a realistic request
 // (20 s, 10 s of strong motion) and a shorter one (12 s, 6 s: RG 1.60 then starts at
-// 0.5 Hz, two periods in the strong motion). Not met yet: 3 of these 30 cases are refused
-// (20 s records, 10.1–11.3 % off below 0.7 Hz after their rounds); none is generated
+// 0.5 Hz, two periods in the strong motion). Not met yet: 2 of these 30 cases are refused
+// (20 s records, 10.3 and 10.7 % off below 0.75 Hz after 40 rounds); none is generated
 // further off than the tolerance. Run with
 // `cargo test -p chocmodal-physics --release synthetic -- --ignored --nocapture` for the
 // figures of each case.
 #[test]
-#[ignore = "not met yet: 3 of 30 cases refused (20 s records, below 0.7 Hz)"]
+#[ignore = "not met yet: 2 of 30 cases refused (20 s records, below 0.75 Hz)"]
 fn design_spectra_up_to_33_hz_reach_the_tolerance_for_every_seed() {
     let mut failures = Vec::new();
     for (duration, strong_motion) in [(20.0, 10.0), (12.0, 6.0)] {

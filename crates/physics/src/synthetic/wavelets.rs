@@ -22,8 +22,8 @@
 //!    Δtⱼ = atan(√(1 − ξ²)/ξ)/ω'ⱼ, γⱼ = 1.178 fⱼ^−0.93 s, cut at |τ| > 4γⱼ and where the
 //!    envelope is 0 (the record's ends).
 //! 4. Its weight as if it were alone: bⱼ = Δⱼ / Cⱼⱼ, Cⱼⱼ the response of oscillator j at
-//!    tⱼ to wⱼ alone, from rest; add [`RELAXATION`] × Σ bⱼ wⱼ (the caller then corrects
-//!    the baseline).
+//!    tⱼ to wⱼ alone, from rest; add r × Σ bⱼ wⱼ, r the caller's relaxation (at most
+//!    [`RELAXATION`]; the caller then corrects the baseline).
 //!
 //! The wavelets are a few periods long, hence broad in frequency: neighbours 7 % apart
 //! respond to each other's wavelets almost as much as to their own. Solving the coupled
@@ -37,11 +37,12 @@
 use crate::portable;
 use crate::response_spectrum::{STEPS_PER_PERIOD, Step};
 
-/// Fraction of the uncoupled wavelet weights added in a round (1 would meet every
-/// selected peak exactly if the other wavelets moved nothing there). Measured on the
-/// design spectra of the synthetic tests (30 cases, seeds 1–5, and seeds 6–10): 0.3
-/// left 2 + 2 of 60 over the tolerance, 0.5 left 5 + 3 (the rounds overshoot), 0.2
-/// left 2 + 1 at a larger cost.
+/// Largest fraction of the uncoupled wavelet weights added in a round (1 would meet
+/// every selected peak exactly if the other wavelets moved nothing there; the caller
+/// lowers it after a round that overshot). Measured at a fixed fraction on the design
+/// spectra of the synthetic tests (30 cases with seeds 1–5, 30 with seeds 6–10): 0.3
+/// left 2 + 2 of the 60 refused, 0.5 left 5 + 3 (the rounds overshoot), 0.2 left 2 + 1
+/// at a larger cost.
 pub const RELAXATION: f64 = 0.3;
 
 /// A selected frequency has the largest deviation among the grid's frequencies within
@@ -210,6 +211,8 @@ pub struct Matching<'a> {
     pub step: f64,
     /// The record's envelope: the wavelets are 0 where it is 0.
     pub envelope: &'a [f64],
+    /// Fraction r of the uncoupled weights added.
+    pub relaxation: f64,
 }
 
 impl Matching<'_> {
@@ -271,7 +274,7 @@ impl Matching<'_> {
             if response == 0.0 || !response.is_finite() {
                 continue;
             }
-            let weight = RELAXATION * change / response;
+            let weight = self.relaxation * change / response;
             for (x, w) in out.iter_mut().skip(*first).zip(values) {
                 *x += weight * w;
             }
