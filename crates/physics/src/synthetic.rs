@@ -52,10 +52,11 @@
 //!    verification grid has a local extreme (±7 % in frequency), each weighted as if
 //!    alone, a fraction of that added (0.3; halved after a round that left the deviation
 //!    larger, raised 1.5 times up to 0.3 after one that lowered it), baseline-corrected,
-//!    the peak held as in 6b; each round verified as in 7. They move an oscillator's peak where it is, which a Fourier ratio
-//!    cannot do finely enough at the low end of the band. They stop once the deviation
-//!    is within the tolerance or after `max_iterations` rounds in all; the record with
-//!    the smallest verified deviation is kept, and refused if it exceeds the tolerance.
+//!    the peak held as in 6b; each round verified as in 7. They move an oscillator's
+//!    peak where it is, which a Fourier ratio cannot do finely enough at the low end of
+//!    the band. They stop once the deviation is within the tolerance or after
+//!    `max_iterations` rounds in all; the record with the smallest verified deviation is
+//!    kept, and refused if it exceeds the tolerance.
 //!
 //! # What it reaches, what it costs
 //! Measured on 5 %-damped design spectra to 33 Hz (RG 1.60 at 0.3 g, Eurocode 8 type 1
