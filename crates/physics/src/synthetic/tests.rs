@@ -118,7 +118,7 @@ fn a_seed_determines_every_bit() {
     );
 }
 
-const PINNED_CHECKSUM: u64 = 5_894_428_964_103_173_744;
+const PINNED_CHECKSUM: u64 = 4_180_708_962_985_436_035;
 
 #[test]
 fn bad_requests_name_their_field() {
@@ -314,6 +314,14 @@ fn check_design_case(
             (worst, worst_at) = (deviation, *f);
         }
     }
+    // What the generator reports is measured on a grid that holds this one: never less.
+    if record.max_deviation < worst {
+        fail(format!(
+            "reports {:.2} %, {:.2} % found at {worst_at:.3} Hz",
+            100.0 * record.max_deviation,
+            100.0 * worst
+        ));
+    }
     if worst > DEFAULT_TOLERANCE {
         fail(format!(
             "PSA({worst_at:.3} Hz) off the target by {:.1} %",
@@ -343,24 +351,33 @@ fn check_design_case(
     );
 }
 
+/// The three design targets of the acceptance test for a record of `duration` s with
+/// `strong_motion` s of strong motion (RG 1.60 from 0.25 Hz when the strong motion holds
+/// two of its periods, from 0.5 Hz otherwise): (label, target, whether its top value is
+/// the zero-period acceleration).
+fn design_cases(strong_motion: f64) -> [(&'static str, TargetSpectrum, bool); 3] {
+    let lowest = if strong_motion >= 8.0 { 0.25 } else { 0.5 };
+    [
+        ("RG 1.60", rg_1_60(lowest), true),
+        ("EC8 type 1 C", eurocode_8_type_1_ground_c(), false),
+        ("issue target", issue_target(), false),
+    ]
+}
+
 // The issue's acceptance: design spectra to 33 Hz reach the default tolerance for every
-// seed, checked independently, in a realistic request (20 s, 10 s of strong motion) and
-// a shorter one (12 s, 6 s: RG 1.60 then starts at 0.5 Hz, two periods in the strong
-// motion). Not met yet: 10 of these 30 cases fail (2 refused at 10.1 and 11.3 %, 8 whose
-// spectrum between the generator's check frequencies, mostly below 2 Hz, is 10.0–13.0 %
-// off); run with --ignored --nocapture for the figures of each case.
+// seed, checked independently at 1000 frequencies per decade, in a realistic request
+// (20 s, 10 s of strong motion) and a shorter one (12 s, 6 s: RG 1.60 then starts at
+// 0.5 Hz, two periods in the strong motion). Not met yet: 2 of these 30 cases are refused
+// (20 s records, 10.3 and 10.7 % off below 0.75 Hz after 40 rounds); none is generated
+// further off than the tolerance. Run with
+// `cargo test -p chocmodal-physics --release synthetic -- --ignored --nocapture` for the
+// figures of each case.
 #[test]
-#[ignore = "not met yet: 10 of 30 cases (the low-frequency spectrum between check frequencies)"]
+#[ignore = "not met yet: 2 of 30 cases refused (20 s records, below 0.75 Hz)"]
 fn design_spectra_up_to_33_hz_reach_the_tolerance_for_every_seed() {
     let mut failures = Vec::new();
     for (duration, strong_motion) in [(20.0, 10.0), (12.0, 6.0)] {
-        let lowest = if strong_motion >= 8.0 { 0.25 } else { 0.5 };
-        let cases = [
-            ("RG 1.60", rg_1_60(lowest), true),
-            ("EC8 type 1 C", eurocode_8_type_1_ground_c(), false),
-            ("issue target", issue_target(), false),
-        ];
-        for (label, target, zero_period) in &cases {
+        for (label, target, zero_period) in &design_cases(strong_motion) {
             for seed in 1..=5 {
                 check_design_case(
                     label,
@@ -372,6 +389,18 @@ fn design_spectra_up_to_33_hz_reach_the_tolerance_for_every_seed() {
                 );
             }
         }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+// The part of the acceptance test above that is met and runs by default: seed 1 of each
+// target in the short request (12 s, 6 s), whose low end holds the fewest cycles. Each of
+// the three needs wavelet rounds after its verification (22–26 rounds in all, measured).
+#[test]
+fn design_spectra_reach_the_tolerance_checked_at_1000_frequencies_per_decade() {
+    let mut failures = Vec::new();
+    for (label, target, zero_period) in &design_cases(6.0) {
+        check_design_case(label, target, (12.0, 6.0), 1, *zero_period, &mut failures);
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
@@ -393,7 +422,7 @@ fn rg_1_60_is_matched_at_its_zero_period_end_with_the_pga_it_implies() {
                 strong_motion,
                 ..request(seed)
             };
-            let record = request.iterate().unwrap_or_else(|issue| panic!("{issue:?}"));
+            let (record, _) = request.iterate().unwrap_or_else(|issue| panic!("{issue:?}"));
             let grid = log_spaced(9.0, 33.0, (1000.0 * (33.0_f64 / 9.0).log10()).ceil() as usize + 1);
             let spectrum =
                 pseudo_acceleration(&record.table(), &grid, 0.05).unwrap_or_else(|e| panic!("{e}"));
@@ -424,22 +453,27 @@ fn rg_1_60_is_matched_at_its_zero_period_end_with_the_pga_it_implies() {
 }
 
 // The longest record allowed (MAX_SAMPLES at the default 200 samples per second) through
-// every round: what the worst request costs. Run with --ignored.
+// every round: what the worst request costs. Run with --release --ignored --nocapture.
 #[test]
-#[ignore]
+#[ignore = "a minute or more: a cost measurement, not a check"]
 fn the_longest_request_costs_seconds() {
-    let request = SpectrumCompatible {
-        target: rg_1_60(0.25),
-        duration: 320.0,
-        strong_motion: 200.0,
-        tolerance: 0.01,
-        ..request(1)
-    };
-    let clock = std::time::Instant::now();
-    let issues = request.generate().err().unwrap_or_default();
-    eprintln!(
-        "{} samples, 40 rounds: {:.1} s, {issues:?}",
-        (320.0 / 0.005) as usize + 1,
-        clock.elapsed().as_secs_f64()
-    );
+    // A 1 % tolerance: the closest Fourier round is verified at several times it and
+    // refused without wavelet rounds. A 4 % tolerance: verified within twice it, so
+    // wavelet rounds on the dense grid run through round 40 (the costliest path).
+    for tolerance in [0.01, 0.04] {
+        let request = SpectrumCompatible {
+            target: rg_1_60(0.25),
+            duration: 320.0,
+            strong_motion: 200.0,
+            tolerance,
+            ..request(1)
+        };
+        let clock = std::time::Instant::now();
+        let issues = request.generate().err().unwrap_or_default();
+        eprintln!(
+            "{} samples, tolerance {tolerance}: {:.1} s, {issues:?}",
+            (320.0 / 0.005) as usize + 1,
+            clock.elapsed().as_secs_f64()
+        );
+    }
 }
