@@ -86,10 +86,14 @@ pub trait Simulation: Send + Sync + std::fmt::Debug + 'static {
     const DESCRIPTION: &'static str;
     /// The histories a run writes.
     const HISTORIES: &'static [HistoryOutput];
-    /// Whether a run shares its steps between the threads `solver.threads` asks for
-    /// (a worker then grants it up to that many cores; otherwise two at most, for the run
-    /// and its check's repetition at once: [`super::common_inputs::usable_threads`]).
-    const SHARES_STEPS: bool = false;
+    /// Whether a run of `inputs` shares its steps between the threads `solver.threads`
+    /// asks for, where that pays (a worker then grants it up to that many cores;
+    /// otherwise two at most, for the run and its check's repetition at once:
+    /// [`super::common_inputs::usable_threads`]).
+    fn shares_steps(inputs: &serde_json::Value) -> bool {
+        let _ = inputs;
+        false
+    }
     /// Its shipped examples (`examples/`): the dashboard's templates, checked by the tests
     /// that go through every example.
     const EXAMPLES: &'static [super::Example] = &[];
@@ -175,7 +179,7 @@ impl<S: Simulation> Process for S {
     }
 
     fn threads(&self, inputs: &serde_json::Value) -> usize {
-        super::common_inputs::usable_threads(inputs, S::SHARES_STEPS)
+        super::common_inputs::usable_threads(inputs, S::shares_steps(inputs))
     }
 
     fn examples(&self) -> &'static [super::Example] {

@@ -93,13 +93,14 @@ async fn a_run_gets_only_the_free_cores(backend: Backend) {
     );
 }
 
-/// A 19-pin bundle rattling against its neighbours and the wrapper.
+/// A 61-pin bundle rattling against its neighbours and the wrapper: 2 196 modal DOFs,
+/// enough to share its steps.
 fn bundle(threads: usize) -> Value {
     json!({"inputs": {
         "pin": {"length": 0.6, "young_modulus": 2.1e11, "density": 7800.0,
                 "section": {"type": "tube", "outer_diameter": 0.0097, "inner_diameter": 0.0085},
-                "added_mass_per_length": 0.6, "elements": 24, "modes": 4, "static_correction": "none"},
-        "bundle": {"rings": 2, "pitch": 0.0107, "wire_diameter": 0.001, "wire_lead": 0.15,
+                "added_mass_per_length": 0.6, "elements": 24, "modes": 18, "static_correction": "none"},
+        "bundle": {"rings": 4, "pitch": 0.0107, "wire_diameter": 0.001, "wire_lead": 0.15,
                    "wrapper_flat_to_flat": 0.0492},
         "contact": {"stiffness": 2e6, "damping": 20.0},
         "gaps": {"type": "uniform", "pin_pin": 1e-5, "pin_wall": 2e-5},
@@ -184,16 +185,25 @@ async fn a_checked_row_gives_the_same_results_on_one_and_two_threads() {
     );
 }
 
-/// Only the hex bundle shares its steps: a row process asking for threads is granted two
-/// cores where its check repeats the run (the run and the repetition at once), one
-/// without a check: not cores it would leave idle.
+/// Only large hex bundles share their steps: a row process or a small bundle asking for
+/// threads is granted two cores where its check repeats the run (the run and the
+/// repetition at once), one without a check: not cores it would leave idle.
 #[test]
 fn processes_are_granted_the_threads_they_can_use() {
     use chocmodal::processes::Process;
     use chocmodal::processes::bundle_dynamics::BundleDynamics;
     use chocmodal::processes::cantilever_impact::CantileverImpact;
     let asking = |threads: u64| json!({"solver": {"threads": threads}});
-    assert_eq!(HexBundleDynamics.threads(&asking(4)), 4);
+    let hex = |rings: u64, check: &str| json!({"bundle": {"rings": rings}, "pin": {"modes": 10}, "solver": {"threads": 4, "check": check}});
+    // 217 pins of 10 modes: 4 340 modal DOFs, shared; 19 pins: 380, too few.
+    assert_eq!(HexBundleDynamics.threads(&hex(8, "auto")), 4);
+    assert_eq!(HexBundleDynamics.threads(&hex(8, "none")), 4);
+    assert_eq!(HexBundleDynamics.threads(&hex(2, "auto")), 2);
+    assert_eq!(HexBundleDynamics.threads(&hex(2, "none")), 1);
+    assert!(
+        HexBundleDynamics.threads(&bundle(4)["inputs"]) == 4,
+        "the shared test bundle"
+    );
     assert_eq!(HexBundleDynamics.threads(&json!({})), 1);
     assert_eq!(BundleDynamics.threads(&asking(4)), 2);
     assert_eq!(CantileverImpact.threads(&asking(4)), 2);
@@ -201,5 +211,4 @@ fn processes_are_granted_the_threads_they_can_use() {
     let unchecked = json!({"solver": {"threads": 4, "check": "none"}});
     assert_eq!(BundleDynamics.threads(&unchecked), 1);
     assert_eq!(CantileverImpact.threads(&unchecked), 1);
-    assert_eq!(HexBundleDynamics.threads(&unchecked), 4);
 }

@@ -38,6 +38,13 @@ use crate::physics::{InputIssue, require_non_negative};
 use inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
 use loads::PlaneLoads;
 
+/// The fewest modal DOFs whose step is worth sharing between threads: on the 2-core
+/// machine two threads ran a 19-pin bundle's steps (760 DOFs) no faster than one, a
+/// 61-pin bundle's (2 440) 1.12× faster, a 217-pin bundle's (8 680) 1.17× faster
+/// (`scripts/threads-bench.py`, `check: "none"`, 2026-11-26). Smaller bundles are
+/// granted threads only for their step check, as the rows.
+pub const MIN_SHARED_STEP_DOFS: u64 = 2000;
+
 /// Default history interval (s).
 pub const DEFAULT_OUTPUT_INTERVAL: f64 = 1e-4;
 
@@ -311,7 +318,22 @@ impl Simulation for HexBundleDynamics {
         impact_report::TABLE_OUTPUT,
         excitation_record::OUTPUT,
     ];
-    const SHARES_STEPS: bool = true;
+
+    /// Bundles of at least [`MIN_SHARED_STEP_DOFS`] modal DOFs (two lines of `modes`
+    /// per pin, the static correction's pseudo-modes aside; `auto` counts as enough).
+    fn shares_steps(inputs: &serde_json::Value) -> bool {
+        let rings = inputs
+            .pointer("/bundle/rings")
+            .and_then(serde_json::Value::as_u64)
+            .unwrap_or(0);
+        let modes = match inputs.pointer("/pin/modes") {
+            None => 10,
+            Some(serde_json::Value::String(_)) => MIN_SHARED_STEP_DOFS,
+            Some(modes) => modes.as_u64().unwrap_or(0),
+        };
+        let pins = 3 * rings * (rings + 1) + 1;
+        (2 * pins).saturating_mul(modes) >= MIN_SHARED_STEP_DOFS
+    }
 
     type Inputs = HexInputs;
     type Results = HexResults;
