@@ -101,7 +101,7 @@ fn bundle(threads: usize) -> Value {
                 "section": {"type": "tube", "outer_diameter": 0.0097, "inner_diameter": 0.0085},
                 "added_mass_per_length": 0.6, "elements": 24, "modes": 18, "static_correction": "none"},
         "bundle": {"rings": 4, "pitch": 0.0107, "wire_diameter": 0.001, "wire_lead": 0.15,
-                   "wrapper_flat_to_flat": 0.0492},
+                   "wrapper_flat_to_flat": 0.0868},
         "contact": {"stiffness": 2e6, "damping": 20.0},
         "gaps": {"type": "uniform", "pin_pin": 1e-5, "pin_wall": 2e-5},
         "excitation": {"base_acceleration": {"type": "half_sine", "amplitude": 80.0, "duration": 0.01},
