@@ -373,16 +373,23 @@ pub fn probe_contacts(model: &Model<'_>, peaks: &[f64]) -> Vec<ProbeContact> {
         .collect();
     // The largest peaks first; each distinct probe once, at most MAX_PROBES of them.
     candidates.sort_by(|a, b| b.0.total_cmp(&a.0));
-    let mut contacts: Vec<ProbeContact> = Vec::new();
-    for (_, contact) in candidates {
-        if contacts.len() == MAX_PROBES {
+    let mut contacts = distinct(candidates.into_iter().map(|(_, contact)| contact));
+    contacts.truncate(MAX_PROBES);
+    contacts
+}
+
+/// Each probe of `contacts` once, in their order, up to one more than [`MAX_PROBES`].
+fn distinct(contacts: impl Iterator<Item = ProbeContact>) -> Vec<ProbeContact> {
+    let mut kept: Vec<ProbeContact> = Vec::new();
+    for contact in contacts {
+        if kept.len() > MAX_PROBES {
             break;
         }
-        if !contacts.contains(&contact) {
-            contacts.push(contact);
+        if !kept.contains(&contact) {
+            kept.push(contact);
         }
     }
-    contacts
+    kept
 }
 
 /// The probes of `model`'s basis and mesh at the contacts that pushed in the run
@@ -401,14 +408,9 @@ pub fn assess(model: &Model<'_>, peaks: &[f64]) -> Result<BasisErrors, ModalErro
 /// which did (on a thread the run leaves free), when there are at most [`MAX_PROBES`]
 /// of them (then the run's probes are among them); `None` otherwise.
 pub fn prepare(model: &Model<'_>) -> Option<Result<Vec<Probe>, ModalError>> {
-    let mut contacts: Vec<ProbeContact> = Vec::new();
-    for contact in (0..model.contacts.len()).filter_map(|c| probe_contact(model, c)) {
-        if !contacts.contains(&contact) {
-            if contacts.len() == MAX_PROBES {
-                return None;
-            }
-            contacts.push(contact);
-        }
+    let contacts = distinct((0..model.contacts.len()).filter_map(|c| probe_contact(model, c)));
+    if contacts.len() > MAX_PROBES {
+        return None;
     }
     Some(if contacts.is_empty() {
         Ok(Vec::new())

@@ -442,9 +442,11 @@ pub struct Settings {
     pub recorded_contacts: Option<Vec<usize>>,
     /// How impacts are counted, summarised and tabulated.
     pub impacts: ImpactCounting,
-    /// Threads the step may share (at least 1), within the threads of the rayon pool
-    /// the run is called in: the plane's step shares its level deflections, its closed
-    /// contacts and its x and y modal updates; a row's step runs on one. Every result is
+    /// Threads the run may use (at least 1), within the threads of the rayon pool the
+    /// run is called in: with two or more, the run and its step check's repetition
+    /// compute at once ([`super::Plan::run`]), and the plane's step shares its level
+    /// deflections, its closed contacts and its x and y modal updates between the run's
+    /// threads; a row's step runs on one. Every result is
     /// the same, bit for bit, for every count. Call the run from inside the pool
     /// (`ThreadPool::install`): a thread outside it hands every fork to the pool and
     /// waits, two thread wake-ups per fork, three forks a step.
