@@ -313,6 +313,11 @@ impl ContactLanes {
         layout
     }
 
+    /// Lanes per group (the SIMD width).
+    pub fn lanes(&self) -> usize {
+        self.lanes
+    }
+
     /// Number of lanes (groups × lanes).
     pub fn len(&self) -> usize {
         self.contact.len()
@@ -390,7 +395,7 @@ pub(super) fn penetrations<S: Simd>(
 /// The lanes of the groups marked in `words` whose penetration `now` is positive,
 /// listed first in `closed`; returns how many.
 #[inline(always)]
-fn list_closed(lanes: usize, words: &[u64], now: &[f64], closed: &mut [u32]) -> usize {
+pub(super) fn list_closed(lanes: usize, words: &[u64], now: &[f64], closed: &mut [u32]) -> usize {
     let mut count = 0;
     for (w, word) in words.iter().enumerate() {
         let mut bits = *word;
@@ -430,30 +435,50 @@ pub(super) fn plane_penetrations<S: Simd>(
     state: ContactState<'_>,
 ) -> usize {
     let groups = layout.left.len();
+    let words = &mut state.closed_groups[..groups.div_ceil(64)];
+    let (now, _) = S::as_mut_simd_f64s(state.now);
+    let (max, _) = S::as_mut_simd_f64s(state.max);
+    plane_penetrations_of_words(simd, (layout, plane), deflections, gaps, (now, max, words), 0);
+    list_closed(layout.lanes, words, state.now, state.closed)
+}
+
+/// The vector pass of [`plane_penetrations`] over the groups of the words `words`
+/// (64 groups a word) from word `first_word` on: `now` and `max` start at its first
+/// group. Each group's values are computed alone, so any split of the words gives the
+/// values of the whole pass.
+#[inline(always)]
+pub(super) fn plane_penetrations_of_words<S: Simd>(
+    simd: S,
+    (layout, plane): (&ContactLanes, &PlaneGroups),
+    deflections: &[S::f64s],
+    gaps: &[f64],
+    (now, max, words): (&mut [S::f64s], &mut [S::f64s], &mut [u64]),
+    first_word: usize,
+) {
+    let start = first_word * 64;
+    let groups = layout.left.len().min((first_word + words.len()) * 64);
     let (left, right) = (&layout.left[..groups], &layout.right[..groups]);
     let (left_y, right_y) = (&plane.left_y[..groups], &plane.right_y[..groups]);
     let (normal_x, _) = S::as_simd_f64s(&plane.normal_x);
     let (normal_y, _) = S::as_simd_f64s(&plane.normal_y);
     let (normal_x, normal_y) = (&normal_x[..groups], &normal_y[..groups]);
     let (gaps, _) = S::as_simd_f64s(gaps);
-    let (now, _) = S::as_mut_simd_f64s(state.now);
-    let (max, _) = S::as_mut_simd_f64s(state.max);
-    let (gaps, now, max) = (&gaps[..groups], &mut now[..groups], &mut max[..groups]);
-    let words = &mut state.closed_groups[..groups.div_ceil(64)];
+    let gaps = &gaps[..groups];
+    let (now, max) = (&mut now[..groups - start], &mut max[..groups - start]);
     for (w, word) in words.iter_mut().enumerate() {
         let mut bits = 0u64;
-        for g in w * 64..groups.min(w * 64 + 64) {
+        let first = start + w * 64;
+        for g in first..groups.min(first + 64) {
             let along_x = simd.sub_f64s(deflections[left[g] as usize], deflections[right[g] as usize]);
             let along_y = simd.sub_f64s(deflections[left_y[g] as usize], deflections[right_y[g] as usize]);
             let approach = simd.mul_add_e_f64s(normal_x[g], along_x, simd.mul_f64s(normal_y[g], along_y));
             let n = simd.sub_f64s(approach, gaps[g]);
-            now[g] = n;
-            max[g] = simd.max_f64s(max[g], n);
+            now[g - start] = n;
+            max[g - start] = simd.max_f64s(max[g - start], n);
             bits |= u64::from(simd.reduce_max_f64s(n) > 0.0) << (g % 64);
         }
         *word = bits;
     }
-    list_closed(layout.lanes, words, state.now, state.closed)
 }
 
 /// ½ Σ (v² + ωᵢ² q²) over every pin (`stiffness` = ωᵢ² per mode: one row of vectors).

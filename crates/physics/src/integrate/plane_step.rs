@@ -21,7 +21,8 @@
 use pulp::Simd;
 
 use super::kernels::{
-    LevelShapes, ModalCoefficients, UpdateSums, level_deflections_of_groups, modal_update, penetration_rate,
+    ContactLanes, ContactState, LevelShapes, ModalCoefficients, PlaneGroups, UpdateSums, advance_positions,
+    level_deflections_of_groups, list_closed, modal_update, penetration_rate, plane_penetrations_of_words,
     row_axpy,
 };
 use super::layout::{LaneContact, Layout, PlaneLane};
@@ -73,6 +74,76 @@ pub(super) fn level_deflections<S: Simd>(
                 q,
                 second,
                 (middle..groups.end, shares.1),
+            )
+        },
+    );
+}
+
+/// The plane's penetrations ([`super::kernels::plane_penetrations`]), the words of
+/// groups (64 groups a word) shared by up to `threads` threads; then the closed lanes,
+/// listed in lane order as on one thread. Returns how many are closed.
+pub(super) fn penetrations<S: Simd>(
+    simd: S,
+    contacts: (&ContactLanes, &PlaneGroups),
+    deflections: &[S::f64s],
+    gaps: &[f64],
+    state: ContactState<'_>,
+    threads: usize,
+) -> usize {
+    let lanes = contacts.0.len();
+    let words = &mut state.closed_groups[..contacts.0.left.len().div_ceil(64)];
+    {
+        let (now, _) = S::as_mut_simd_f64s(&mut state.now[..lanes]);
+        let (max, _) = S::as_mut_simd_f64s(&mut state.max[..lanes]);
+        penetrations_of_words(
+            simd,
+            contacts,
+            (deflections, gaps),
+            (now, max, &mut *words),
+            (0, threads),
+        );
+    }
+    list_closed(contacts.0.lanes(), words, state.now, state.closed)
+}
+
+/// [`penetrations`]' vector pass over `words` from word `first_word` on, split in two
+/// halves of words while `threads` > 1.
+fn penetrations_of_words<S: Simd>(
+    simd: S,
+    contacts: (&ContactLanes, &PlaneGroups),
+    (deflections, gaps): (&[S::f64s], &[f64]),
+    (now, max, words): (&mut [S::f64s], &mut [S::f64s], &mut [u64]),
+    (first_word, threads): (usize, usize),
+) {
+    if threads <= 1 || words.len() <= 1 {
+        simd.vectorize(
+            #[inline(always)]
+            || plane_penetrations_of_words(simd, contacts, deflections, gaps, (now, max, words), first_word),
+        );
+        return;
+    }
+    let middle = words.len() / 2;
+    let (words_first, words_second) = words.split_at_mut(middle);
+    let (now_first, now_second) = now.split_at_mut(middle * 64);
+    let (max_first, max_second) = max.split_at_mut(middle * 64);
+    let shares = (threads / 2, threads - threads / 2);
+    rayon::join(
+        || {
+            penetrations_of_words(
+                simd,
+                contacts,
+                (deflections, gaps),
+                (now_first, max_first, words_first),
+                (first_word, shares.0),
+            )
+        },
+        || {
+            penetrations_of_words(
+                simd,
+                contacts,
+                (deflections, gaps),
+                (now_second, max_second, words_second),
+                (first_word + middle, shares.1),
             )
         },
     );
@@ -263,7 +334,7 @@ pub(super) struct Half<'a> {
     pub y: bool,
     /// Offset (in vectors) of the half's first row in the whole state.
     pub start: usize,
-    pub q: &'a [f64],
+    pub q: &'a mut [f64],
     pub v: &'a mut [f64],
     pub a: &'a mut [f64],
     pub force: &'a mut [f64],
@@ -281,14 +352,21 @@ pub(super) struct Loads<'a> {
     pub walls: Option<(&'a WallLayout, &'a WallState)>,
 }
 
+/// The modal update of a half: its coefficients, the second half of the step (Δt/2,
+/// or 0 for Tchamwa) and, if the next step's first half is taken with it, that first
+/// half's (Δt, half step, curvature) ([`advance_positions`]).
+pub(super) type Update<'a, S> = (&'a ModalCoefficients<'a, S>, f64, Option<(f64, f64, f64)>);
+
 /// Both halves' contact loads (and the walls' transport loads); with `update`, their
-/// modal update with `second_half` too, returning the x and the y sums. Up to
-/// `threads` threads (two at most: one per half).
+/// modal update with `second_half` too (and with a first half, the first half of the
+/// next step after it: [`advance_positions`], the same operations the next step would
+/// make), returning the x and the y sums. Up to `threads` threads (two at most: one per
+/// half).
 pub(super) fn update_halves<S: Simd>(
     simd: S,
     loads: &Loads<'_>,
     halves: [Half<'_>; 2],
-    update: Option<(&ModalCoefficients<'_, S>, f64)>,
+    update: Option<Update<'_, S>>,
     threads: usize,
 ) -> [Option<UpdateSums>; 2] {
     let [x, y] = halves;
@@ -312,7 +390,7 @@ fn update_half<S: Simd>(
     simd: S,
     loads: &Loads<'_>,
     half: Half<'_>,
-    update: Option<(&ModalCoefficients<'_, S>, f64)>,
+    update: Option<Update<'_, S>>,
 ) -> Option<UpdateSums> {
     simd.vectorize(
         #[inline(always)]
@@ -350,19 +428,23 @@ fn update_half<S: Simd>(
             if let Some((walls, wall)) = loads.walls {
                 wall.add_transport_load(walls, half.force, layout.row, usize::from(half.y));
             }
-            update.map(|(coefficients, second_half)| {
-                modal_update(
+            update.map(|(coefficients, second_half, next)| {
+                let (q, v, a) = (
+                    S::as_mut_simd_f64s(half.q).0,
+                    S::as_mut_simd_f64s(half.v).0,
+                    S::as_mut_simd_f64s(half.a).0,
+                );
+                let sums = modal_update(
                     simd,
                     coefficients,
                     half.base,
                     second_half,
-                    (
-                        S::as_simd_f64s(half.q).0,
-                        S::as_mut_simd_f64s(half.v).0,
-                        S::as_mut_simd_f64s(half.a).0,
-                        S::as_mut_simd_f64s(half.force).0,
-                    ),
-                )
+                    (q, v, a, S::as_mut_simd_f64s(half.force).0),
+                );
+                if let Some(first_half) = next {
+                    advance_positions(simd, first_half, q, v, a);
+                }
+                sums
             })
         },
     )

@@ -38,6 +38,9 @@ pub(super) struct State {
     pub lane_powers: Vec<[f64; 2]>,
     /// The walls, when they have their own motion.
     pub wall: Option<WallState>,
+    /// The first half of the next step is done (q and v advanced with the modal update
+    /// of a shared step, [`super::plane_step::update_halves`]).
+    pub advanced: bool,
 }
 
 impl State {
@@ -78,6 +81,7 @@ impl State {
             closed_count: 0,
             lane_powers: vec![[0.0; 2]; lanes],
             wall: layout.walls.as_ref().map(|walls| WallState::new(walls, model)),
+            advanced: false,
         }
     }
 

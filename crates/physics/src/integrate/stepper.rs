@@ -56,12 +56,65 @@ use crate::stability::Scheme;
 
 /// Steps between two calls of the progress callback.
 const PROGRESS_EVERY: u64 = 4096;
+/// Looks for forked work (about 0.1 µs each) a worker of a shared step makes before it
+/// yields its core to the system once.
+const IDLE_LOOKS_BEFORE_YIELDING: u32 = 1024;
 /// Steps between two divergence checks.
 const DIVERGENCE_CHECK_EVERY: u64 = 32;
 
 /// The time loop, with the step compiled for the SIMD level `arch`. The model and
 /// settings must have been checked and the step resolved ([`super::Plan`]).
 pub(super) fn integrate(
+    arch: pulp::Arch,
+    model: &Model<'_>,
+    settings: &Settings,
+    step: &StepSize,
+    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+) -> Result<Simulation, SimulationError> {
+    let threads = settings.threads.clamp(1, rayon::current_num_threads().max(1));
+    if threads == 1 || model.plane.is_none() {
+        return time_loop(arch, model, settings, step, progress);
+    }
+    // The plane's step is shared: three forks a step, too short for a worker of the pool
+    // to fall asleep and be woken between them (a wake-up costs about what a fork saves).
+    // A job of this scope keeps the other workers busy looking for the forked work
+    // until the run ends; a worker taken by other work (the step check beside the run)
+    // joins when it is done, and the forks the run makes until then run on its thread.
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    rayon::in_place_scope(|scope| {
+        for _ in 1..threads {
+            scope.spawn(|_| {
+                let mut idle = 0u32;
+                while !stop.load(std::sync::atomic::Ordering::Acquire) {
+                    if rayon::yield_now() == Some(rayon::Yield::Executed) {
+                        idle = 0;
+                    } else if idle == IDLE_LOOKS_BEFORE_YIELDING {
+                        // Long without work (the run records a sample, or the core is
+                        // wanted elsewhere): let the system run something else.
+                        std::thread::yield_now();
+                        idle = 0;
+                    } else {
+                        idle += 1;
+                        std::hint::spin_loop();
+                    }
+                }
+            });
+        }
+        // Stops the workers however the run ends (an error, or a panic that the scope
+        // carries out once its jobs are done).
+        struct Stop<'a>(&'a std::sync::atomic::AtomicBool);
+        impl Drop for Stop<'_> {
+            fn drop(&mut self) {
+                self.0.store(true, std::sync::atomic::Ordering::Release);
+            }
+        }
+        let _stop = Stop(&stop);
+        time_loop(arch, model, settings, step, progress)
+    })
+}
+
+/// [`integrate`]'s loop over the steps, on the threads it was given.
+fn time_loop(
     arch: pulp::Arch,
     model: &Model<'_>,
     settings: &Settings,
@@ -259,14 +312,25 @@ impl<'m> Integrator<'m> {
             closed_groups: &mut state.closed_groups,
         };
         if let (true, ContactModel::Plane(plane)) = (PLANE, &layout.contact_model) {
-            let count = plane_penetrations(
-                simd,
-                &layout.contacts,
-                &plane.groups,
-                deflections,
-                gaps,
-                contact_state,
-            );
+            let count = if threads > 1 {
+                plane_step::penetrations(
+                    simd,
+                    (&layout.contacts, &plane.groups),
+                    deflections,
+                    gaps,
+                    contact_state,
+                    threads,
+                )
+            } else {
+                plane_penetrations(
+                    simd,
+                    &layout.contacts,
+                    &plane.groups,
+                    deflections,
+                    gaps,
+                    contact_state,
+                )
+            };
             state.closed_count = count;
             if threads > 1 {
                 return shared_plane_contact_forces(
@@ -400,15 +464,18 @@ impl<'m> Integrator<'m> {
         steps: std::ops::RangeInclusive<u64>,
         vectors: usize,
     ) {
+        let last = *steps.end();
         for n in steps {
-            self.step_body::<S, PLANE>(simd, n, vectors);
+            self.step_body::<S, PLANE>(simd, n, vectors, n < last);
         }
     }
 
     /// Step n (to t = nΔt); `vectors` is the row length in vectors (a constant in the
-    /// usual cases).
+    /// usual cases). With `more` (step n + 1 follows in the same batch), a step shared
+    /// between threads may take the first half of step n + 1 with its modal update
+    /// ([`State::advanced`]).
     #[inline(always)]
-    fn step_body<S: Simd, const PLANE: bool>(&mut self, simd: S, n: u64, vectors: usize) {
+    fn step_body<S: Simd, const PLANE: bool>(&mut self, simd: S, n: u64, vectors: usize, more: bool) {
         let dt = self.layout.dt;
         let t = n as f64 * dt;
         self.recorder.enter_step(n);
@@ -421,13 +488,15 @@ impl<'m> Integrator<'m> {
         // The pins' rows (`v` and `a` have the walls' row of zeros after them).
         let state = &mut self.state;
         let pins_state = state.q.len();
-        advance_positions(
-            simd,
-            first_half,
-            S::as_mut_simd_f64s(&mut state.q).0,
-            S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
-            S::as_simd_f64s(&state.a[..pins_state]).0,
-        );
+        if !std::mem::take(&mut state.advanced) {
+            advance_positions(
+                simd,
+                first_half,
+                S::as_mut_simd_f64s(&mut state.q).0,
+                S::as_mut_simd_f64s(&mut state.v[..pins_state]).0,
+                S::as_simd_f64s(&state.a[..pins_state]).0,
+            );
+        }
         if let (Some(walls), Some(wall)) = (&self.layout.walls, &mut self.state.wall) {
             wall.advance(walls, self.layout.model, (t, dt));
         }
@@ -499,8 +568,12 @@ impl<'m> Integrator<'m> {
                 // update, of the x lines and of the y lines: the additions each row
                 // receives, in the order the step on one thread makes them.
                 let bases = base_accelerations(layout.model, t);
+                // The next step's first half with the update, unless something reads
+                // the velocities at the end of this step (point forces, moving walls).
+                let advance = more && layout.model.point_forces.is_empty() && layout.walls.is_none();
+                state.advanced = advance;
                 let (halves, loads) = plane_split(layout, state, bases, true);
-                let update = Some((&coefficients, second_half));
+                let update = Some((&coefficients, second_half, advance.then_some(first_half)));
                 let [x, y] = plane_step::update_halves(simd, &loads, halves, update, *threads)
                     .map(|sums| sums.expect("an update was asked"));
                 (
@@ -594,7 +667,7 @@ fn plane_split<'a>(
         ContactModel::Row => unreachable!("the plane's step runs on plane models"),
     };
     let x = lines / 2;
-    let (q_x, q_y) = state.q.split_at(x);
+    let (q_x, q_y) = state.q.split_at_mut(x);
     let (v_x, v_y) = state.v[..lines].split_at_mut(x);
     let (a_x, a_y) = state.a[..lines].split_at_mut(x);
     let (f_x, f_y) = state.force.split_at_mut(x);

@@ -1,8 +1,10 @@
 //! Threads inside one run ([`Settings::threads`]): the plane's step shared by 2 or 3
 //! threads gives the run of one thread bit for bit (histories, statistics, impacts,
 //! wear, energy), with many contacts closed at once (several chunks of the contact
-//! pass), walls that move on their own and a point force. Given two threads, the run
-//! and its step check run at once and give what they give one after the other.
+//! pass), walls that move on their own and a point force, and without them (where the
+//! shared step takes the next step's first half with its modal update), for both
+//! schemes. Given two threads, the run and its step check run at once and give what
+//! they give one after the other.
 
 use std::ops::ControlFlow;
 
@@ -11,6 +13,7 @@ use crate::beam::tests::default_tube;
 use crate::contact::{Body, Contact, Law};
 use crate::loads::{BaseAcceleration, PointForce, Table};
 use crate::modal::ModalBasis;
+use crate::stability::Scheme;
 
 /// 37 pins on a hexagonal lattice, 24 levels turning by 60° as a wire-wrapped bundle's
 /// do; one contact in three without a gap, the others with small gaps; neighbours
@@ -90,7 +93,7 @@ fn bundle(basis: &ModalBasis) -> Model<'_> {
 
 fn settings(threads: usize) -> Settings {
     Settings {
-        scheme: crate::stability::Scheme::CentralDifference,
+        scheme: Scheme::CentralDifference,
         time_step: TimeStep::Auto,
         tolerance: DEFAULT_TOLERANCE,
         check: Check::None,
@@ -105,12 +108,17 @@ fn settings(threads: usize) -> Settings {
 
 /// The run of `model` with `threads` threads asked, in a pool of `pool` threads.
 fn run(model: &Model<'_>, threads: usize, pool: usize) -> Simulation {
+    run_with(model, &settings(threads), pool)
+}
+
+/// The run of `model` with `settings`, in a pool of `pool` threads.
+fn run_with(model: &Model<'_>, settings: &Settings, pool: usize) -> Simulation {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(pool)
         .build()
         .expect("a thread pool");
     pool.install(|| {
-        Plan::new(model, &settings(threads))
+        Plan::new(model, settings)
             .expect("a valid model")
             .run(&mut |_| ControlFlow::Continue(()))
             .expect("runs")
@@ -138,6 +146,27 @@ fn results_are_the_same_bit_for_bit_for_every_thread_count() {
             shared == one,
             "{threads} threads in a pool of {pool} differ from one thread"
         );
+    }
+    // Without point forces and moving walls, nothing reads the velocities at the end of
+    // a step: the shared step advances the positions of the next one with its update.
+    let free = Model {
+        point_forces: vec![],
+        walls: None,
+        ..bundle(&basis)
+    };
+    for scheme in [Scheme::CentralDifference, Scheme::Tchamwa { phi: 1.1 }] {
+        let with = |threads| Settings {
+            scheme,
+            ..settings(threads)
+        };
+        let one = run_with(&free, &with(1), 1);
+        assert!(one.contact_statistics.iter().map(|s| s.impacts).sum::<u64>() > 100);
+        for (threads, pool) in [(2, 2), (3, 3), (2, 1)] {
+            assert!(
+                run_with(&free, &with(threads), pool) == one,
+                "{scheme:?}: {threads} threads in a pool of {pool} differ from one thread"
+            );
+        }
     }
 }
 
