@@ -1,22 +1,26 @@
 //! The plane's step shared between threads ([`super::Settings::threads`] > 1); on one
-//! thread the stepper runs its own inlined copy. Three parts of the step are split, each
+//! thread the stepper runs its own inlined copy. Four parts of the step are split, each
 //! so that every number is computed by the same operations in the same order as on one
 //! thread, so the results are the same, bit for bit, for every thread count.
 //!
 //! 1. The level deflections ([`level_deflections`]): the groups of blocks of levels are
 //!    split; each deflection is its own dot product.
-//! 2. The closed contacts ([`ClosedPass`]): the list of closed lanes is split into
+//! 2. The vector pass over the contact groups ([`penetrations`]): the words of 64 groups
+//!    are split; the closed lanes are then listed from the words on one thread.
+//! 3. The closed contacts ([`ClosedPass`]): the list of closed lanes is split into
 //!    chunks of [`CLOSED_CHUNK`]; threads write disjoint lanes, each lane's powers
 //!    included, which the stepper then sums in the order of the list, as on one thread.
 //!    The impacts a thread ends wait in a list and join the log in lane order.
-//! 3. The loads and the modal update ([`update_halves`]): the x lines and the y lines.
+//! 4. The loads and the modal update ([`update_halves`]): the x lines and the y lines.
 //!    Each half adds its share of every closed contact's force (so each row receives
 //!    the same additions in the same order as on one thread), the walls' transport load,
-//!    then updates its modes.
+//!    then updates its modes, and may take the next step's first half with it.
 //!
 //! The work is forked on the rayon pool the run is called in (`rayon::join`), at most
 //! `threads` ways; each piece re-enters the SIMD context of the step
-//! (`Simd::vectorize`), as a closure run on another thread is compiled without it.
+//! (`Simd::vectorize`), as a closure run on another thread is compiled without it. The
+//! stepper keeps the pool's other workers looking for these forks for the whole run
+//! (`stepper::integrate`).
 
 use pulp::Simd;
 

@@ -30,8 +30,9 @@
 //! lane ([`plane_penetrations`]), two dashpot dot products and four force axpys per
 //! closed contact ([`plane_contact_forces`]), and the modal update on the x and the y
 //! lines with their own base acceleration. The row's copy does none of it. With
-//! [`Settings::threads`] > 1 the plane's step forks its level deflections, closed
-//! contacts and x/y updates ([`plane_step`]); on one thread it is this inlined copy.
+//! [`Settings::threads`] > 1 the plane's step forks its level deflections, vector pass,
+//! closed contacts and x/y updates ([`plane_step`]); on one thread it is this inlined
+//! copy.
 //!
 //! The step is dispatched through `pulp` so that it is compiled for the SIMD level of
 //! the running CPU (AVX2 + FMA on x86-64-v3) without unsafe code; see [`kernels`] for
