@@ -97,13 +97,17 @@ impl<'a> Plan<'a> {
                 }),
             )),
         };
-        // Shares of the progress: the run, then the check's repetitions (at 2Δt half the
-        // run's steps, at Δt/2 twice); a fallback to Δt/2 after 2Δt takes the last 20 %.
-        let (weight, first_ends) = match &first {
-            None => (0.0, 1.0),
-            Some((quality::StepComparison::DoubleStep, ..)) => (0.5, 0.8),
-            Some((quality::StepComparison::HalfStep, ..)) => (2.0, 1.0),
+        // Shares of the progress, in proportion to the steps: the run, then the check's
+        // repetition (at 2Δt half the run's steps, at Δt/2 twice). A fallback to Δt/2
+        // after 2Δt adds two runs to the 1.5 done: the progress then steps back to
+        // 1.5/3.5 and goes on from there, so that the time left extrapolated from it
+        // (job status, CLI) holds.
+        let weight = match &first {
+            None => 0.0,
+            Some((quality::StepComparison::DoubleStep, ..)) => 0.5,
+            Some((quality::StepComparison::HalfStep, ..)) => 2.0,
         };
+        let fallback_starts = (1.0 + weight) / (1.0 + weight + 2.0);
         let threads = settings.threads.clamp(1, rayon::current_num_threads().max(1));
         // A repeated run is only compared by its key figures, which the step tracks at
         // every step (peaks, impacts, wear): one sample at its last step keeps them whole
@@ -141,7 +145,7 @@ impl<'a> Plan<'a> {
                     quality::StepComparison::DoubleStep => {
                         let (simulation, (repeated, prepared)) = at_once(
                             [1.0, weight],
-                            &mut |f| scale(0.0, first_ends, progress, f),
+                            &mut |f| progress(f),
                             |p| run(threads - 1, p),
                             |p| Ok((repeat(at, 1, p)?, prepare())),
                         )?;
@@ -150,7 +154,7 @@ impl<'a> Plan<'a> {
                     quality::StepComparison::HalfStep => {
                         let (repeated, (simulation, prepared)) = at_once(
                             [weight, 1.0],
-                            &mut |f| scale(0.0, first_ends, progress, f),
+                            &mut |f| progress(f),
                             |p| repeat(at, threads - 1, p),
                             |p| Ok((run(1, p)?, prepare())),
                         )?;
@@ -160,9 +164,9 @@ impl<'a> Plan<'a> {
                 (simulation, Some(repeated), prepared)
             }
             Some((_, at, _)) => {
-                let share = first_ends / (1.0 + weight);
+                let share = 1.0 / (1.0 + weight);
                 let simulation = run(threads, &mut |f| scale(0.0, share, progress, f))?;
-                let repeated = repeat(at, threads, &mut |f| scale(share, first_ends, progress, f))?;
+                let repeated = repeat(at, threads, &mut |f| scale(share, 1.0, progress, f))?;
                 (simulation, Some(repeated), None)
             }
         };
@@ -185,7 +189,8 @@ impl<'a> Plan<'a> {
                     Some(compared)
                 } else {
                     let half = step.halved();
-                    let (fine, also) = repeat(&half, threads, &mut |f| scale(first_ends, 1.0, progress, f))?;
+                    let (fine, also) =
+                        repeat(&half, threads, &mut |f| scale(fallback_starts, 1.0, progress, f))?;
                     Some(quality::StepHalving {
                         why_half_step: Some(format!(
                             "the comparison with 2Δt did not prove the result (peak contact force \
