@@ -455,6 +455,58 @@ fn the_check_falls_back_to_half_the_step_and_says_why() {
     assert!(asked.why_half_step.unwrap().contains("asked for"));
 }
 
+/// The progress is the share of the steps done: a run checked at 2Δt fills the bar
+/// with its 1.5 runs of steps; when the comparison does not prove the result, the
+/// repetition at Δt/2 adds two runs, and the bar steps back once, to the 1.5 of 3.5
+/// done, then fills again (so that a time left extrapolated from it holds).
+#[test]
+fn the_progress_follows_the_steps_and_steps_back_once_when_the_check_falls_back() {
+    let (_, row) = realistic_rows().remove(0);
+    let basis = row.basis();
+    let model = row.model(&basis);
+    let auto = *Plan::new(&model, &row.settings(TimeStep::Auto)).unwrap().step();
+    let progress_of = |tolerance: f64| {
+        let mut seen = Vec::new();
+        let settings = Settings {
+            check: Check::Auto,
+            tolerance,
+            ..row.settings(TimeStep::Fixed(auto.time_step))
+        };
+        Plan::new(&model, &settings)
+            .and_then(|plan| {
+                plan.run(&mut |f| {
+                    seen.push(f);
+                    ControlFlow::Continue(())
+                })
+            })
+            .expect("runs");
+        seen
+    };
+    let drops = |seen: &[f64]| seen.windows(2).filter(|w| w[1] < w[0]).count();
+    let proven = progress_of(0.05);
+    assert!(proven.len() >= 4, "{proven:?}");
+    assert_eq!(drops(&proven), 0, "{proven:?}");
+    assert!(proven.iter().all(|f| (0.0..=1.0).contains(f)), "{proven:?}");
+    // The last report comes within a batch of reports (4 096 steps) of the end.
+    let batch = 4096.0 / (1.5 * (row.duration / auto.time_step).round());
+    assert!(proven.last().unwrap() >= &(1.0 - batch), "{proven:?}");
+
+    let fallback = progress_of(1e-9);
+    assert_eq!(drops(&fallback), 1, "{fallback:?}");
+    let at = fallback.windows(2).position(|w| w[1] < w[0]).unwrap() + 1;
+    let (before, after) = (fallback[at - 1], fallback[at]);
+    assert!(
+        before >= 1.0 - batch,
+        "the bar was full before the fallback: {before}"
+    );
+    let restart = 1.5 / 3.5;
+    assert!(
+        after >= restart && after <= restart + batch * 1.5 / 3.5 * 2.0,
+        "after the step back: {after}, 1.5/3.5 = {restart}"
+    );
+    assert!(fallback.last().unwrap() >= &(1.0 - batch), "{fallback:?}");
+}
+
 /// Without the step-halving check the step's error is not measured: the same run is
 /// `unchecked` where the checked one is `good`, and never `good`.
 #[test]
