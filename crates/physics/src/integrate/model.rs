@@ -445,11 +445,12 @@ pub struct Settings {
     /// Threads the run may use (at least 1), within the threads of the rayon pool the
     /// run is called in: with two or more, the run and its step check's repetition
     /// compute at once ([`super::Plan::run`]), and the plane's step shares its level
-    /// deflections, its closed contacts and its x and y modal updates between the run's
-    /// threads; a row's step runs on one. Every result is
-    /// the same, bit for bit, for every count. Call the run from inside the pool
-    /// (`ThreadPool::install`): a thread outside it hands every fork to the pool and
-    /// waits, two thread wake-ups per fork, three forks a step.
+    /// deflections, its vector pass over the contacts, its closed contacts and its x and
+    /// y modal updates between the run's threads, whose other workers keep looking for
+    /// its forks until the run ends (they spin: the run holds its cores); a row's step
+    /// runs on one. Every result is the same, bit for bit, for every count. Call the run
+    /// from inside the pool (`ThreadPool::install`): a thread outside it hands every
+    /// fork to the pool and waits, four forks a step.
     pub threads: usize,
 }
 
