@@ -133,9 +133,11 @@ impl<'a> Plan<'a> {
             progress(from + (to - from) * f)
         };
         // The run and the check's first repetition are independent: given two threads or
-        // more, they run at once (the repetition on one thread, the run on the others),
+        // more, they run at once (the shorter on one thread, the longer on the others),
         // each computing exactly what it computes alone. The shorter of the two then
-        // computes the impact probes of every contact that could push, on its thread.
+        // computes the impact probes of every contact that could push, on its thread,
+        // and its thread then joins the longer one's steps where they are shared
+        // (`stepper::integrate`).
         let (simulation, first_run, prepared) = match &first {
             None => (run(threads, &mut |f| progress(f))?, None, None),
             Some((comparison, at, _)) if threads >= 2 => {
@@ -146,7 +148,7 @@ impl<'a> Plan<'a> {
                         let (simulation, (repeated, prepared)) = at_once(
                             [1.0, weight],
                             &mut |f| progress(f),
-                            |p| run(threads - 1, p),
+                            |p| run(threads, p),
                             |p| Ok((repeat(at, 1, p)?, prepare())),
                         )?;
                         (simulation, repeated, prepared)
@@ -155,7 +157,7 @@ impl<'a> Plan<'a> {
                         let (repeated, (simulation, prepared)) = at_once(
                             [weight, 1.0],
                             &mut |f| progress(f),
-                            |p| repeat(at, threads - 1, p),
+                            |p| repeat(at, threads, p),
                             |p| Ok((run(1, p)?, prepare())),
                         )?;
                         (simulation, repeated, prepared)

@@ -299,3 +299,56 @@ fn runs_at_once_stop_together() {
     });
     assert_eq!(failed, Err(failure));
 }
+
+/// The run may change its count of threads from one batch of steps to the next (a
+/// worker joins the run's steps once the step check beside it ends): another thread
+/// switches the count between one and two every 50 µs while the run steps, at whatever
+/// batches that falls on; the results are those of one thread, bit for bit.
+#[test]
+fn the_step_gives_the_same_numbers_when_its_threads_change_between_batches() {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    let basis = ModalBasis::compute(&default_tube(20), 6).expect("valid beam");
+    let with_loads = bundle(&basis);
+    let free = Model {
+        point_forces: vec![],
+        walls: None,
+        ..bundle(&basis)
+    };
+    for model in [&with_loads, &free] {
+        let one = run(model, 1, 1);
+        let settings = settings(2);
+        let plan = Plan::new(model, &settings).expect("a valid model");
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a thread pool");
+        let (helping, done) = (AtomicUsize::new(0), AtomicBool::new(false));
+        let mut switches = 0u64;
+        let switched = std::thread::scope(|scope| {
+            scope.spawn(|| {
+                while !done.load(Ordering::Acquire) {
+                    helping.store(1 - helping.load(Ordering::Acquire), Ordering::Release);
+                    switches += 1;
+                    std::thread::sleep(std::time::Duration::from_micros(50));
+                }
+            });
+            let simulation = pool.install(|| {
+                stepper::time_loop(
+                    pulp::Arch::new(),
+                    model,
+                    &settings,
+                    plan.step(),
+                    Some(&helping),
+                    &mut |_| ControlFlow::Continue(()),
+                )
+            });
+            done.store(true, Ordering::Release);
+            simulation.expect("runs")
+        });
+        assert!(switches > 10, "{switches} switches");
+        assert!(
+            switched == one,
+            "the run whose threads changed differs from one thread"
+        );
+    }
+}
