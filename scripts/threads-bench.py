@@ -4,11 +4,11 @@ binary or more (the previous one beside the new one).
 
 Usage: scripts/threads-bench.py BINARY [BINARY ...] [--rounds N]
 
-Runs `chocmodal run` on row17 (examples/bundle-row17.json), hex217 (examples/hex217.json)
-and the public cantilever (examples/cantilever-impact.json), each as shipped (the step
-check at its default), hex217 and the same bundle with 61 and 19 pins also with
-`check: "none"` (their steps shared, nothing to run beside them), with `solver.threads` 1 and 2, alternating binaries and counts within
-each round. Prints the median wall and CPU time (user + system) of each and the speed-up
+Runs `chocmodal run` on row17 (examples/bundle-row17.json), hex217 (examples/hex217.json),
+the same bundle with 61 pins and the public cantilever (examples/cantilever-impact.json),
+each as shipped (the step check at its default), hex217 and the same bundle with 61 and
+19 pins also with `check: "none"` (their steps shared, nothing to run beside them), with
+`solver.threads` 1 and 2, alternating binaries and counts within each round. Prints the median wall and CPU time (user + system) of each and the speed-up
 of two threads over one. Run it on an otherwise idle machine with two free cores: a
 second thread that waits for its core makes a run slower, not faster.
 """
@@ -28,6 +28,7 @@ CASES = [
     ("row17", "bundle-dynamics", "bundle-row17", {}, None),
     ("hex217", "hex-bundle-dynamics", "hex217", {}, None),
     ("hex217 check none", "hex-bundle-dynamics", "hex217", {"check": "none"}, None),
+    ("hex61", "hex-bundle-dynamics", "hex217", {}, 4),
     ("hex61 check none", "hex-bundle-dynamics", "hex217", {"check": "none"}, 4),
     ("hex19 check none", "hex-bundle-dynamics", "hex217", {"check": "none"}, 2),
     ("cantilever", "cantilever-impact", "cantilever-impact", {}, None),
