@@ -39,10 +39,11 @@ use inputs::{ContactSelectionInput, HexExcitationInput, HexInputs};
 use loads::PlaneLoads;
 
 /// The fewest modal DOFs whose step is worth sharing between threads: on the 2-core
-/// machine two threads ran a 19-pin bundle's steps (760 DOFs) no faster than one, a
-/// 61-pin bundle's (2 440) 1.12× faster, a 217-pin bundle's (8 680) 1.17× faster
-/// (`scripts/threads-bench.py`, `check: "none"`, 2026-11-26). Smaller bundles are
-/// granted threads only for their step check, as the rows.
+/// machine two threads ran a 19-pin bundle's steps (760 DOFs) 1.05× faster than one, a
+/// 61-pin bundle's (2 440) 1.23× faster, a 217-pin bundle's (8 680) 1.43× faster
+/// (`scripts/threads-bench.py`, `check: "none"`, 2026-11-27). Smaller bundles are
+/// granted threads only for their step check, as the rows (the run then shares its
+/// steps with the check's core once the check is done: the core is held anyway).
 pub const MIN_SHARED_STEP_DOFS: u64 = 2000;
 
 /// Default history interval (s).

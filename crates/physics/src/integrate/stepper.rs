@@ -75,7 +75,7 @@ pub(super) fn integrate(
 ) -> Result<Simulation, SimulationError> {
     let threads = settings.threads.clamp(1, rayon::current_num_threads().max(1));
     if threads == 1 || model.plane.is_none() {
-        return time_loop(arch, model, settings, step, None, progress);
+        return time_loop(arch, model, settings, step, (threads, None), progress);
     }
     // The plane's step is shared: four forks a step, too close for a worker of the pool
     // to fall asleep and be woken between them (a wake-up costs about what a fork
@@ -116,23 +116,23 @@ pub(super) fn integrate(
             }
         }
         let _stop = Stop(&stop);
-        time_loop(arch, model, settings, step, Some(&helping), progress)
+        time_loop(arch, model, settings, step, (threads, Some(&helping)), progress)
     })
 }
 
 /// [`integrate`]'s loop over the steps. With `helping` (the workers looking for the
 /// run's forks), each batch of steps is shared by the run's thread and those that have
-/// joined (at most [`Settings::threads`] in all): the step gives the same numbers
-/// whatever the count, so the count may change from one batch to the next.
+/// joined (at most `threads` in all: [`Settings::threads`] within the pool): the step
+/// gives the same numbers whatever the count, so the count may change from one batch
+/// to the next.
 pub(super) fn time_loop(
     arch: pulp::Arch,
     model: &Model<'_>,
     settings: &Settings,
     step: &StepSize,
-    helping: Option<&AtomicUsize>,
+    (threads, helping): (usize, Option<&AtomicUsize>),
     progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
 ) -> Result<Simulation, SimulationError> {
-    let threads = settings.threads.clamp(1, rayon::current_num_threads().max(1));
     let sharing = || helping.map_or(1, |helping| (1 + helping.load(Ordering::Acquire)).min(threads));
     let mut run = Integrator::new(arch, model, settings, step, sharing());
     let (total_steps, output_every) = step_counts(settings.duration, step, settings.output_interval);

@@ -338,7 +338,7 @@ fn the_step_gives_the_same_numbers_when_its_threads_change_between_batches() {
                     model,
                     &settings,
                     plan.step(),
-                    Some(&helping),
+                    (2, Some(&helping)),
                     &mut |_| ControlFlow::Continue(()),
                 )
             });
