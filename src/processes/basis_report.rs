@@ -68,11 +68,12 @@ pub struct BasisCost {
     pub modal_dofs_per_pin: usize,
     /// Modal coordinates of the whole run (pins × per pin).
     pub modal_dofs: usize,
-    /// Critical step of this basis (s), every contact closed.
-    pub critical_time_step: f64,
+    /// Critical step of this basis (s), every contact closed; null under `exact_modal`,
+    /// which has none (its step follows the contacts, not the basis).
+    pub critical_time_step: Option<f64>,
     /// Critical step (s) the eigenmodes alone would have: the pseudo-modes' share of the
-    /// cost shows in the ratio (equal without correction).
-    pub critical_time_step_without_correction: f64,
+    /// cost shows in the ratio (equal without correction); null under `exact_modal`.
+    pub critical_time_step_without_correction: Option<f64>,
 }
 
 impl BasisReport {
@@ -118,8 +119,8 @@ impl BasisReport {
             cost: BasisCost {
                 modal_dofs_per_pin: basis.modes(),
                 modal_dofs: basis.modes() * model.pins,
-                critical_time_step: critical,
-                critical_time_step_without_correction: without,
+                critical_time_step: crate::physics::finite(critical),
+                critical_time_step_without_correction: crate::physics::finite(without),
             },
         }
     }

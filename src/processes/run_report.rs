@@ -154,8 +154,9 @@ pub struct RunSummary {
     pub energy: EnergyReport,
     /// Step used (s).
     pub time_step: f64,
-    /// Critical step with every contact closed (s).
-    pub critical_time_step: f64,
+    /// Critical step with every contact closed (s); null under `exact_modal`, which has
+    /// no stability limit.
+    pub critical_time_step: Option<f64>,
     /// Steps taken.
     pub steps: u64,
     /// Time between two history samples (s).
@@ -208,7 +209,7 @@ impl RunSummary {
             impact_summary: impact_report::summary(run, &settings.impacts),
             energy: run.energy.into(),
             time_step: run.step.time_step,
-            critical_time_step: run.step.critical_time_step,
+            critical_time_step: crate::physics::finite(run.step.critical_time_step),
             steps: run.steps,
             output_interval: run.output_interval,
             quality,

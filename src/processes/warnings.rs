@@ -129,6 +129,9 @@ pub struct Subject<'a> {
     pub model: Model<'a>,
     /// Simulated duration (s).
     pub duration: f64,
+    /// The integration scheme (the static correction costs step only to the explicit
+    /// ones).
+    pub scheme: crate::physics::stability::Scheme,
     /// Where the user wrote the gap of contact k.
     pub gap_pointer: Box<dyn Fn(usize) -> String + 'a>,
     /// Where to add an excitation when nothing excites the model.
@@ -375,6 +378,9 @@ fn excitation_outlasts_run(subject: &Subject<'_>) -> Option<Warning> {
 fn static_correction_cost(subject: &Subject<'_>) -> Option<Warning> {
     use crate::physics::integrate::critical_time_step;
     use crate::physics::stability::Scheme;
+    if !subject.scheme.is_explicit() {
+        return None;
+    }
     let correction = subject.basis().static_correction()?;
     let modes_only = subject.basis().without_static_correction();
     let lean = Model {

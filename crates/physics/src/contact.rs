@@ -319,6 +319,24 @@ impl NormalLaw {
         self.damping > 0.0 || self.hunt_crossley > 0.0
     }
 
+    /// The derivatives (∂F/∂δ, ∂F/∂δ̇) of [`NormalLaw::force`]'s unclamped force at δ > 0,
+    /// δ̇: n K δⁿ⁻¹ (1 + α δ̇) and K δⁿ α + c (the implicit solve of the `exact_modal`
+    /// scheme linearises the law with them).
+    pub fn tangent(&self, penetration: f64, rate: f64) -> (f64, f64) {
+        let (spring, power) = if self.exponent == 1.0 {
+            (self.stiffness, self.stiffness * penetration)
+        } else {
+            (
+                self.exponent * self.stiffness * penetration.powf(self.exponent - 1.0),
+                self.stiffness * penetration.powf(self.exponent),
+            )
+        };
+        (
+            spring * (1.0 + self.hunt_crossley * rate),
+            power * self.hunt_crossley + self.damping,
+        )
+    }
+
     /// Whether it can push at all: only such contacts count impacts.
     pub fn is_active(&self) -> bool {
         self.stiffness > 0.0 || self.damping > 0.0

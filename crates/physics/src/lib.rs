@@ -68,6 +68,12 @@ impl InputIssue {
     }
 }
 
+/// `value` when finite (a critical step is infinite for a scheme without a stability
+/// limit: reported as null).
+pub fn finite(value: f64) -> Option<f64> {
+    value.is_finite().then_some(value)
+}
+
 /// `value` rounded to 12 significant digits: a height computed as `first + k·spacing` or
 /// `node · element length` printed as the decimal it stands for (0.6, not
 /// 0.6000000000000001), 1e-12 relative being far below any geometric meaning.

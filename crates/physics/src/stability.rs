@@ -29,7 +29,7 @@ use super::contact::{Body, Contact};
 /// Largest modal system (pins × modes) whose λ_max is computed exactly.
 pub const DENSE_LIMIT: usize = 1500;
 
-/// Explicit integration scheme on the modal coordinates.
+/// Integration scheme on the modal coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Scheme {
     /// Central difference, velocity form: second order, no numerical dissipation.
@@ -37,16 +37,26 @@ pub enum Scheme {
     /// Tchamwa–Wielgosz with parameter φ ≥ 1 (φ = 1: no dissipation): first order,
     /// damps high frequencies.
     Tchamwa { phi: f64 },
+    /// Every mode propagated exactly over the step, the contact forces implicit
+    /// (`crate::integrate`'s `exact` module): second order, no stability limit; the step
+    /// resolves the contacts and the excitation, not the top of the basis.
+    ExactModal,
 }
 
 impl Scheme {
     /// Stability limit of ω Δt for an undamped oscillator: 2 (central difference),
-    /// 2/√(2φ − 1) (Tchamwa–Wielgosz).
+    /// 2/√(2φ − 1) (Tchamwa–Wielgosz), none (∞) for the exact modal scheme.
     pub fn stability_limit(&self) -> f64 {
         match *self {
             Scheme::CentralDifference => 2.0,
             Scheme::Tchamwa { phi } => 2.0 / (2.0 * phi - 1.0).sqrt(),
+            Scheme::ExactModal => f64::INFINITY,
         }
+    }
+
+    /// Whether a step is bounded by stability (the explicit schemes).
+    pub fn is_explicit(&self) -> bool {
+        !matches!(self, Scheme::ExactModal)
     }
 }
 

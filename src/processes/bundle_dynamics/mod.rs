@@ -509,6 +509,7 @@ impl Simulation for BundleDynamics {
             diameter: None,
             model: plan.model(),
             duration: plan.settings.duration,
+            scheme: plan.settings.scheme,
             gap_pointer: Box::new(|k| plan.inputs.gap_pointer(&plan.contacts[k], k)),
             excitation_pointer: "/inputs/excitation",
         }

@@ -278,8 +278,9 @@ pub struct NumericalResults {
     pub min_tip_displacement: f64,
     /// Step used (s).
     pub time_step: f64,
-    /// Critical step with the contact closed (s).
-    pub critical_time_step: f64,
+    /// Critical step with the contact closed (s); null under `exact_modal`, which has no
+    /// stability limit.
+    pub critical_time_step: Option<f64>,
     /// Steps taken.
     pub steps: u64,
     /// Time between two history samples (s).
@@ -633,6 +634,7 @@ impl Simulation for CantileverImpact {
             diameter: None,
             model: plan.model(),
             duration: plan.settings.duration,
+            scheme: plan.settings.scheme,
             gap_pointer: Box::new(|_| "/inputs/contact/gap".to_owned()),
             excitation_pointer: "/inputs/release/tip_displacement",
         }
@@ -716,7 +718,7 @@ impl Simulation for CantileverImpact {
                 impulse: stats.impulse,
                 min_tip_displacement: -contact.gap - stats.max_penetration,
                 time_step: simulation.step.time_step,
-                critical_time_step: simulation.step.critical_time_step,
+                critical_time_step: crate::physics::finite(simulation.step.critical_time_step),
                 steps: simulation.steps,
                 output_interval: simulation.output_interval,
                 frequencies_hz: plan.basis.frequencies_hz(),

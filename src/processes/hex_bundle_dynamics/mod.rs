@@ -537,6 +537,7 @@ impl Simulation for HexBundleDynamics {
                 .map(|d| (d, "/inputs/bundle/pin_diameter")),
             model: plan.model(),
             duration: plan.settings.duration,
+            scheme: plan.settings.scheme,
             gap_pointer: Box::new(|k| plan.inputs.gap_pointer(&plan.contacts[k], k)),
             excitation_pointer: "/inputs/excitation",
         }

@@ -352,7 +352,7 @@ impl<'m> Layout<'m> {
                     .iter()
                     .map(|c| match settings.scheme {
                         Scheme::CentralDifference => 1.0 / (1.0 + 0.5 * c * dt),
-                        Scheme::Tchamwa { .. } => 1.0,
+                        Scheme::Tchamwa { .. } | Scheme::ExactModal => 1.0,
                     })
                     .collect::<Vec<_>>(),
                 row,
@@ -362,7 +362,7 @@ impl<'m> Layout<'m> {
             participation: padded(basis.participation(), row, 0.0),
             dashpot_lookahead: match settings.scheme {
                 Scheme::CentralDifference => 0.5 * dt,
-                Scheme::Tchamwa { .. } => 0.0,
+                Scheme::Tchamwa { .. } | Scheme::ExactModal => 0.0,
             },
             level_shapes,
             grouped_level_shapes,

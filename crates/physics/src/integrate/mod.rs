@@ -177,6 +177,7 @@ pub(crate) fn simulate(
     Ok(Plan::new(model, settings)?.run(progress)?.simulation)
 }
 
+mod exact;
 mod kernels;
 mod layout;
 mod model;
@@ -213,6 +214,8 @@ mod thread_tests;
 
 #[cfg(test)]
 mod bending_tests;
+#[cfg(test)]
+mod exact_tests;
 #[cfg(test)]
 mod law_tests;
 #[cfg(test)]

@@ -393,7 +393,28 @@ fn check(model: &Model<'_>, settings: &Settings) -> Result<(), SimulationError> 
     if !issues.is_empty() {
         return Err(SimulationError::InvalidModel(issues));
     }
-    let issues = settings.validate(model.basis.length(), model.contacts.len());
+    let mut issues = settings.validate(model.basis.length(), model.contacts.len());
+    if settings.scheme == crate::stability::Scheme::ExactModal {
+        if model.plane.is_some() {
+            issues.push(InputIssue::new(
+                "scheme",
+                "`exact_modal` integrates pins bending in one plane (the row and the cantilever); \
+                 for the hexagonal bundle use `central_difference`",
+            ));
+        }
+        if model.walls.is_some() {
+            issues.push(InputIssue::new(
+                "scheme",
+                "`exact_modal` does not take walls with their own motion; use `central_difference`",
+            ));
+        }
+        if model.contacts.iter().any(|c| c.law.friction.is_on()) {
+            issues.push(InputIssue::new(
+                "scheme",
+                "`exact_modal` does not take friction; use `central_difference`",
+            ));
+        }
+    }
     if !issues.is_empty() {
         return Err(SimulationError::InvalidSettings(issues));
     }

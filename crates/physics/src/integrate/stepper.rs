@@ -43,6 +43,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use pulp::Simd;
 
+use super::exact::{self, ExactRun};
 use super::kernels::{
     self, ContactState, ModalCoefficients, advance_positions, axpy, lanes, level_deflections, modal_update,
     penetration_rate, penetrations, plane_penetrations, row_axpy,
@@ -147,7 +148,7 @@ pub(super) fn time_loop(
             .map(|every| (n / every + 1) * every)
             .fold(total_steps, u64::min);
         run.threads = sharing();
-        run.steps(n + 1..=next);
+        run.steps(n + 1..=next)?;
         n = next;
         if n % DIVERGENCE_CHECK_EVERY == 0 || n == total_steps {
             run.check_divergence(n as f64 * step.time_step)?;
@@ -172,6 +173,8 @@ struct Integrator<'m> {
     layout: Layout<'m>,
     state: State,
     recorder: Recorder,
+    /// The exact modal scheme's own data (`None` for the explicit schemes).
+    exact: Option<ExactRun>,
 }
 
 /// What [`StepOp`] does.
@@ -246,6 +249,7 @@ impl<'m> Integrator<'m> {
             layout,
             state,
             recorder,
+            exact: None,
         };
         // The state at t = 0: contacts already closed count as impacts at t = 0; a₀ from
         // equilibrium (velocities are zero).
@@ -254,6 +258,7 @@ impl<'m> Integrator<'m> {
             layout,
             state,
             recorder,
+            exact,
             ..
         } = &mut integrator;
         recorder.record_initial_contacts(layout, state);
@@ -262,6 +267,11 @@ impl<'m> Integrator<'m> {
         let (row, pins) = (layout.row, model.pins);
         if let (Some(walls), Some(wall)) = (&layout.walls, &state.wall) {
             wall.add_transport_loads(walls, &mut state.force, (row, pins));
+        }
+        if layout.scheme == Scheme::ExactModal {
+            // The exact scheme starts from the loads at t = 0 (it takes loads linear
+            // over each step).
+            *exact = Some(ExactRun::new(layout, state.force.clone()));
         }
         for (line, ((a, f), q)) in state
             .a
@@ -458,8 +468,15 @@ impl<'m> Integrator<'m> {
 
     /// Takes the steps of `steps` (step n advances to t = n·Δt), compiled for the best
     /// SIMD level of this CPU.
-    fn steps(&mut self, steps: std::ops::RangeInclusive<u64>) {
+    fn steps(&mut self, steps: std::ops::RangeInclusive<u64>) -> Result<(), SimulationError> {
+        if self.exact.is_some() {
+            return self.arch.dispatch(ExactSteps {
+                integrator: self,
+                steps,
+            });
+        }
         self.dispatch(Operation::Steps(steps));
+        Ok(())
     }
 
     /// `operation` compiled for the best SIMD level of this CPU, with the row's or the
@@ -503,7 +520,7 @@ impl<'m> Integrator<'m> {
         let half = 0.5 * dt;
         // q ← qₙ₊₁ and v ← v½ (central difference), or vₙ₊₁ (Tchamwa).
         let first_half = match self.layout.scheme {
-            Scheme::CentralDifference => (dt, half, half * dt),
+            Scheme::CentralDifference | Scheme::ExactModal => (dt, half, half * dt),
             Scheme::Tchamwa { phi } => (dt, dt, phi * dt * dt),
         };
         // The pins' rows (`v` and `a` have the walls' row of zeros after them).
@@ -535,7 +552,7 @@ impl<'m> Integrator<'m> {
         }
         recorder.track_deflection_peaks(layout, &state.level_deflections);
         let second_half = match layout.scheme {
-            Scheme::CentralDifference => half,
+            Scheme::CentralDifference | Scheme::ExactModal => half,
             Scheme::Tchamwa { .. } => 0.0,
         };
         let n = vectors;
@@ -658,6 +675,47 @@ impl<'m> Integrator<'m> {
     fn finish(self, steps: u64, output_interval: f64) -> Simulation {
         self.recorder
             .finish(self.arch, &self.layout, &self.state, steps, output_interval)
+    }
+}
+
+/// Steps of the exact modal scheme ([`exact::step`]) as a [`pulp::WithSimd`] operation.
+struct ExactSteps<'a, 'm> {
+    integrator: &'a mut Integrator<'m>,
+    steps: std::ops::RangeInclusive<u64>,
+}
+
+impl pulp::WithSimd for ExactSteps<'_, '_> {
+    type Output = Result<(), SimulationError>;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> Self::Output {
+        let Integrator {
+            layout,
+            state,
+            recorder,
+            exact,
+            ..
+        } = self.integrator;
+        let run = exact.as_mut().expect("an exact run has its data");
+        let half = 0.5 * layout.dt;
+        for n in self.steps {
+            match exact::step(simd, (layout, state, recorder), run, n) {
+                Ok(powers) => recorder.add_powers(half, powers),
+                Err(failure) => {
+                    return Err(SimulationError::Diverged {
+                        time: n as f64 * layout.dt,
+                        detail: format!(
+                            "the implicit contact solve did not converge in {} iterations ({} contacts)",
+                            exact::MAX_ITERATIONS,
+                            failure.contacts
+                        ),
+                        time_step: layout.dt,
+                        critical_time_step: layout.step.critical_time_step,
+                    });
+                }
+            }
+        }
+        Ok(())
     }
 }
 
