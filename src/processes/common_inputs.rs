@@ -740,7 +740,17 @@ pub fn resolve_step(
 ) -> Result<crate::physics::integrate::StepSize, InvalidInputs> {
     use crate::physics::integrate::{Plan, SimulationError};
     Plan::new(model, settings).map(|plan| *plan.step()).map_err(|e| {
-        let field = match e {
+        let field = match &e {
+            // What the scheme cannot integrate (the plane, moving walls, friction under
+            // `exact_modal`) is the scheme's fault.
+            SimulationError::InvalidSettings(issues) if issues.iter().all(|i| i.field == "scheme") => {
+                return InvalidInputs(
+                    issues
+                        .iter()
+                        .map(|i| FieldError::new("/inputs/solver/scheme", i.reason.clone()))
+                        .collect(),
+                );
+            }
             SimulationError::InvalidModel(_) | SimulationError::InvalidSettings(_) => "/inputs",
             _ => "/inputs/solver/time_step",
         };
