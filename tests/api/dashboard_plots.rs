@@ -601,7 +601,10 @@ async fn the_job_list_fits_1280_px_shows_where_a_failed_run_stopped_and_hides_sw
     assert_eq!(form["stiffness"], "N/m");
     assert_eq!(form["damping_ratio"], "dimensionless");
     assert_eq!(form["scheme"], "SELECT");
-    assert_eq!(form["schemes"], json!(["central_difference", "tchamwa"]));
+    assert_eq!(
+        form["schemes"],
+        json!(["central_difference", "tchamwa", "exact_modal"])
+    );
     assert_eq!(form["section"], "SELECT");
     // Another section type offers its own members, empty, and keeps the form's JSON valid.
     browser

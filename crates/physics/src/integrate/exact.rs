@@ -40,14 +40,16 @@
 
 use pulp::Simd;
 
-use super::kernels::{self, ContactState};
+use super::kernels;
 use super::layout::Layout;
 use super::recorder::{Powers, Recorder, record_closed_contact};
 use super::state::State;
 use crate::contact::NormalLaw;
 
 /// Newton iterations of the contact solve before it gives up.
-pub(super) const MAX_ITERATIONS: usize = 60;
+pub(super) const MAX_ITERATIONS: usize = 80;
+/// Iterations of the contact solve after which one contact changes side per iterate.
+const SINGLE_CHANGES_AFTER: usize = 20;
 /// Terms of the Taylor series of the scaled exponential (its norm is at most 1/4).
 const TAYLOR_TERMS: usize = 20;
 
@@ -153,6 +155,8 @@ fn product(a: &[[f64; 4]; 4], b: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
 #[derive(Debug, Clone, Copy)]
 struct LaneBodies {
     lane: usize,
+    /// The first line it touches (its place in the banded Newton system).
+    order: usize,
     level: usize,
     left: Option<usize>,
     right: Option<usize>,
@@ -176,19 +180,26 @@ impl LaneBodies {
 /// of the basis between contact levels over a step, and the loads the next step starts
 /// from.
 pub(super) struct ExactRun {
-    /// Per entry of a row (padded modes have ω = 0 and ψ = 0, and stay 0).
-    propagators: Vec<Propagator>,
+    /// Per entry of a row (padded modes have ω = 0 and ψ = 0, and stay 0), the
+    /// propagator's coefficients one array each (`q[k][i]`: mode i's coefficient k of
+    /// its position), so that the updates run in vectors.
+    q_coefficients: [Vec<f64>; 4],
+    v_coefficients: [Vec<f64>; 4],
     /// G(l, l') and G'(l, l') over one step (levels × levels).
     levels: usize,
     flexibility: Vec<f64>,
     rate_flexibility: Vec<f64>,
-    /// The contacts that can push, by lane.
+    /// Every contact, by lane (one that cannot push never does: its law gives 0).
     contacts: Vec<LaneBodies>,
     /// Contact and point loads on each line's modes at the current time (lines × row),
     /// the next step's, and the contact part of the next step's.
     loads: Vec<f64>,
     next_loads: Vec<f64>,
     contact_loads: Vec<f64>,
+    /// Whether some law reads the penetration rate, and then the predicted velocities
+    /// at the levels (laid out as the level deflections).
+    rates: bool,
+    level_velocities: Vec<f64>,
     solve: ContactSolve,
 }
 
@@ -227,11 +238,14 @@ impl ExactRun {
             .lane_contacts
             .iter()
             .enumerate()
-            .filter(|(lane, contact)| {
-                layout.contacts.contact[*lane] != kernels::ContactLanes::EMPTY && contact.active
-            })
+            .filter(|(lane, _)| layout.contacts.contact[*lane] != kernels::ContactLanes::EMPTY)
             .map(|(lane, contact)| LaneBodies {
                 lane,
+                order: line(contact.left)
+                    .into_iter()
+                    .chain(line(contact.right))
+                    .min()
+                    .unwrap_or(0),
                 level: contact.shape / vectors,
                 left: line(contact.left),
                 right: line(contact.right),
@@ -239,12 +253,17 @@ impl ExactRun {
             })
             .collect();
         let size = loads.len();
+        let rates = contacts.iter().any(|c| c.law.needs_rate());
+        let column = |get: &dyn Fn(&Propagator) -> f64| propagators.iter().map(get).collect::<Vec<f64>>();
         Self {
-            propagators,
+            rates,
+            level_velocities: vec![0.0; layout.level_deflections_len()],
+            q_coefficients: [0, 1, 2, 3].map(|k| column(&|p: &Propagator| p.q[k])),
+            v_coefficients: [0, 1, 2, 3].map(|k| column(&|p: &Propagator| p.v[k])),
             levels,
             flexibility,
             rate_flexibility,
-            solve: ContactSolve::new(contacts.len(), layout.lines * levels),
+            solve: ContactSolve::new(contacts.len(), (layout.lines, levels)),
             contacts,
             loads,
             next_loads: vec![0.0; size],
@@ -268,40 +287,74 @@ impl ExactRun {
     }
 }
 
+/// What a contact does in an iterate of the contact solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Side {
+    /// No force.
+    Open,
+    /// Penetrating and pushing: F = law(δ, δ̇) > 0.
+    Pushing,
+    /// Just touching at the step's end (δ = 0) with 0 ≤ F ≤ law(0⁺, δ̇): where the
+    /// dashpot makes the law jump at δ = 0 (c δ̇ at once), the step may end with the
+    /// contact held exactly at touch by a force within that jump (the set-valued law's
+    /// solution; no other exists there).
+    Touching,
+}
+
 /// Scratch of the implicit contact solve, per contact of [`ExactRun::contacts`].
 struct ContactSolve {
-    /// Predicted penetration and rate (no contact force at the step's end).
+    /// Predicted penetration and rate (no contact force at the step's end; the rate
+    /// NaN until needed).
     predicted: Vec<f64>,
     predicted_rate: Vec<f64>,
     /// Forces of the iterate, the penetrations and rates they give.
     force: Vec<f64>,
     penetration: Vec<f64>,
     rate: Vec<f64>,
-    /// The contacts that push in the iterate, the previous iterate's, and the Newton
-    /// system on them.
-    pushing: Vec<usize>,
-    previous: Vec<usize>,
+    /// Each contact's side in the iterate, kept from one step to the next (the next
+    /// step starts from it).
+    side: Vec<Side>,
+    /// The contacts with a force in the iterate, those not open in the next one, and
+    /// the contacts whose side is wrong.
+    loaded: Vec<usize>,
+    active: Vec<usize>,
+    wrong: Vec<(usize, Side)>,
+    /// Per contact, whether it is in the Newton system; the system, and a copy of it
+    /// for the pivoted solve.
+    in_system: Vec<bool>,
     matrix: Vec<f64>,
     right: Vec<f64>,
+    backup: (Vec<f64>, Vec<f64>),
+    /// Per contact of the system, the law's tangent (∂F/∂δ, ∂F/∂δ̇) (K, 0 for a touching
+    /// one); per line, the system's contacts on it and their sign.
+    factors: Vec<(f64, f64)>,
+    by_line: Vec<Vec<(usize, f64)>>,
     /// Per line and level: the deflection and velocity the iterate's forces add.
     shift: Vec<f64>,
     rate_shift: Vec<f64>,
 }
 
 impl ContactSolve {
-    fn new(contacts: usize, lines_by_levels: usize) -> Self {
+    fn new(contacts: usize, (lines, levels): (usize, usize)) -> Self {
+        let lines_by_levels = lines * levels;
         Self {
-            shift: vec![0.0; lines_by_levels],
-            rate_shift: vec![0.0; lines_by_levels],
             predicted: vec![0.0; contacts],
             predicted_rate: vec![0.0; contacts],
             force: vec![0.0; contacts],
             penetration: vec![0.0; contacts],
             rate: vec![0.0; contacts],
-            pushing: Vec::with_capacity(contacts),
-            previous: Vec::with_capacity(contacts),
+            side: vec![Side::Open; contacts],
+            loaded: Vec::with_capacity(contacts),
+            active: Vec::with_capacity(contacts),
+            wrong: Vec::with_capacity(contacts),
+            in_system: vec![false; contacts],
             matrix: Vec::new(),
             right: Vec::new(),
+            backup: (Vec::new(), Vec::new()),
+            factors: Vec::new(),
+            by_line: vec![Vec::new(); lines],
+            shift: vec![0.0; lines_by_levels],
+            rate_shift: vec![0.0; lines_by_levels],
         }
     }
 }
@@ -340,6 +393,11 @@ pub(super) fn step<S: Simd>(
     let base = |time: f64| model.base_acceleration.as_ref().map_or(0.0, |b| b.at(time));
     let (base0, base1) = (base(t0), base(t));
     // Every mode without contact force at the step's end.
+    let ([q0, q1, q2, q3], [v0, v1, v2, v3]) = (&run.q_coefficients, &run.v_coefficients);
+    // One length for every row, so that the loop runs in vectors without bounds checks.
+    let (q0, q1, q2, q3) = (&q0[..row], &q1[..row], &q2[..row], &q3[..row]);
+    let (v0, v1, v2, v3) = (&v0[..row], &v1[..row], &v2[..row], &v3[..row]);
+    let gamma = &layout.participation[..row];
     for (((q, v), (f0, f1)), _) in state
         .q
         .chunks_exact_mut(row)
@@ -347,13 +405,12 @@ pub(super) fn step<S: Simd>(
         .zip(run.loads.chunks_exact(row).zip(run.next_loads.chunks_exact(row)))
         .zip(0..layout.lines)
     {
+        let (q, v, f0, f1) = (&mut q[..row], &mut v[..row], &f0[..row], &f1[..row]);
         for i in 0..row {
-            let p = &run.propagators[i];
-            let gamma = layout.participation[i];
-            let (load0, load1) = (f0[i] - gamma * base0, f1[i] - gamma * base1);
+            let (load0, load1) = (f0[i] - gamma[i] * base0, f1[i] - gamma[i] * base1);
             let (qi, vi) = (q[i], v[i]);
-            q[i] = p.q[0] * qi + p.q[1] * vi + p.q[2] * load0 + p.q[3] * load1;
-            v[i] = p.v[0] * qi + p.v[1] * vi + p.v[2] * load0 + p.v[3] * load1;
+            q[i] = q0[i] * qi + q1[i] * vi + q2[i] * load0 + q3[i] * load1;
+            v[i] = v0[i] * qi + v1[i] * vi + v2[i] * load0 + v3[i] * load1;
         }
     }
     // The predicted penetrations and rates of the contacts that can push.
@@ -366,17 +423,32 @@ pub(super) fn step<S: Simd>(
         deflections,
         layout.stride,
     );
+    // The velocities at the levels too, where a law reads the rate.
+    if run.rates {
+        kernels::level_deflections(
+            simd,
+            &layout.grouped_level_shapes,
+            row,
+            &state.v[..layout.lines * row],
+            S::as_mut_simd_f64s(&mut run.level_velocities).0,
+            layout.stride,
+        );
+    }
     let lanes = layout.lanes;
-    let levels = &state.level_deflections;
-    let at = |vector: u32, k: usize| levels[vector as usize * lanes + k];
+    let (levels, velocities) = (&state.level_deflections, &run.level_velocities);
+    let at = |values: &[f64], vector: u32, k: usize| values[vector as usize * lanes + k];
     let solve = &mut run.solve;
     for (c, contact) in run.contacts.iter().enumerate() {
         let (group, k) = (contact.lane / lanes, contact.lane % lanes);
         let (left, right) = (layout.contacts.left[group], layout.contacts.right[group]);
-        solve.predicted[c] = at(left, k) - at(right, k) - layout.gaps[contact.lane];
-        solve.predicted_rate[c] = f64::NAN;
+        solve.predicted[c] = at(levels, left, k) - at(levels, right, k) - layout.gaps[contact.lane];
+        solve.predicted_rate[c] = if run.rates {
+            at(velocities, left, k) - at(velocities, right, k)
+        } else {
+            0.0
+        };
     }
-    contact_forces(simd, layout, state, run)?;
+    contact_forces(run)?;
     // The contacts' loads, into the modes and the next step's loads.
     let run_contacts = &run.contacts;
     run.contact_loads.fill(0.0);
@@ -404,46 +476,45 @@ pub(super) fn step<S: Simd>(
         )
         .zip(0..layout.lines)
     {
+        let ([.., q3], [.., v3]) = (&run.q_coefficients, &run.v_coefficients);
+        let (q3, v3, q, v) = (&q3[..row], &v3[..row], &mut q[..row], &mut v[..row]);
+        let (loads, next) = (&loads[..row], &mut next[..row]);
         for i in 0..row {
-            let p = &run.propagators[i];
-            q[i] += p.q[3] * loads[i];
-            v[i] += p.v[3] * loads[i];
+            q[i] += q3[i] * loads[i];
+            v[i] += v3[i] * loads[i];
             next[i] += loads[i];
         }
     }
     std::mem::swap(&mut run.loads, &mut run.next_loads);
-    // The step's end as the other schemes record it: level deflections, penetrations
-    // (with their running maxima and the closed lanes), forces, statistics, powers.
-    let deflections = S::as_mut_simd_f64s(&mut state.level_deflections).0;
-    kernels::level_deflections(
-        simd,
-        &layout.grouped_level_shapes,
-        row,
-        &state.q,
-        deflections,
-        layout.stride,
-    );
-    std::mem::swap(&mut state.penetration, &mut state.previous_penetration);
-    let count = kernels::penetrations(
-        simd,
-        &layout.contacts,
-        S::as_simd_f64s(&state.level_deflections).0,
-        &layout.gaps,
-        ContactState {
-            now: &mut state.penetration,
-            max: &mut recorder.max_penetration,
-            closed: &mut state.closed,
-            closed_groups: &mut state.closed_groups,
-        },
-    );
-    state.closed_count = count;
+    // The step's end as the other schemes record it: the level deflections (the
+    // predicted ones moved by the forces, as the solve found them), penetrations with
+    // their running maxima and the closed lanes, forces, statistics, powers.
     let solve = &run.solve;
+    let (lanes, stride, levels) = (layout.lanes, layout.stride, run.levels);
+    for (line, shift) in solve.shift.chunks_exact(levels).enumerate() {
+        for (level, moved) in shift.iter().enumerate() {
+            state.level_deflections[((level / lanes) * stride + 1 + line) * lanes + level % lanes] += moved;
+        }
+    }
+    std::mem::swap(&mut state.penetration, &mut state.previous_penetration);
+    let mut count = 0;
+    for (c, contact) in run.contacts.iter().enumerate() {
+        let (lane, penetration) = (contact.lane, solve.penetration[c]);
+        state.penetration[lane] = penetration;
+        let max = &mut recorder.max_penetration[lane];
+        *max = max.max(penetration);
+        if penetration > 0.0 {
+            state.closed[count] = lane as u32;
+            count += 1;
+        }
+    }
+    state.closed_count = count;
     let mut contact_damping = 0.0;
     for (c, contact) in run.contacts.iter().enumerate() {
         let lane = contact.lane;
         let force = solve.force[c];
         state.contact_force[lane] = force;
-        let penetration = state.penetration[lane];
+        let penetration = solve.penetration[c];
         if penetration <= 0.0 {
             continue;
         }
@@ -490,42 +561,30 @@ pub(super) fn step<S: Simd>(
 }
 
 /// The contact forces at the step's end (`run.solve.force`, with the penetrations and
-/// rates they give): F_c = law_c(δ_c, δ̇_c) where that pushes, 0 elsewhere, with
-/// δ = δ̃ − W F and δ̇ = δ̃̇ − W' F. Semismooth Newton: at each iterate, the contacts
-/// that push get a Newton step of F − law(δ(F), δ̇(F)) = 0 and the others F = 0; it
-/// stops when the residual is at rounding level (for the linear law, one solve per
-/// change of the set that pushes).
-#[inline(always)]
-fn contact_forces<S: Simd>(
-    simd: S,
-    layout: &Layout<'_>,
-    state: &State,
-    run: &mut ExactRun,
-) -> Result<(), NotConverged> {
-    let row = layout.row;
+/// rates they give), with δ = δ̃ − W F and δ̇ = δ̃̇ − W' F: each contact open (F = 0),
+/// pushing (F = law(δ, δ̇) > 0 with δ > 0) or touching (δ = 0, 0 ≤ F ≤ law(0⁺, δ̇)).
+/// An active-set Newton iteration: each iterate puts every contact on the side its
+/// penetration and force ask for, then takes a Newton step of the equations of those
+/// sides (one linear solve per change of sides for the linear law); it stops when every
+/// side holds and the residual is at rounding level. From
+/// [`SINGLE_CHANGES_AFTER`] iterations on, one contact changes side per iterate (the
+/// first in order), which ends the cycles simultaneous changes can fall into. Each
+/// step starts from the sides the last one ended with.
+fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
+    let levels = run.levels;
     let contacts = &run.contacts;
-    let mut solve = std::mem::replace(&mut run.solve, ContactSolve::new(0, 0));
-    let rows = |line: Option<usize>| line.map(|line| &state.v[line * row..][..row]);
-    let predicted_rate = |contact: &LaneBodies| {
-        let shape = &layout.level_shapes[contact.level * row..][..row];
-        let side = |line| rows(line).map_or(0.0, |v| kernels::dot(simd, shape, v));
-        side(contact.left) - side(contact.right)
-    };
-    solve.force.fill(0.0);
-    solve.previous.clear();
+    let mut solve = std::mem::replace(&mut run.solve, ContactSolve::new(0, (0, 0)));
+    for &d in &solve.loaded {
+        solve.force[d] = 0.0;
+    }
+    solve.loaded.clear();
     let mut converged = false;
-    for _ in 0..MAX_ITERATIONS {
-        // δ and δ̇ of the iterate (only the pushing contacts of the last iterate have a
-        // force), and the contacts that push.
-        let mut largest: f64 = 0.0;
-        let mut residual: f64 = 0.0;
-        solve.pushing.clear();
+    for iteration in 0..MAX_ITERATIONS {
         // The iterate's forces move each pin at each level by Σ ∓F G(l, l_d) (and its
         // velocity by G'): every contact's penetration then reads two of these.
         solve.shift.fill(0.0);
         solve.rate_shift.fill(0.0);
-        let levels = run.levels;
-        for &d in &solve.previous {
+        for &d in &solve.loaded {
             let (source, force) = (&contacts[d], solve.force[d]);
             let g = &run.flexibility[source.level * levels..][..levels];
             let g_rate = &run.rate_flexibility[source.level * levels..][..levels];
@@ -544,42 +603,122 @@ fn contact_forces<S: Simd>(
             let at = |line: Option<usize>| line.map_or(0.0, |line| shift[line * levels + contact.level]);
             at(contact.left) - at(contact.right)
         };
+        // Each contact's side, and the residual of its equation. An open contact whose
+        // predicted penetration is below −2 × the largest shift cannot close: skipped
+        // (its penetration is read once the solve is done).
+        let reach = -2.0 * solve.shift.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+        let (mut scale, mut residual): (f64, f64) = (0.0, 0.0);
+        solve.wrong.clear();
         for (c, contact) in contacts.iter().enumerate() {
+            let side = solve.side[c];
+            if side == Side::Open && solve.predicted[c] < reach {
+                continue;
+            }
             let penetration = solve.predicted[c] + moved(&solve.shift, contact);
             solve.penetration[c] = penetration;
-            let mut target = 0.0;
-            if penetration > 0.0 {
-                let rate = if contact.law.needs_rate() {
-                    if solve.predicted_rate[c].is_nan() {
-                        solve.predicted_rate[c] = predicted_rate(contact);
-                    }
-                    solve.predicted_rate[c] + moved(&solve.rate_shift, contact)
-                } else {
-                    0.0
-                };
-                solve.rate[c] = rate;
-                target = contact.law.force(penetration, rate).force.max(0.0);
-                if target > 0.0 {
-                    solve.pushing.push(c);
-                }
+            let force = solve.force[c];
+            let rate = if contact.law.needs_rate() && (penetration > 0.0 || side != Side::Open) {
+                solve.predicted_rate[c] + moved(&solve.rate_shift, contact)
             } else {
-                solve.rate[c] = f64::NAN;
+                0.0
+            };
+            solve.rate[c] = rate;
+            let law = if penetration > 0.0 {
+                contact.law.force(penetration, rate).force
+            } else {
+                0.0
+            };
+            let touch = contact.law.force(0.0, rate).force;
+            let wanted = match side {
+                Side::Open if penetration > 0.0 && law > 0.0 => Side::Pushing,
+                Side::Open => Side::Open,
+                Side::Pushing if penetration <= 0.0 && touch > 0.0 => Side::Touching,
+                Side::Pushing if penetration <= 0.0 || law <= 0.0 => Side::Open,
+                Side::Pushing => {
+                    residual = residual.max((force - law).abs());
+                    Side::Pushing
+                }
+                Side::Touching if touch <= 0.0 || force < 0.0 => Side::Open,
+                Side::Touching if force > touch => Side::Pushing,
+                Side::Touching => {
+                    residual = residual.max((contact.law.stiffness * penetration).abs());
+                    Side::Touching
+                }
+            };
+            scale = scale.max(force.abs()).max(law);
+            if wanted != side {
+                solve.wrong.push((c, wanted));
             }
-            largest = largest.max(target).max(solve.force[c]);
-            residual = residual.max((solve.force[c] - target).abs());
         }
-        if residual <= 1e-11 * largest {
+        if solve.wrong.is_empty() && residual <= 1e-11 * scale {
             converged = true;
+            for (c, contact) in contacts.iter().enumerate() {
+                if solve.side[c] == Side::Open && solve.predicted[c] < reach {
+                    solve.penetration[c] = solve.predicted[c] + moved(&solve.shift, contact);
+                    solve.rate[c] = 0.0;
+                }
+            }
             break;
         }
-        // The Newton step on the pushing contacts; the others drop to 0.
-        let m = solve.pushing.len();
+        // Every wrong side changed, or the first only once simultaneous changes have
+        // had their chance.
+        let changes = if iteration < SINGLE_CHANGES_AFTER {
+            solve.wrong.len()
+        } else {
+            solve.wrong.len().min(1)
+        };
+        for &(c, side) in &solve.wrong[..changes] {
+            solve.side[c] = side;
+        }
+        // The Newton step on the contacts not open; the others drop to 0.
+        // In the order of the pins they touch, so that the system is banded (contacts
+        // couple only through a pin they share).
+        solve.active.clear();
+        solve
+            .active
+            .extend((0..contacts.len()).filter(|&c| solve.side[c] != Side::Open));
+        solve.active.sort_by_key(|&c| contacts[c].order);
+        for &c in &solve.active {
+            solve.in_system[c] = true;
+        }
+        let m = solve.active.len();
         solve.matrix.clear();
         solve.matrix.resize(m * m, 0.0);
         solve.right.clear();
-        for (a, &c) in solve.pushing.iter().enumerate() {
+        solve.factors.clear();
+        // Per line, the system's contacts on it with their sign (+1 on the left pin).
+        for list in &mut solve.by_line {
+            list.clear();
+        }
+        for (a, &c) in solve.active.iter().enumerate() {
             let contact = &contacts[c];
-            let (stiffness, damping) = contact.law.tangent(solve.penetration[c], solve.rate[c]);
+            if let Some(line) = contact.left {
+                solve.by_line[line].push((a, 1.0));
+            }
+            if let Some(line) = contact.right {
+                solve.by_line[line].push((a, -1.0));
+            }
+        }
+        for (a, &c) in solve.active.iter().enumerate() {
+            let contact = &contacts[c];
+            let (penetration, rate, force) = (solve.penetration[c], solve.rate[c], solve.force[c]);
+            // A pushing contact's row: F − law(δ(F), δ̇(F)) = 0, linearised; a touching
+            // one's: K δ(F) = 0.
+            let (stiffness, damping, mut right) = match solve.side[c] {
+                Side::Pushing => {
+                    let (k, g) = contact.law.tangent(penetration.max(0.0), rate);
+                    let law = contact.law.force(penetration.max(0.0), rate).force;
+                    (k, g, law - force)
+                }
+                _ => {
+                    let k = if contact.law.stiffness > 0.0 {
+                        contact.law.stiffness
+                    } else {
+                        1.0
+                    };
+                    (k, 0.0, k * penetration)
+                }
+            };
             let jacobian = |d: usize| {
                 let other = &contacts[d];
                 stiffness * run.coupling(contact, other, false)
@@ -589,28 +728,49 @@ fn contact_forces<S: Simd>(
                         0.0
                     }
             };
-            let target = contact.law.force(solve.penetration[c], solve.rate[c]).force;
-            let mut right = target - solve.force[c];
-            for &d in &solve.previous {
-                if solve.pushing.binary_search(&d).is_err() {
+            for &d in &solve.loaded {
+                if !solve.in_system[d] {
                     right += jacobian(d) * solve.force[d];
                 }
             }
             solve.right.push(right);
-            for (b, &d) in solve.pushing.iter().enumerate() {
-                solve.matrix[a * m + b] = jacobian(d) + if a == b { 1.0 } else { 0.0 };
+            solve.factors.push((stiffness, damping));
+            if solve.side[c] == Side::Pushing {
+                solve.matrix[a * m + a] = 1.0;
             }
         }
-        solve_dense(&mut solve.matrix, &mut solve.right, m);
-        for &d in &solve.previous {
-            if solve.pushing.binary_search(&d).is_err() {
+        // J_ab += (k_a G(l_a, l_b) + γ_a G'(l_a, l_b)) s_a s_b over the lines both
+        // touch: W = Σ_lines, assembled line by line (contacts couple only there).
+        let mut band = 0;
+        for list in &solve.by_line {
+            for &(a, sign_a) in list {
+                let (stiffness, damping) = solve.factors[a];
+                let level = contacts[solve.active[a]].level * levels;
+                let (g, g_rate) = (
+                    &run.flexibility[level..][..levels],
+                    &run.rate_flexibility[level..][..levels],
+                );
+                for &(b, sign_b) in list {
+                    let other = contacts[solve.active[b]].level;
+                    let value = stiffness * g[other] + damping * g_rate[other];
+                    solve.matrix[a * m + b] += sign_a * sign_b * value;
+                    band = band.max(a.abs_diff(b));
+                }
+            }
+        }
+        solve_banded(&mut solve.matrix, &mut solve.right, (m, band), &mut solve.backup);
+        for &d in &solve.loaded {
+            if !solve.in_system[d] {
                 solve.force[d] = 0.0;
             }
         }
-        for (a, &c) in solve.pushing.iter().enumerate() {
+        for &c in &solve.active {
+            solve.in_system[c] = false;
+        }
+        for (a, &c) in solve.active.iter().enumerate() {
             solve.force[c] += solve.right[a];
         }
-        std::mem::swap(&mut solve.previous, &mut solve.pushing);
+        std::mem::swap(&mut solve.loaded, &mut solve.active);
     }
     let count = contacts.len();
     run.solve = solve;
@@ -618,6 +778,56 @@ fn contact_forces<S: Simd>(
         Ok(())
     } else {
         Err(NotConverged { contacts: count })
+    }
+}
+
+/// Solves the m × m system `matrix` x = `right` in place (x in `right`) by Gaussian
+/// elimination within its band, without pivoting: the contacts are ordered by the pins
+/// they touch and couple only through a shared pin, so the band is a few pins' contacts
+/// wide, and the system (K⁻¹ + W scaled by K, W the basis's flexibility between the
+/// contacts) does not need pivots. Should a pivot still be tiny against its row, the
+/// system is solved again from `backup` with partial pivoting over the whole matrix.
+fn solve_banded(
+    matrix: &mut [f64],
+    right: &mut [f64],
+    (m, band): (usize, usize),
+    backup: &mut (Vec<f64>, Vec<f64>),
+) {
+    backup.0.clear();
+    backup.0.extend_from_slice(matrix);
+    backup.1.clear();
+    backup.1.extend_from_slice(right);
+    for k in 0..m {
+        let end = m.min(k + band + 1);
+        let diagonal = matrix[k * m + k];
+        let size = matrix[k * m..k * m + end]
+            .iter()
+            .fold(0.0_f64, |a, x| a.max(x.abs()));
+        if diagonal.abs() <= 1e-10 * size || diagonal.is_nan() {
+            matrix.copy_from_slice(&backup.0);
+            right.copy_from_slice(&backup.1);
+            solve_dense(matrix, right, m);
+            return;
+        }
+        let (pivot_row, rest) = matrix[k * m..].split_at_mut(m);
+        for i in k + 1..end {
+            let row = &mut rest[(i - k - 1) * m..][..m];
+            let factor = row[k] / diagonal;
+            if factor != 0.0 {
+                for j in k..end {
+                    row[j] -= factor * pivot_row[j];
+                }
+                right[i] -= factor * right[k];
+            }
+        }
+    }
+    for k in (0..m).rev() {
+        let end = m.min(k + band + 1);
+        let mut value = right[k];
+        for j in k + 1..end {
+            value -= matrix[k * m + j] * right[j];
+        }
+        right[k] = value / matrix[k * m + k];
     }
 }
 
