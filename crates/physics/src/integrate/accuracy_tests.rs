@@ -28,6 +28,7 @@ struct Row {
     modes: usize,
     excitation: BaseAcceleration,
     duration: f64,
+    scheme: Scheme,
 }
 
 impl Row {
@@ -48,6 +49,7 @@ impl Row {
                 cycles: 100.0,
             },
             duration: 0.3,
+            scheme: Scheme::CentralDifference,
         }
     }
 
@@ -105,7 +107,7 @@ impl Row {
 
     fn settings(&self, time_step: TimeStep) -> Settings {
         Settings {
-            scheme: Scheme::CentralDifference,
+            scheme: self.scheme,
             time_step,
             tolerance: DEFAULT_TOLERANCE,
             check: Check::None,
@@ -207,12 +209,27 @@ fn limit(model: &Model<'_>, row: &Row, h: f64) -> (f64, f64) {
     )
 }
 
+/// Each case with central difference, then with the exact modal scheme (named so).
+fn both_schemes(rows: Vec<(&'static str, Row)>) -> Vec<(String, Row)> {
+    let exact = rows.iter().map(|(name, row)| {
+        (
+            format!("{name} (exact_modal)"),
+            Row {
+                scheme: Scheme::ExactModal,
+                ..row.clone()
+            },
+        )
+    });
+    let explicit = rows.iter().map(|(name, row)| (name.to_string(), row.clone()));
+    explicit.chain(exact).collect()
+}
+
 /// Over the whole run, chaotic rattling included, the energy balance of an `auto` run
 /// closes within the default tolerance: energy is neither created nor lost by the
 /// scheme beyond 1e-3 of the energy involved.
 #[test]
 fn auto_closes_the_energy_balance_within_the_tolerance() {
-    for (name, row) in realistic_rows() {
+    for (name, row) in both_schemes(realistic_rows()) {
         let basis = row.basis();
         let model = row.model(&basis);
         let assessed = run_at(&model, &row, TimeStep::Auto, Check::None);
@@ -271,7 +288,7 @@ fn assert_no_step_reason(name: &str, quality: &Quality) {
 /// factor 3 of the true error.
 #[test]
 fn auto_peaks_are_within_one_percent_of_the_limit_and_the_check_estimates_the_error() {
-    for (name, row) in realistic_rows() {
+    for (name, row) in both_schemes(realistic_rows()) {
         let row = shock_window(row);
         let basis = row.basis();
         let model = row.model(&basis);
@@ -290,8 +307,8 @@ fn auto_peaks_are_within_one_percent_of_the_limit_and_the_check_estimates_the_er
             "{name}: peak deflection {displacement:.6e} m vs limit {limit_displacement:.6e} m"
         );
         let check = assessed.quality.step_halving.as_ref().expect("the check ran");
-        assert_estimates(name, check.estimated_peak_force_error, error);
-        assert_no_step_reason(name, &assessed.quality);
+        assert_estimates(&name, check.estimated_peak_force_error, error);
+        assert_no_step_reason(&name, &assessed.quality);
         if assessed.quality.reasons.is_empty() {
             assert_eq!(assessed.quality.verdict, Verdict::Good, "{name}");
         }
