@@ -441,8 +441,7 @@ pub enum SchemeInput {
     /// Every mode propagated exactly over the step, the contact forces implicit (second
     /// order, no stability limit: the step follows the contacts and the excitation, not
     /// the top of the basis, so more modes and the static correction do not shorten it).
-    /// Pins bending in one plane (`bundle-dynamics`, `cantilever-impact`), no walls
-    /// with their own motion.
+    /// Every process; not with friction nor with walls that have their own motion.
     ExactModal,
 }
 

@@ -38,7 +38,7 @@ pub enum Scheme {
     /// damps high frequencies.
     Tchamwa { phi: f64 },
     /// Every mode propagated exactly over the step, the contact forces implicit
-    /// (`crate::integrate`'s `exact` module): second order, no stability limit; the step
+    /// (`crate::integrate`'s `exact` module; no friction, no walls with their own motion): second order, no stability limit; the step
     /// resolves the contacts and the excitation, not the top of the basis.
     ExactModal,
 }

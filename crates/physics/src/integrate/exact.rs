@@ -34,14 +34,18 @@
 //! **Energy.** The dissipated and external works are integrated by the trapezoidal rule
 //! on the powers at the step ends, as in the other schemes; the balance holds to O(h²).
 //!
-//! What it does not do (refused up front, [`super::Settings::validate`] and
-//! [`super::Model::validate`]): the plane (the hexagonal bundle), walls with their own
-//! motion, friction.
+//! **The plane.** A contact reads each pin's x and y lines along its normal n:
+//! δ = n·(u_L − u_R) − gap, one term per line ([`Term`]); W couples two contacts through
+//! the lines they share with the product of their normal components, and the sliding
+//! velocity t·(u̇_L − u̇_R) (the wear work) comes from the same terms with t = (−n_y, n_x).
+//!
+//! What it does not do (refused up front at `scheme`, `Plan::new`): friction, walls
+//! with their own motion.
 
 use pulp::Simd;
 
 use super::kernels;
-use super::layout::Layout;
+use super::layout::{ContactModel, Layout};
 use super::recorder::{Powers, Recorder, record_closed_contact};
 use super::state::State;
 use crate::contact::NormalLaw;
@@ -149,30 +153,45 @@ fn product(a: &[[f64; 4]; 4], b: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
     c
 }
 
-/// Where a lane's contact acts: its level and the lines of its left and right pins
-/// (`None` for a wall), and its law. Empty lanes and contacts that cannot push are left
-/// out of the solve.
+/// One deflection line a contact reads: δ = Σ `normal` × w_line(z) − gap over its
+/// terms, and the sliding velocity v_t = Σ `tangent` × ẇ_line(z). The row: +1 on the
+/// left pin's line, −1 on the right one's; the plane: ±n_x on the x lines, ±n_y on the
+/// y lines (t = (−n_y, n_x)). A force F on the contact loads the line by −`normal` F ψ.
+#[derive(Debug, Clone, Copy, Default)]
+struct Term {
+    line: usize,
+    normal: f64,
+    tangent: f64,
+}
+
+/// A lane's contact: its level, the lines it reads (none for a wall) and its law.
 #[derive(Debug, Clone, Copy)]
 struct LaneBodies {
     lane: usize,
-    /// The first line it touches (its place in the banded Newton system).
+    /// The first pin it touches (its place in the banded Newton system).
     order: usize,
     level: usize,
-    left: Option<usize>,
-    right: Option<usize>,
+    terms: [Term; 4],
+    count: usize,
     law: NormalLaw,
 }
 
 impl LaneBodies {
-    /// Σ_b s_c(b) s_c'(b) over the pins both contacts touch.
+    fn terms(&self) -> &[Term] {
+        &self.terms[..self.count]
+    }
+
+    /// Σ over the lines both contacts read of the product of their normal coefficients.
     fn coupling(&self, other: &Self) -> f64 {
-        let sign = |line: Option<usize>, contact: &Self| match line {
-            None => 0.0,
-            Some(line) if contact.left == Some(line) => 1.0,
-            Some(line) if contact.right == Some(line) => -1.0,
-            Some(_) => 0.0,
-        };
-        sign(self.left, other) - sign(self.right, other)
+        let mut sum = 0.0;
+        for a in self.terms() {
+            for b in other.terms() {
+                if a.line == b.line {
+                    sum += a.normal * b.normal;
+                }
+            }
+        }
+        sum
     }
 }
 
@@ -233,27 +252,48 @@ impl ExactRun {
             }
         }
         let vectors = row / layout.lanes;
+        let pins = layout.model.pins;
         let line = |offset: usize| (offset != layout.wall_row).then_some(offset / vectors);
         let contacts: Vec<LaneBodies> = layout
             .lane_contacts
             .iter()
             .enumerate()
             .filter(|(lane, _)| layout.contacts.contact[*lane] != kernels::ContactLanes::EMPTY)
-            .map(|(lane, contact)| LaneBodies {
-                lane,
-                order: line(contact.left)
-                    .into_iter()
-                    .chain(line(contact.right))
-                    .min()
-                    .unwrap_or(0),
-                level: contact.shape / vectors,
-                left: line(contact.left),
-                right: line(contact.right),
-                law: layout.lane_laws[lane],
+            .map(|(lane, contact)| {
+                let (left, right) = (line(contact.left), line(contact.right));
+                // The row reads the x lines along +x; the plane each pin's x and y lines
+                // along its normal.
+                let [n_x, n_y] = match &layout.contact_model {
+                    ContactModel::Row => [1.0, 0.0],
+                    ContactModel::Plane(plane) => plane.lanes[lane].normal,
+                };
+                let mut terms = [Term::default(); 4];
+                let mut count = 0;
+                for (pin, side) in [(left, 1.0), (right, -1.0)] {
+                    let Some(pin) = pin else { continue };
+                    for (line, normal, tangent) in [(pin, n_x, -n_y), (pins + pin, n_y, n_x)] {
+                        if normal != 0.0 || (tangent != 0.0 && line < layout.lines) {
+                            terms[count] = Term {
+                                line,
+                                normal: side * normal,
+                                tangent: side * tangent,
+                            };
+                            count += 1;
+                        }
+                    }
+                }
+                LaneBodies {
+                    lane,
+                    order: left.into_iter().chain(right).min().unwrap_or(0),
+                    level: contact.shape / vectors,
+                    terms,
+                    count,
+                    law: layout.lane_laws[lane],
+                }
             })
             .collect();
         let size = loads.len();
-        let rates = contacts.iter().any(|c| c.law.needs_rate());
+        let rates = contacts.iter().any(|c| c.law.needs_rate()) || layout.model.plane.is_some();
         let column = |get: &dyn Fn(&Propagator) -> f64| propagators.iter().map(get).collect::<Vec<f64>>();
         Self {
             rates,
@@ -390,21 +430,32 @@ pub(super) fn step<S: Simd>(
             &mut run.next_loads[point.line * row..][..row],
         );
     }
-    let base = |time: f64| model.base_acceleration.as_ref().map_or(0.0, |b| b.at(time));
-    let (base0, base1) = (base(t0), base(t));
+    // The base acceleration along x, and along y in the plane (the y lines follow the x
+    // lines).
+    let base_y = model.plane.as_ref().and_then(|p| p.base_acceleration_y.as_ref());
+    let at = |base: Option<&crate::loads::BaseAcceleration>, time: f64| base.map_or(0.0, |b| b.at(time));
+    let bases = [
+        (
+            at(model.base_acceleration.as_ref(), t0),
+            at(model.base_acceleration.as_ref(), t),
+        ),
+        (at(base_y, t0), at(base_y, t)),
+    ];
+    let pins = model.pins;
     // Every mode without contact force at the step's end.
     let ([q0, q1, q2, q3], [v0, v1, v2, v3]) = (&run.q_coefficients, &run.v_coefficients);
     // One length for every row, so that the loop runs in vectors without bounds checks.
     let (q0, q1, q2, q3) = (&q0[..row], &q1[..row], &q2[..row], &q3[..row]);
     let (v0, v1, v2, v3) = (&v0[..row], &v1[..row], &v2[..row], &v3[..row]);
     let gamma = &layout.participation[..row];
-    for (((q, v), (f0, f1)), _) in state
+    for (((q, v), (f0, f1)), line) in state
         .q
         .chunks_exact_mut(row)
         .zip(state.v.chunks_exact_mut(row))
         .zip(run.loads.chunks_exact(row).zip(run.next_loads.chunks_exact(row)))
         .zip(0..layout.lines)
     {
+        let (base0, base1) = bases[usize::from(line >= pins)];
         let (q, v, f0, f1) = (&mut q[..row], &mut v[..row], &f0[..row], &f1[..row]);
         for i in 0..row {
             let (load0, load1) = (f0[i] - gamma[i] * base0, f1[i] - gamma[i] * base1);
@@ -434,19 +485,20 @@ pub(super) fn step<S: Simd>(
             layout.stride,
         );
     }
-    let lanes = layout.lanes;
+    let (lanes, stride) = (layout.lanes, layout.stride);
     let (levels, velocities) = (&state.level_deflections, &run.level_velocities);
-    let at = |values: &[f64], vector: u32, k: usize| values[vector as usize * lanes + k];
+    let offset = |line: usize, level: usize| ((level / lanes) * stride + 1 + line) * lanes + level % lanes;
     let solve = &mut run.solve;
     for (c, contact) in run.contacts.iter().enumerate() {
-        let (group, k) = (contact.lane / lanes, contact.lane % lanes);
-        let (left, right) = (layout.contacts.left[group], layout.contacts.right[group]);
-        solve.predicted[c] = at(levels, left, k) - at(levels, right, k) - layout.gaps[contact.lane];
-        solve.predicted_rate[c] = if run.rates {
-            at(velocities, left, k) - at(velocities, right, k)
-        } else {
-            0.0
+        let read = |values: &[f64]| {
+            contact
+                .terms()
+                .iter()
+                .map(|t| t.normal * values[offset(t.line, contact.level)])
+                .sum::<f64>()
         };
+        solve.predicted[c] = read(levels) - layout.gaps[contact.lane];
+        solve.predicted_rate[c] = if run.rates { read(velocities) } else { 0.0 };
     }
     contact_forces(run)?;
     // The contacts' loads, into the modes and the next step's loads.
@@ -458,11 +510,13 @@ pub(super) fn step<S: Simd>(
             continue;
         }
         let shape = &layout.level_shapes[contact.level * row..][..row];
-        if let Some(line) = contact.left {
-            kernels::axpy(simd, -force, shape, &mut run.contact_loads[line * row..][..row]);
-        }
-        if let Some(line) = contact.right {
-            kernels::axpy(simd, force, shape, &mut run.contact_loads[line * row..][..row]);
+        for term in contact.terms() {
+            kernels::axpy(
+                simd,
+                -term.normal * force,
+                shape,
+                &mut run.contact_loads[term.line * row..][..row],
+            );
         }
     }
     for (((q, v), (loads, next)), _) in state
@@ -490,7 +544,7 @@ pub(super) fn step<S: Simd>(
     // predicted ones moved by the forces, as the solve found them), penetrations with
     // their running maxima and the closed lanes, forces, statistics, powers.
     let solve = &run.solve;
-    let (lanes, stride, levels) = (layout.lanes, layout.stride, run.levels);
+    let levels = run.levels;
     for (line, shift) in solve.shift.chunks_exact(levels).enumerate() {
         for (level, moved) in shift.iter().enumerate() {
             state.level_deflections[((level / lanes) * stride + 1 + line) * lanes + level % lanes] += moved;
@@ -531,6 +585,20 @@ pub(super) fn step<S: Simd>(
         if force > recorder.force_peak[lane] {
             recorder.force_peak[lane] = force;
         }
+        if !recorder.wear.is_empty() {
+            // The sliding velocity at the step's end: the predicted level velocities
+            // moved by the forces (the plane's wear work ∫ F |v_t| dt).
+            let sliding: f64 = contact
+                .terms()
+                .iter()
+                .map(|term| {
+                    let at = offset(term.line, contact.level);
+                    term.tangent
+                        * (run.level_velocities[at] + solve.rate_shift[term.line * levels + contact.level])
+                })
+                .sum();
+            recorder.wear[lane] += force * sliding.abs() * h;
+        }
         record_closed_contact(
             (&mut recorder.statistics[lane], &mut recorder.impacts[lane]),
             (&recorder.impact_clock, &mut recorder.impact_log),
@@ -541,14 +609,15 @@ pub(super) fn step<S: Simd>(
     }
     recorder.resultants.track(layout, state, n);
     recorder.track_deflection_peaks(layout, &state.level_deflections);
-    let (mut modal_damping, mut participation_velocity) = (0.0, 0.0);
-    for v in state.v[..layout.lines * row].chunks_exact(row) {
+    let (mut modal_damping, mut external) = (0.0, 0.0);
+    for (line, v) in state.v[..layout.lines * row].chunks_exact(row).enumerate() {
+        let mut participation_velocity = 0.0;
         for i in 0..row {
             modal_damping += layout.damping[i] * v[i] * v[i];
             participation_velocity += layout.participation[i] * v[i];
         }
+        external -= bases[usize::from(line >= pins)].1 * participation_velocity;
     }
-    let mut external = -base1 * participation_velocity;
     for (point, shape) in model.point_forces.iter().zip(&layout.point_force_shapes) {
         let velocity = kernels::dot(simd, shape, &state.v[point.line * row..][..row]);
         external += point.force.at(t) * velocity;
@@ -588,20 +657,22 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
             let (source, force) = (&contacts[d], solve.force[d]);
             let g = &run.flexibility[source.level * levels..][..levels];
             let g_rate = &run.rate_flexibility[source.level * levels..][..levels];
-            for (line, sign) in [(source.left, -force), (source.right, force)] {
-                if let Some(line) = line {
-                    let shift = &mut solve.shift[line * levels..][..levels];
-                    let rate_shift = &mut solve.rate_shift[line * levels..][..levels];
-                    for l in 0..levels {
-                        shift[l] += sign * g[l];
-                        rate_shift[l] += sign * g_rate[l];
-                    }
+            for term in source.terms() {
+                let sign = -term.normal * force;
+                let shift = &mut solve.shift[term.line * levels..][..levels];
+                let rate_shift = &mut solve.rate_shift[term.line * levels..][..levels];
+                for l in 0..levels {
+                    shift[l] += sign * g[l];
+                    rate_shift[l] += sign * g_rate[l];
                 }
             }
         }
         let moved = |shift: &[f64], contact: &LaneBodies| {
-            let at = |line: Option<usize>| line.map_or(0.0, |line| shift[line * levels + contact.level]);
-            at(contact.left) - at(contact.right)
+            contact
+                .terms()
+                .iter()
+                .map(|t| t.normal * shift[t.line * levels + contact.level])
+                .sum::<f64>()
         };
         // Each contact's side, and the residual of its equation. An open contact whose
         // predicted penetration is below −2 × the largest shift cannot close: skipped
@@ -691,12 +762,8 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
             list.clear();
         }
         for (a, &c) in solve.active.iter().enumerate() {
-            let contact = &contacts[c];
-            if let Some(line) = contact.left {
-                solve.by_line[line].push((a, 1.0));
-            }
-            if let Some(line) = contact.right {
-                solve.by_line[line].push((a, -1.0));
+            for term in contacts[c].terms() {
+                solve.by_line[term.line].push((a, term.normal));
             }
         }
         for (a, &c) in solve.active.iter().enumerate() {

@@ -395,13 +395,6 @@ fn check(model: &Model<'_>, settings: &Settings) -> Result<(), SimulationError> 
     }
     let mut issues = settings.validate(model.basis.length(), model.contacts.len());
     if settings.scheme == crate::stability::Scheme::ExactModal {
-        if model.plane.is_some() {
-            issues.push(InputIssue::new(
-                "scheme",
-                "`exact_modal` integrates pins bending in one plane (the row and the cantilever); \
-                 for the hexagonal bundle use `central_difference`",
-            ));
-        }
         if model.walls.is_some() {
             issues.push(InputIssue::new(
                 "scheme",
