@@ -219,6 +219,8 @@ pub(super) struct ExactRun {
     /// at the levels (laid out as the level deflections).
     rates: bool,
     level_velocities: Vec<f64>,
+    /// Whether every law is linear (its Newton system then depends on the sides only).
+    linear: bool,
     solve: ContactSolve,
 }
 
@@ -294,9 +296,11 @@ impl ExactRun {
             .collect();
         let size = loads.len();
         let rates = contacts.iter().any(|c| c.law.needs_rate()) || layout.model.plane.is_some();
+        let linear = contacts.iter().all(|c| c.law.is_linear());
         let column = |get: &dyn Fn(&Propagator) -> f64| propagators.iter().map(get).collect::<Vec<f64>>();
         Self {
             rates,
+            linear,
             level_velocities: vec![0.0; layout.level_deflections_len()],
             q_coefficients: [0, 1, 2, 3].map(|k| column(&|p: &Propagator| p.q[k])),
             v_coefficients: [0, 1, 2, 3].map(|k| column(&|p: &Propagator| p.v[k])),
@@ -364,7 +368,11 @@ struct ContactSolve {
     in_system: Vec<bool>,
     matrix: Vec<f64>,
     right: Vec<f64>,
-    backup: (Vec<f64>, Vec<f64>),
+    backup: Vec<f64>,
+    /// The contacts and sides of the system whose factors `matrix` holds (empty when
+    /// it holds none), and its band.
+    factored: Vec<(usize, Side)>,
+    factored_band: usize,
     /// Per contact of the system, the law's tangent (∂F/∂δ, ∂F/∂δ̇) (K, 0 for a touching
     /// one); per line, the system's contacts on it and their sign.
     factors: Vec<(f64, f64)>,
@@ -390,7 +398,9 @@ impl ContactSolve {
             in_system: vec![false; contacts],
             matrix: Vec::new(),
             right: Vec::new(),
-            backup: (Vec::new(), Vec::new()),
+            backup: Vec::new(),
+            factored: Vec::new(),
+            factored_band: 0,
             factors: Vec::new(),
             by_line: vec![Vec::new(); lines],
             shift: vec![0.0; lines_by_levels],
@@ -638,7 +648,9 @@ pub(super) fn step<S: Simd>(
 /// side holds and the residual is at rounding level. From
 /// [`SINGLE_CHANGES_AFTER`] iterations on, one contact changes side per iterate (the
 /// first in order), which ends the cycles simultaneous changes can fall into. Each
-/// step starts from the sides the last one ended with.
+/// step starts from the sides the last one ended with. Inlined into the step, so that
+/// its loops (the banded elimination above all) are compiled for the step's SIMD level.
+#[inline(always)]
 fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
     let levels = run.levels;
     let contacts = &run.contacts;
@@ -753,8 +765,20 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
             solve.in_system[c] = true;
         }
         let m = solve.active.len();
-        solve.matrix.clear();
-        solve.matrix.resize(m * m, 0.0);
+        // With linear laws the system depends on the contacts and their sides only:
+        // the factors of the last system serve again while they are the same (a
+        // contact stays closed over many steps).
+        let reuse = run.linear
+            && solve.factored.len() == m
+            && solve
+                .factored
+                .iter()
+                .zip(&solve.active)
+                .all(|(&(c, side), &a)| c == a && side == solve.side[a]);
+        if !reuse {
+            solve.matrix.clear();
+            solve.matrix.resize(m * m, 0.0);
+        }
         solve.right.clear();
         solve.factors.clear();
         // Per line, the system's contacts on it with their sign (+1 on the left pin).
@@ -802,14 +826,14 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
             }
             solve.right.push(right);
             solve.factors.push((stiffness, damping));
-            if solve.side[c] == Side::Pushing {
+            if !reuse && solve.side[c] == Side::Pushing {
                 solve.matrix[a * m + a] = 1.0;
             }
         }
         // J_ab += (k_a G(l_a, l_b) + γ_a G'(l_a, l_b)) s_a s_b over the lines both
         // touch: W = Σ_lines, assembled line by line (contacts couple only there).
-        let mut band = 0;
-        for list in &solve.by_line {
+        let mut band = if reuse { solve.factored_band } else { 0 };
+        for list in solve.by_line.iter().filter(|_| !reuse) {
             for &(a, sign_a) in list {
                 let (stiffness, damping) = solve.factors[a];
                 let level = contacts[solve.active[a]].level * levels;
@@ -825,7 +849,23 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
                 }
             }
         }
-        solve_banded(&mut solve.matrix, &mut solve.right, (m, band), &mut solve.backup);
+        if reuse {
+            substitute_banded(&solve.matrix, &mut solve.right, (m, band));
+        } else {
+            solve.backup.clear();
+            solve.backup.extend_from_slice(&solve.matrix);
+            solve.factored.clear();
+            if factor_banded(&mut solve.matrix, (m, band)) {
+                substitute_banded(&solve.matrix, &mut solve.right, (m, band));
+                solve
+                    .factored
+                    .extend(solve.active.iter().map(|&c| (c, solve.side[c])));
+                solve.factored_band = band;
+            } else {
+                solve.matrix.copy_from_slice(&solve.backup);
+                solve_dense(&mut solve.matrix, &mut solve.right, m);
+            }
+        }
         for &d in &solve.loaded {
             if !solve.in_system[d] {
                 solve.force[d] = 0.0;
@@ -848,22 +888,13 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
     }
 }
 
-/// Solves the m × m system `matrix` x = `right` in place (x in `right`) by Gaussian
-/// elimination within its band, without pivoting: the contacts are ordered by the pins
-/// they touch and couple only through a shared pin, so the band is a few pins' contacts
-/// wide, and the system (K⁻¹ + W scaled by K, W the basis's flexibility between the
-/// contacts) does not need pivots. Should a pivot still be tiny against its row, the
-/// system is solved again from `backup` with partial pivoting over the whole matrix.
-fn solve_banded(
-    matrix: &mut [f64],
-    right: &mut [f64],
-    (m, band): (usize, usize),
-    backup: &mut (Vec<f64>, Vec<f64>),
-) {
-    backup.0.clear();
-    backup.0.extend_from_slice(matrix);
-    backup.1.clear();
-    backup.1.extend_from_slice(right);
+/// Factors the m × m system `matrix` in place as L U within its band (the multipliers
+/// below the diagonal), without pivoting: the contacts are ordered by the pins they
+/// touch and couple only through a shared pin, and the system (K⁻¹ + W scaled by K, W
+/// the basis's flexibility between the contacts) needs no pivots. False, and `matrix`
+/// spoilt, when a pivot is tiny against its row (the caller then solves with pivots).
+#[inline(always)]
+fn factor_banded(matrix: &mut [f64], (m, band): (usize, usize)) -> bool {
     for k in 0..m {
         let end = m.min(k + band + 1);
         let diagonal = matrix[k * m + k];
@@ -871,30 +902,41 @@ fn solve_banded(
             .iter()
             .fold(0.0_f64, |a, x| a.max(x.abs()));
         if diagonal.abs() <= 1e-10 * size || diagonal.is_nan() {
-            matrix.copy_from_slice(&backup.0);
-            right.copy_from_slice(&backup.1);
-            solve_dense(matrix, right, m);
-            return;
+            return false;
         }
         let (pivot_row, rest) = matrix[k * m..].split_at_mut(m);
+        let pivot_row = &pivot_row[..end];
         for i in k + 1..end {
-            let row = &mut rest[(i - k - 1) * m..][..m];
+            let row = &mut rest[(i - k - 1) * m..][..end];
             let factor = row[k] / diagonal;
+            row[k] = factor;
             if factor != 0.0 {
-                for j in k..end {
+                for j in k + 1..end {
                     row[j] -= factor * pivot_row[j];
                 }
-                right[i] -= factor * right[k];
             }
         }
+    }
+    true
+}
+
+/// Solves L U x = `right` in place with the factors of [`factor_banded`].
+#[inline(always)]
+fn substitute_banded(factors: &[f64], right: &mut [f64], (m, band): (usize, usize)) {
+    for i in 0..m {
+        let mut value = right[i];
+        for k in i.saturating_sub(band)..i {
+            value -= factors[i * m + k] * right[k];
+        }
+        right[i] = value;
     }
     for k in (0..m).rev() {
         let end = m.min(k + band + 1);
         let mut value = right[k];
         for j in k + 1..end {
-            value -= matrix[k * m + j] * right[j];
+            value -= factors[k * m + j] * right[j];
         }
-        right[k] = value / matrix[k * m + k];
+        right[k] = value / factors[k * m + k];
     }
 }
 
