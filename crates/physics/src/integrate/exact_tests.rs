@@ -232,12 +232,6 @@ fn impacts_match_converged_central_difference_with_far_fewer_steps() {
         &model,
         &settings(Scheme::ExactModal, exact.step.time_step / 8.0, 0.03),
     );
-    let peak = |s: &Simulation| {
-        s.contact_statistics
-            .iter()
-            .map(|c| c.max_force)
-            .fold(0.0, f64::max)
-    };
     let reference = peak(&converged);
     let impacts: u64 = exact.contact_statistics.iter().map(|s| s.impacts).sum();
     assert!(impacts > 3, "the case must exercise contacts: {impacts} impacts");
@@ -268,31 +262,7 @@ fn pins_bending_in_the_plane_match_central_difference() {
     let heights = [0.5, 1.0];
     let basis = ModalBasis::compute_with_static_correction(&default_tube(30), 8, &heights).unwrap();
     let model = triangle(&basis, &heights, Friction::NONE);
-    let exact = run(
-        &model,
-        &Settings {
-            time_step: TimeStep::Auto,
-            ..settings(Scheme::ExactModal, 1.0, 0.04)
-        },
-    );
-    let explicit_step = step_size::resolve(
-        &model,
-        &Settings {
-            time_step: TimeStep::Auto,
-            ..settings(Scheme::CentralDifference, 1.0, 0.04)
-        },
-    )
-    .unwrap();
-    let explicit = run(
-        &model,
-        &settings(Scheme::CentralDifference, explicit_step.time_step / 4.0, 0.04),
-    );
-    let peak = |s: &Simulation| {
-        s.contact_statistics
-            .iter()
-            .map(|c| c.max_force)
-            .fold(0.0, f64::max)
-    };
+    let (exact, explicit) = exact_and_converged_explicit(&model, 0.04);
     let wear = |s: &Simulation| s.wear_work.iter().sum::<f64>();
     let impacts: u64 = exact.contact_statistics.iter().map(|s| s.impacts).sum();
     assert!(impacts > 5, "the case must exercise contacts: {impacts} impacts");
@@ -340,6 +310,31 @@ fn friction_is_refused_at_the_scheme() {
             .iter()
             .any(|i| i.field == "scheme" && i.reason.contains("friction"))
     );
+}
+
+/// The exact scheme at its `auto` step, and central difference at a quarter of its own
+/// (converged for the comparisons), over `duration`.
+fn exact_and_converged_explicit(model: &Model<'_>, duration: f64) -> (Simulation, Simulation) {
+    let auto = |scheme| Settings {
+        time_step: TimeStep::Auto,
+        ..settings(scheme, 1.0, duration)
+    };
+    let exact = run(model, &auto(Scheme::ExactModal));
+    let explicit_step = step_size::resolve(model, &auto(Scheme::CentralDifference)).unwrap();
+    let explicit = run(
+        model,
+        &settings(Scheme::CentralDifference, explicit_step.time_step / 4.0, duration),
+    );
+    (exact, explicit)
+}
+
+/// The largest contact force of a run (N).
+fn peak(simulation: &Simulation) -> f64 {
+    simulation
+        .contact_statistics
+        .iter()
+        .map(|c| c.max_force)
+        .fold(0.0, f64::max)
 }
 
 /// Three pins at the corners of a triangle (0 at the lower left, 1 at the lower right,
@@ -409,12 +404,6 @@ fn exact_modal_cost_by_modes() {
     for modes in [6, 12, 24, 40] {
         let basis = ModalBasis::compute_with_static_correction(&default_tube(60), modes, &heights).unwrap();
         let model = three_pin_model(&basis, &heights);
-        let peak = |s: &Simulation| {
-            s.contact_statistics
-                .iter()
-                .map(|c| c.max_force)
-                .fold(0.0, f64::max)
-        };
         let timed = |scheme| {
             let start = std::time::Instant::now();
             let result = run(
@@ -526,31 +515,7 @@ fn stiff_contacts_with_dashpots_rattle_to_central_differences_peak() {
         plane: None,
         point_forces: vec![],
     };
-    let exact = run(
-        &model,
-        &Settings {
-            time_step: TimeStep::Auto,
-            ..settings(Scheme::ExactModal, 1.0, 0.04)
-        },
-    );
-    let explicit_step = step_size::resolve(
-        &model,
-        &Settings {
-            time_step: TimeStep::Auto,
-            ..settings(Scheme::CentralDifference, 1.0, 0.04)
-        },
-    )
-    .unwrap();
-    let explicit = run(
-        &model,
-        &settings(Scheme::CentralDifference, explicit_step.time_step / 4.0, 0.04),
-    );
-    let peak = |s: &Simulation| {
-        s.contact_statistics
-            .iter()
-            .map(|c| c.max_force)
-            .fold(0.0, f64::max)
-    };
+    let (exact, explicit) = exact_and_converged_explicit(&model, 0.04);
     let impacts: u64 = exact.contact_statistics.iter().map(|s| s.impacts).sum();
     assert!(impacts > 10, "the case must rattle: {impacts} impacts");
     assert!(exact.energy.dissipated_contact > 0.0);
