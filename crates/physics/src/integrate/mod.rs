@@ -72,6 +72,15 @@ pub enum SimulationError {
         time_step: f64,
         critical_time_step: f64,
     },
+    #[error(
+        "the implicit contact solve of the `exact_modal` scheme did not settle at t = {time:e} s \
+         ({iterations} iterations over {contacts} contacts); use `central_difference`"
+    )]
+    ContactSolveFailed {
+        time: f64,
+        iterations: usize,
+        contacts: usize,
+    },
     #[error("the model cannot be integrated: {}", describe(.0))]
     InvalidModel(Vec<InputIssue>),
     #[error("the integration settings are invalid: {}", describe(.0))]

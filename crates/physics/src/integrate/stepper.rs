@@ -702,15 +702,10 @@ impl pulp::WithSimd for ExactSteps<'_, '_> {
             match exact::step(simd, (layout, state, recorder), run, n) {
                 Ok(powers) => recorder.add_powers(half, powers),
                 Err(failure) => {
-                    return Err(SimulationError::Diverged {
+                    return Err(SimulationError::ContactSolveFailed {
                         time: n as f64 * layout.dt,
-                        detail: format!(
-                            "the implicit contact solve did not converge in {} iterations ({} contacts)",
-                            exact::MAX_ITERATIONS,
-                            failure.contacts
-                        ),
-                        time_step: layout.dt,
-                        critical_time_step: layout.step.critical_time_step,
+                        iterations: exact::MAX_ITERATIONS,
+                        contacts: failure.contacts,
                     });
                 }
             }
