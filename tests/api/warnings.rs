@@ -462,7 +462,8 @@ async fn sweep_runs_show_their_warnings_unless_the_base_inputs_turn_them_off() {
 /// The hexagonal bundle with its default static correction: a pseudo-mode per contact
 /// level (24 here, a level every H/12, two per element) stiffer than every eigenmode makes the critical
 /// step many times smaller: a warning at `pin/static_correction` saying by how much;
-/// none with the correction off (the shipped hex217 example checks that side).
+/// none under `exact_modal` (whose step the pseudo-modes do not bound), none with the
+/// correction off (the shipped hex217 example checks that side).
 #[tokio::test]
 async fn a_static_correction_that_shrinks_the_step_is_flagged_with_its_cost() {
     let app = spawn_idle().await;
@@ -486,6 +487,19 @@ async fn a_static_correction_that_shrinks_the_step_is_flagged_with_its_cost() {
     let message = message_of(&body, "costly_static_correction");
     let ratio = number_before(&message, "times smaller");
     assert!(ratio > 4.0, "{message}");
+    // Under `exact_modal` the pseudo-modes cost no step: no warning.
+    inputs["solver"]["scheme"] = json!("exact_modal");
+    inputs["solver"]["time_step"] = json!("auto");
+    let body = accepted(&app, "hex-bundle-dynamics", &inputs).await;
+    assert!(
+        !has(
+            &warnings(&body),
+            "costly_static_correction",
+            "/inputs/pin/static_correction"
+        ),
+        "{body}"
+    );
+    inputs["solver"]["scheme"] = json!("central_difference");
     inputs["pin"]["static_correction"] = json!("none");
     let body = accepted(&app, "hex-bundle-dynamics", &inputs).await;
     assert!(!has(

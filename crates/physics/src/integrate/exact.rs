@@ -51,9 +51,12 @@ use super::state::State;
 use crate::contact::NormalLaw;
 
 /// Newton iterations of the contact solve before it gives up.
-pub(super) const MAX_ITERATIONS: usize = 80;
-/// Iterations of the contact solve after which one contact changes side per iterate.
+pub(super) const MAX_ITERATIONS: usize = 400;
+/// Iterations of the contact solve after which a contact caught in a cycle changes side
+/// only when it is the first wrong one (`CYCLING_CHANGES`).
 const SINGLE_CHANGES_AFTER: usize = 20;
+/// Side changes in one step that mark a contact as cycling.
+const CYCLING_CHANGES: u8 = 3;
 /// Terms of the Taylor series of the scaled exponential (its norm is at most 1/4).
 const TAYLOR_TERMS: usize = 20;
 
@@ -363,6 +366,9 @@ struct ContactSolve {
     loaded: Vec<usize>,
     active: Vec<usize>,
     wrong: Vec<(usize, Side)>,
+    /// Per contact, how many times it changed side in this step, and those that did.
+    changes: Vec<u8>,
+    changed: Vec<usize>,
     /// Per contact, whether it is in the Newton system; the system, and a copy of it
     /// for the pivoted solve.
     in_system: Vec<bool>,
@@ -395,6 +401,8 @@ impl ContactSolve {
             loaded: Vec::with_capacity(contacts),
             active: Vec::with_capacity(contacts),
             wrong: Vec::with_capacity(contacts),
+            changes: vec![0; contacts],
+            changed: Vec::with_capacity(contacts),
             in_system: vec![false; contacts],
             matrix: Vec::new(),
             right: Vec::new(),
@@ -645,9 +653,10 @@ pub(super) fn step<S: Simd>(
 /// An active-set Newton iteration: each iterate puts every contact on the side its
 /// penetration and force ask for, then takes a Newton step of the equations of those
 /// sides (one linear solve per change of sides for the linear law); it stops when every
-/// side holds and the residual is at rounding level. From
-/// [`SINGLE_CHANGES_AFTER`] iterations on, one contact changes side per iterate (the
-/// first in order), which ends the cycles simultaneous changes can fall into. Each
+/// side holds and the residual is at rounding level. From [`SINGLE_CHANGES_AFTER`]
+/// iterations on, a contact that has changed side [`CYCLING_CHANGES`] times in the step
+/// changes again only as the first wrong one, which ends the cycles simultaneous
+/// changes can fall into without slowing the many changes of a bundle's first touch. Each
 /// step starts from the sides the last one ended with. Inlined into the step, so that
 /// its loops (the banded elimination above all) are compiled for the step's SIMD level.
 #[inline(always)]
@@ -659,6 +668,10 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
         solve.force[d] = 0.0;
     }
     solve.loaded.clear();
+    for &c in &solve.changed {
+        solve.changes[c] = 0;
+    }
+    solve.changed.clear();
     let mut converged = false;
     for iteration in 0..MAX_ITERATIONS {
         // The iterate's forces move each pin at each level by Σ ∓F G(l, l_d) (and its
@@ -743,15 +756,20 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
             }
             break;
         }
-        // Every wrong side changed, or the first only once simultaneous changes have
-        // had their chance.
-        let changes = if iteration < SINGLE_CHANGES_AFTER {
-            solve.wrong.len()
-        } else {
-            solve.wrong.len().min(1)
-        };
-        for &(c, side) in &solve.wrong[..changes] {
-            solve.side[c] = side;
+        // Every wrong side changed; once simultaneous changes have had their chance,
+        // a contact that has already changed `CYCLING_CHANGES` times in this step (a
+        // cycle) changes only if it is the first wrong one.
+        let mut first = true;
+        for &(c, side) in &solve.wrong {
+            let cycling = iteration >= SINGLE_CHANGES_AFTER && solve.changes[c] >= CYCLING_CHANGES;
+            if !cycling || first {
+                if solve.changes[c] == 0 {
+                    solve.changed.push(c);
+                }
+                solve.changes[c] = solve.changes[c].saturating_add(1);
+                solve.side[c] = side;
+            }
+            first = false;
         }
         // The Newton step on the contacts not open; the others drop to 0.
         // In the order of the pins they touch, so that the system is banded (contacts
