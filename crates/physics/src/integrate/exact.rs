@@ -23,9 +23,9 @@
 //! the velocity's coefficient d₁ᵢ), the sum over the pins b that both contacts touch and
 //! s = +1 on a contact's left pin, −1 on its right one. Each contact's law
 //! F = max(0, law(δ, δ̇)) while δ > 0 ([`crate::contact::NormalLaw`], the one law of
-//! every loop) closes the system; it is solved by a semismooth Newton iteration on the
-//! set of contacts that push ([`ContactSolve`]): one linear solve per change of that
-//! set for the linear law.
+//! every loop) closes the system, each contact open, pushing or held at touch (where a
+//! dashpot makes the law jump): an active-set Newton iteration ([`contact_forces`]),
+//! one banded linear solve per change of sides for the linear law.
 //!
 //! **Order.** Loads linear over the step make the scheme second order (the trapezoidal
 //! rule of the loads' effect), exact for free vibration and for loads that are linear
@@ -79,6 +79,11 @@ impl Propagator {
     /// s = max(w, 1), whose entries are all of order w (a rotation at rate w plus the
     /// load's terms), by scaling and squaring a Taylor series: the entries of a fast
     /// mode stay as accurate as those of a slow one.
+    ///
+    /// The response spectra's step (`response_spectrum::Step`, Nigam–Jennings) is the
+    /// same solution in closed form, but it divides by ω² and loses digits as ωh → 0,
+    /// which the slow modes of a run reach (ωh ~ 1e-5), and has no ω = 0; it is not
+    /// reused here, and left as it is there (its spectra are pinned bit for bit).
     pub(crate) fn new(omega: f64, xi: f64, h: f64) -> Self {
         let w = omega * h;
         let s = w.max(1.0);
@@ -350,8 +355,8 @@ enum Side {
 
 /// Scratch of the implicit contact solve, per contact of [`ExactRun::contacts`].
 struct ContactSolve {
-    /// Predicted penetration and rate (no contact force at the step's end; the rate
-    /// NaN until needed).
+    /// Predicted penetration and rate (no contact force at the step's end; the rate 0
+    /// where no law reads it).
     predicted: Vec<f64>,
     predicted_rate: Vec<f64>,
     /// Forces of the iterate, the penetrations and rates they give.
@@ -423,7 +428,7 @@ pub(super) struct NotConverged {
     pub contacts: usize,
 }
 
-/// One step of the exact scheme (to t = n h) on the row, compiled for `simd`: the modes
+/// One step of the exact scheme (to t = n h), compiled for `simd`: the modes
 /// propagated with no contact force at the step's end, the contact forces solved, the
 /// modes corrected, then the step's records. Returns the step's powers.
 #[inline(always)]
@@ -505,7 +510,7 @@ pub(super) fn step<S: Simd>(
     }
     let (lanes, stride) = (layout.lanes, layout.stride);
     let (levels, velocities) = (&state.level_deflections, &run.level_velocities);
-    let offset = |line: usize, level: usize| ((level / lanes) * stride + 1 + line) * lanes + level % lanes;
+    let offset = |line: usize, level: usize| Layout::level_offset(lanes, stride, level) + line * lanes;
     let solve = &mut run.solve;
     for (c, contact) in run.contacts.iter().enumerate() {
         let read = |values: &[f64]| {
@@ -565,41 +570,31 @@ pub(super) fn step<S: Simd>(
     let levels = run.levels;
     for (line, shift) in solve.shift.chunks_exact(levels).enumerate() {
         for (level, moved) in shift.iter().enumerate() {
-            state.level_deflections[((level / lanes) * stride + 1 + line) * lanes + level % lanes] += moved;
+            state.level_deflections[offset(line, level)] += moved;
         }
     }
     std::mem::swap(&mut state.penetration, &mut state.previous_penetration);
-    let mut count = 0;
+    let (mut count, mut contact_damping) = (0, 0.0);
     for (c, contact) in run.contacts.iter().enumerate() {
-        let (lane, penetration) = (contact.lane, solve.penetration[c]);
+        let (lane, penetration, force) = (contact.lane, solve.penetration[c], solve.force[c]);
         state.penetration[lane] = penetration;
+        state.contact_force[lane] = force;
         let max = &mut recorder.max_penetration[lane];
         *max = max.max(penetration);
-        if penetration > 0.0 {
-            state.closed[count] = lane as u32;
-            count += 1;
+        if penetration <= 0.0 && force == 0.0 {
+            continue;
         }
-    }
-    state.closed_count = count;
-    let mut contact_damping = 0.0;
-    for (c, contact) in run.contacts.iter().enumerate() {
-        let lane = contact.lane;
-        let force = solve.force[c];
-        state.contact_force[lane] = force;
-        let penetration = solve.penetration[c];
+        // The dashpots' and the force clamp's power (F − K δⁿ) δ̇, as the other schemes
+        // count it, and the power of a force held at touch (δ = 0).
+        let rate = solve.rate[c];
+        let elastic = contact.law.force(penetration.max(0.0), 0.0).elastic;
+        let dissipation = (force - elastic) * rate;
+        contact_damping += dissipation;
         if penetration <= 0.0 {
             continue;
         }
-        // The rate the solve found (the predicted one where the contact closed by
-        // rounding alone), and the dashpots' and the force clamp's power (F − K δⁿ) δ̇,
-        // as the other schemes count it.
-        let rate = match solve.rate[c] {
-            rate if rate.is_nan() => 0.0,
-            rate => rate,
-        };
-        let elastic = contact.law.force(penetration, 0.0).elastic;
-        let dissipation = (force - elastic) * rate;
-        contact_damping += dissipation;
+        state.closed[count] = lane as u32;
+        count += 1;
         if force > recorder.force_peak[lane] {
             recorder.force_peak[lane] = force;
         }
@@ -625,6 +620,7 @@ pub(super) fn step<S: Simd>(
             (force, dissipation),
         );
     }
+    state.closed_count = count;
     recorder.resultants.track(layout, state, n);
     recorder.track_deflection_peaks(layout, &state.level_deflections);
     let (mut modal_damping, mut external) = (0.0, 0.0);
@@ -674,8 +670,8 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
     solve.changed.clear();
     let mut converged = false;
     for iteration in 0..MAX_ITERATIONS {
-        // The iterate's forces move each pin at each level by Σ ∓F G(l, l_d) (and its
-        // velocity by G'): every contact's penetration then reads two of these.
+        // The iterate's forces move each line at each level by Σ ∓F G(l, l_d) (and its
+        // velocity by G'): every contact's penetration then reads those of its lines.
         solve.shift.fill(0.0);
         solve.rate_shift.fill(0.0);
         for &d in &solve.loaded {

@@ -409,7 +409,7 @@ impl<'m> Layout<'m> {
 
     /// Index in the level deflections of line 0 at `level` (block-major, the walls in
     /// slots 0 and lines + 1); line r is `lanes` × r further.
-    fn level_offset(lanes: usize, stride: usize, level: usize) -> usize {
+    pub fn level_offset(lanes: usize, stride: usize, level: usize) -> usize {
         ((level / lanes) * stride + 1) * lanes + level % lanes
     }
 
