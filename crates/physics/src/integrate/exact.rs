@@ -24,8 +24,15 @@
 //! s = +1 on a contact's left pin, −1 on its right one. Each contact's law
 //! F = max(0, law(δ, δ̇)) while δ > 0 ([`crate::contact::NormalLaw`], the one law of
 //! every loop) closes the system, each contact open, pushing or held at touch (where a
-//! dashpot makes the law jump): an active-set Newton iteration ([`contact_forces`]),
-//! one banded linear solve per change of sides for the linear law.
+//! dashpot makes the law jump). It is solved by nonlinear Gauss–Seidel
+//! ([`contact_forces`]): each contact's force solved exactly against the others'
+//! ([`implicit_force`]), sweep after sweep, from the last step's forces. W is symmetric
+//! and positive, so the sweeps converge (projected Gauss–Seidel on K⁻¹ + W); where the
+//! step resolves the contacts K W is small (about (ω_c h)², plus K times the static
+//! correction's flexibility), and 3–6 sweeps settle a step (row17, 19 and 37 wire-wrapped
+//! pins). A sweep costs O(contacts × levels); a direct solve of the contacts' system
+//! (the first version: active-set Newton, banded LU) cost O(m³) on a bundle, whose
+//! hundreds of pushing wire contacts couple within a band of hundreds.
 //!
 //! **Order.** Loads linear over the step make the scheme second order (the trapezoidal
 //! rule of the loads' effect), exact for free vibration and for loads that are linear
@@ -50,13 +57,9 @@ use super::recorder::{Powers, Recorder, record_closed_contact};
 use super::state::State;
 use crate::contact::NormalLaw;
 
-/// Newton iterations of the contact solve before it gives up.
-pub(super) const MAX_ITERATIONS: usize = 400;
-/// Iterations of the contact solve after which a contact caught in a cycle changes side
-/// only when it is the first wrong one (`CYCLING_CHANGES`).
-const SINGLE_CHANGES_AFTER: usize = 20;
-/// Side changes in one step that mark a contact as cycling.
-const CYCLING_CHANGES: u8 = 3;
+/// A penetration within this share of the deflections and gap it is the difference of
+/// is rounding (taken as none).
+const ROUNDING: f64 = 1e-12;
 /// Terms of the Taylor series of the scaled exponential (its norm is at most 1/4).
 const TAYLOR_TERMS: usize = 20;
 
@@ -176,8 +179,6 @@ struct Term {
 #[derive(Debug, Clone, Copy)]
 struct LaneBodies {
     lane: usize,
-    /// The first pin it touches (its place in the banded Newton system).
-    order: usize,
     level: usize,
     terms: [Term; 4],
     count: usize,
@@ -189,17 +190,10 @@ impl LaneBodies {
         &self.terms[..self.count]
     }
 
-    /// Σ over the lines both contacts read of the product of their normal coefficients.
-    fn coupling(&self, other: &Self) -> f64 {
-        let mut sum = 0.0;
-        for a in self.terms() {
-            for b in other.terms() {
-                if a.line == b.line {
-                    sum += a.normal * b.normal;
-                }
-            }
-        }
-        sum
+    /// Σ of its normal coefficients squared (its terms read distinct lines): W_cc =
+    /// this × G(l, l).
+    fn self_coupling(&self) -> f64 {
+        self.terms().iter().map(|t| t.normal * t.normal).sum()
     }
 }
 
@@ -227,8 +221,8 @@ pub(super) struct ExactRun {
     /// at the levels (laid out as the level deflections).
     rates: bool,
     level_velocities: Vec<f64>,
-    /// Whether every law is linear (its Newton system then depends on the sides only).
-    linear: bool,
+    /// Per contact, W_cc and W'_cc.
+    own: Vec<(f64, f64)>,
     solve: ContactSolve,
 }
 
@@ -294,7 +288,6 @@ impl ExactRun {
                 }
                 LaneBodies {
                     lane,
-                    order: left.into_iter().chain(right).min().unwrap_or(0),
                     level: contact.shape / vectors,
                     terms,
                     count,
@@ -304,11 +297,18 @@ impl ExactRun {
             .collect();
         let size = loads.len();
         let rates = contacts.iter().any(|c| c.law.needs_rate()) || layout.model.plane.is_some();
-        let linear = contacts.iter().all(|c| c.law.is_linear());
         let column = |get: &dyn Fn(&Propagator) -> f64| propagators.iter().map(get).collect::<Vec<f64>>();
+        let own = contacts
+            .iter()
+            .map(|c| {
+                let g = c.level * levels + c.level;
+                let coupling = c.self_coupling();
+                (coupling * flexibility[g], coupling * rate_flexibility[g])
+            })
+            .collect();
         Self {
+            own,
             rates,
-            linear,
             level_velocities: vec![0.0; layout.level_deflections_len()],
             q_coefficients: [0, 1, 2, 3].map(|k| column(&|p: &Propagator| p.q[k])),
             v_coefficients: [0, 1, 2, 3].map(|k| column(&|p: &Propagator| p.v[k])),
@@ -322,35 +322,6 @@ impl ExactRun {
             contact_loads: vec![0.0; size],
         }
     }
-
-    /// W_cc' (or W'_cc' with `rate`).
-    fn coupling(&self, c: &LaneBodies, other: &LaneBodies, rate: bool) -> f64 {
-        let g = if rate {
-            &self.rate_flexibility
-        } else {
-            &self.flexibility
-        };
-        let coupling = c.coupling(other);
-        if coupling == 0.0 {
-            0.0
-        } else {
-            coupling * g[c.level * self.levels + other.level]
-        }
-    }
-}
-
-/// What a contact does in an iterate of the contact solve.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Side {
-    /// No force.
-    Open,
-    /// Penetrating and pushing: F = law(δ, δ̇) > 0.
-    Pushing,
-    /// Just touching at the step's end (δ = 0) with 0 ≤ F ≤ law(0⁺, δ̇): where the
-    /// dashpot makes the law jump at δ = 0 (c δ̇ at once), the step may end with the
-    /// contact held exactly at touch by a force within that jump (the set-valued law's
-    /// solution; no other exists there).
-    Touching,
 }
 
 /// Scratch of the implicit contact solve, per contact of [`ExactRun::contacts`].
@@ -359,36 +330,21 @@ struct ContactSolve {
     /// where no law reads it).
     predicted: Vec<f64>,
     predicted_rate: Vec<f64>,
-    /// Forces of the iterate, the penetrations and rates they give.
+    /// Per contact, the penetration below which it is rounding: a relative 1e-12 of
+    /// the deflections and gap it is the difference of. Pins that move together on
+    /// contacts with no gap (the wire-wrapped bundle's wires at rest) predict
+    /// penetrations of ±1e-20 m, which must not decide whether a contact pushes.
+    floor: Vec<f64>,
+    /// The forces, kept from one step to the next (the next solve starts from them),
+    /// and the penetrations and rates they give.
     force: Vec<f64>,
     penetration: Vec<f64>,
     rate: Vec<f64>,
-    /// Each contact's side in the iterate, kept from one step to the next (the next
-    /// step starts from it).
-    side: Vec<Side>,
-    /// The contacts with a force in the iterate, those not open in the next one, and
-    /// the contacts whose side is wrong.
+    /// The contacts with a force; those the sweeps visit, and whether each is one.
     loaded: Vec<usize>,
-    active: Vec<usize>,
-    wrong: Vec<(usize, Side)>,
-    /// Per contact, how many times it changed side in this step, and those that did.
-    changes: Vec<u8>,
-    changed: Vec<usize>,
-    /// Per contact, whether it is in the Newton system; the system, and a copy of it
-    /// for the pivoted solve.
-    in_system: Vec<bool>,
-    matrix: Vec<f64>,
-    right: Vec<f64>,
-    backup: Vec<f64>,
-    /// The contacts and sides of the system whose factors `matrix` holds (empty when
-    /// it holds none), and its band.
-    factored: Vec<(usize, Side)>,
-    factored_band: usize,
-    /// Per contact of the system, the law's tangent (∂F/∂δ, ∂F/∂δ̇) (K, 0 for a touching
-    /// one); per line, the system's contacts on it and their sign.
-    factors: Vec<(f64, f64)>,
-    by_line: Vec<Vec<(usize, f64)>>,
-    /// Per line and level: the deflection and velocity the iterate's forces add.
+    swept: Vec<usize>,
+    in_sweep: Vec<bool>,
+    /// Per line and level: the deflection and velocity the forces add.
     shift: Vec<f64>,
     rate_shift: Vec<f64>,
 }
@@ -399,23 +355,13 @@ impl ContactSolve {
         Self {
             predicted: vec![0.0; contacts],
             predicted_rate: vec![0.0; contacts],
+            floor: vec![0.0; contacts],
             force: vec![0.0; contacts],
             penetration: vec![0.0; contacts],
             rate: vec![0.0; contacts],
-            side: vec![Side::Open; contacts],
             loaded: Vec::with_capacity(contacts),
-            active: Vec::with_capacity(contacts),
-            wrong: Vec::with_capacity(contacts),
-            changes: vec![0; contacts],
-            changed: Vec::with_capacity(contacts),
-            in_system: vec![false; contacts],
-            matrix: Vec::new(),
-            right: Vec::new(),
-            backup: Vec::new(),
-            factored: Vec::new(),
-            factored_band: 0,
-            factors: Vec::new(),
-            by_line: vec![Vec::new(); lines],
+            swept: Vec::with_capacity(contacts),
+            in_sweep: vec![false; contacts],
             shift: vec![0.0; lines_by_levels],
             rate_shift: vec![0.0; lines_by_levels],
         }
@@ -520,7 +466,15 @@ pub(super) fn step<S: Simd>(
                 .map(|t| t.normal * values[offset(t.line, contact.level)])
                 .sum::<f64>()
         };
-        solve.predicted[c] = read(levels) - layout.gaps[contact.lane];
+        let gap = layout.gaps[contact.lane];
+        solve.predicted[c] = read(levels) - gap;
+        let magnitude = contact
+            .terms()
+            .iter()
+            .map(|t| (t.normal * levels[offset(t.line, contact.level)]).abs())
+            .sum::<f64>()
+            + gap.abs();
+        solve.floor[c] = ROUNDING * magnitude;
         solve.predicted_rate[c] = if run.rates { read(velocities) } else { 0.0 };
     }
     contact_forces(run)?;
@@ -643,347 +597,203 @@ pub(super) fn step<S: Simd>(
     })
 }
 
+/// Sweeps of the contact solve before it gives up.
+pub(super) const MAX_SWEEPS: usize = 2000;
+
 /// The contact forces at the step's end (`run.solve.force`, with the penetrations and
-/// rates they give), with δ = δ̃ − W F and δ̇ = δ̃̇ − W' F: each contact open (F = 0),
-/// pushing (F = law(δ, δ̇) > 0 with δ > 0) or touching (δ = 0, 0 ≤ F ≤ law(0⁺, δ̇)).
-/// An active-set Newton iteration: each iterate puts every contact on the side its
-/// penetration and force ask for, then takes a Newton step of the equations of those
-/// sides (one linear solve per change of sides for the linear law); it stops when every
-/// side holds and the residual is at rounding level. From [`SINGLE_CHANGES_AFTER`]
-/// iterations on, a contact that has changed side [`CYCLING_CHANGES`] times in the step
-/// changes again only as the first wrong one, which ends the cycles simultaneous
-/// changes can fall into without slowing the many changes of a bundle's first touch. Each
-/// step starts from the sides the last one ended with. Inlined into the step, so that
-/// its loops (the banded elimination above all) are compiled for the step's SIMD level.
+/// rates they give), with δ = δ̃ − W F and δ̇ = δ̃̇ − W' F, by nonlinear Gauss–Seidel:
+/// each contact's force solved exactly against the others' ([`implicit_force`]), sweep
+/// after sweep, from the last step's forces, until no force moves by more than 1e-10 of
+/// the largest. The sweeps visit the contacts with a force and those the forces may
+/// close; the others are checked once the sweeps settle (any that penetrates joins and
+/// the sweeps go on). Inlined into the step, so that its loops are compiled for the
+/// step's SIMD level.
 #[inline(always)]
 fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
     let levels = run.levels;
-    let contacts = &run.contacts;
-    let mut solve = std::mem::replace(&mut run.solve, ContactSolve::new(0, (0, 0)));
+    let (contacts, own) = (&run.contacts, &run.own);
+    let (flexibility, rate_flexibility) = (&run.flexibility, &run.rate_flexibility);
+    let solve = &mut run.solve;
+    // The shift of every line at every level by the forces: Σ ∓F G(l, l_d), and G' for
+    // the velocities where they are read.
+    // (Functions, not closures: a closure is not inlined into the step's SIMD context.)
+    let rate_flexibility = run.rates.then_some(rate_flexibility.as_slice());
+    let (flexibilities, moved) = ((flexibility.as_slice(), rate_flexibility), read_lines);
+    // The sweeps start from the last step's forces.
+    solve.shift.fill(0.0);
+    solve.rate_shift.fill(0.0);
     for &d in &solve.loaded {
-        solve.force[d] = 0.0;
+        add(
+            &mut solve.shift,
+            &mut solve.rate_shift,
+            flexibilities,
+            levels,
+            &contacts[d],
+            solve.force[d],
+        );
+    }
+    // The contacts that may push: those loaded, and those whose predicted penetration
+    // the forces may close (checked again at the end).
+    let reach = -3.0 * solve.shift.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    solve.swept.clear();
+    for c in 0..contacts.len() {
+        solve.in_sweep[c] = solve.force[c] != 0.0 || solve.predicted[c] >= reach;
+        if solve.in_sweep[c] {
+            solve.swept.push(c);
+        }
+    }
+    let mut sweeps = 0;
+    loop {
+        let (mut change, mut scale): (f64, f64) = (0.0, 0.0);
+        for &c in &solve.swept {
+            let contact = &contacts[c];
+            let old = solve.force[c];
+            let (w, w_rate) = own[c];
+            let penetration = solve.predicted[c] + moved(&solve.shift, levels, contact) + w * old;
+            let rate = if contact.law.needs_rate() {
+                solve.predicted_rate[c] + moved(&solve.rate_shift, levels, contact) + w_rate * old
+            } else {
+                0.0
+            };
+            let force = implicit_force(&contact.law, (penetration, rate), (w, w_rate), solve.floor[c]);
+            scale = scale.max(force);
+            if force != old {
+                change = change.max((force - old).abs());
+                solve.force[c] = force;
+                add(
+                    &mut solve.shift,
+                    &mut solve.rate_shift,
+                    flexibilities,
+                    levels,
+                    contact,
+                    force - old,
+                );
+            }
+        }
+        sweeps += 1;
+        if change <= 1e-10 * scale {
+            // The penetrations and rates the forces give; every contact left out must
+            // stay open.
+            let mut more = false;
+            for (c, contact) in contacts.iter().enumerate() {
+                let penetration = solve.predicted[c] + moved(&solve.shift, levels, contact);
+                solve.penetration[c] = penetration;
+                solve.rate[c] = if contact.law.needs_rate() {
+                    solve.predicted_rate[c] + moved(&solve.rate_shift, levels, contact)
+                } else {
+                    0.0
+                };
+                if !solve.in_sweep[c] && penetration > solve.floor[c] {
+                    solve.in_sweep[c] = true;
+                    solve.swept.push(c);
+                    more = true;
+                }
+            }
+            if !more {
+                break;
+            }
+        }
+        if sweeps >= MAX_SWEEPS {
+            return Err(NotConverged {
+                contacts: contacts.len(),
+            });
+        }
     }
     solve.loaded.clear();
-    for &c in &solve.changed {
-        solve.changes[c] = 0;
+    solve
+        .loaded
+        .extend(solve.swept.iter().copied().filter(|&c| solve.force[c] != 0.0));
+    Ok(())
+}
+
+/// Moves the lines by a contact's force: their deflections through G, their velocities
+/// through G' where they are read.
+#[inline(always)]
+fn add(
+    shift: &mut [f64],
+    rate_shift: &mut [f64],
+    (g, g_rate): (&[f64], Option<&[f64]>),
+    levels: usize,
+    source: &LaneBodies,
+    force: f64,
+) {
+    shift_lines(shift, g, levels, source, force);
+    if let Some(g_rate) = g_rate {
+        shift_lines(rate_shift, g_rate, levels, source, force);
     }
-    solve.changed.clear();
-    let mut converged = false;
-    for iteration in 0..MAX_ITERATIONS {
-        // The iterate's forces move each line at each level by Σ ∓F G(l, l_d) (and its
-        // velocity by G'): every contact's penetration then reads those of its lines.
-        solve.shift.fill(0.0);
-        solve.rate_shift.fill(0.0);
-        for &d in &solve.loaded {
-            let (source, force) = (&contacts[d], solve.force[d]);
-            let g = &run.flexibility[source.level * levels..][..levels];
-            let g_rate = &run.rate_flexibility[source.level * levels..][..levels];
-            for term in source.terms() {
-                let sign = -term.normal * force;
-                let shift = &mut solve.shift[term.line * levels..][..levels];
-                let rate_shift = &mut solve.rate_shift[term.line * levels..][..levels];
-                for l in 0..levels {
-                    shift[l] += sign * g[l];
-                    rate_shift[l] += sign * g_rate[l];
-                }
-            }
+}
+
+/// Moves every line a contact reads, at every level, by its force F through the
+/// flexibility `g` (levels × levels): shift(line, l) −= normal F g(l_c, l).
+#[inline(always)]
+fn shift_lines(shift: &mut [f64], g: &[f64], levels: usize, source: &LaneBodies, force: f64) {
+    let g = &g[source.level * levels..][..levels];
+    for term in source.terms() {
+        let sign = -term.normal * force;
+        let shift = &mut shift[term.line * levels..][..levels];
+        for (s, g) in shift.iter_mut().zip(g) {
+            *s += sign * g;
         }
-        let moved = |shift: &[f64], contact: &LaneBodies| {
-            contact
-                .terms()
-                .iter()
-                .map(|t| t.normal * shift[t.line * levels + contact.level])
-                .sum::<f64>()
-        };
-        // Each contact's side, and the residual of its equation. An open contact whose
-        // predicted penetration is below −2 × the largest shift cannot close: skipped
-        // (its penetration is read once the solve is done).
-        let reach = -2.0 * solve.shift.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-        let (mut scale, mut residual): (f64, f64) = (0.0, 0.0);
-        solve.wrong.clear();
-        for (c, contact) in contacts.iter().enumerate() {
-            let side = solve.side[c];
-            if side == Side::Open && solve.predicted[c] < reach {
-                continue;
-            }
-            let penetration = solve.predicted[c] + moved(&solve.shift, contact);
-            solve.penetration[c] = penetration;
-            let force = solve.force[c];
-            let rate = if contact.law.needs_rate() && (penetration > 0.0 || side != Side::Open) {
-                solve.predicted_rate[c] + moved(&solve.rate_shift, contact)
-            } else {
-                0.0
-            };
-            solve.rate[c] = rate;
-            let law = if penetration > 0.0 {
-                contact.law.force(penetration, rate).force
-            } else {
-                0.0
-            };
-            let touch = contact.law.force(0.0, rate).force;
-            let wanted = match side {
-                Side::Open if penetration > 0.0 && law > 0.0 => Side::Pushing,
-                Side::Open => Side::Open,
-                Side::Pushing if penetration <= 0.0 && touch > 0.0 => Side::Touching,
-                Side::Pushing if penetration <= 0.0 || law <= 0.0 => Side::Open,
-                Side::Pushing => {
-                    residual = residual.max((force - law).abs());
-                    Side::Pushing
-                }
-                Side::Touching if touch <= 0.0 || force < 0.0 => Side::Open,
-                Side::Touching if force > touch => Side::Pushing,
-                Side::Touching => {
-                    residual = residual.max((contact.law.stiffness * penetration).abs());
-                    Side::Touching
-                }
-            };
-            scale = scale.max(force.abs()).max(law);
-            if wanted != side {
-                solve.wrong.push((c, wanted));
-            }
-        }
-        if solve.wrong.is_empty() && residual <= 1e-11 * scale {
-            converged = true;
-            for (c, contact) in contacts.iter().enumerate() {
-                if solve.side[c] == Side::Open && solve.predicted[c] < reach {
-                    solve.penetration[c] = solve.predicted[c] + moved(&solve.shift, contact);
-                    solve.rate[c] = 0.0;
-                }
-            }
-            break;
-        }
-        // Every wrong side changed; once simultaneous changes have had their chance,
-        // a contact that has already changed `CYCLING_CHANGES` times in this step (a
-        // cycle) changes only if it is the first wrong one.
-        let mut first = true;
-        for &(c, side) in &solve.wrong {
-            let cycling = iteration >= SINGLE_CHANGES_AFTER && solve.changes[c] >= CYCLING_CHANGES;
-            if !cycling || first {
-                if solve.changes[c] == 0 {
-                    solve.changed.push(c);
-                }
-                solve.changes[c] = solve.changes[c].saturating_add(1);
-                solve.side[c] = side;
-            }
-            first = false;
-        }
-        // The Newton step on the contacts not open; the others drop to 0.
-        // In the order of the pins they touch, so that the system is banded (contacts
-        // couple only through a pin they share).
-        solve.active.clear();
-        solve
-            .active
-            .extend((0..contacts.len()).filter(|&c| solve.side[c] != Side::Open));
-        solve.active.sort_by_key(|&c| contacts[c].order);
-        for &c in &solve.active {
-            solve.in_system[c] = true;
-        }
-        let m = solve.active.len();
-        // With linear laws the system depends on the contacts and their sides only:
-        // the factors of the last system serve again while they are the same (a
-        // contact stays closed over many steps).
-        let reuse = run.linear
-            && solve.factored.len() == m
-            && solve
-                .factored
-                .iter()
-                .zip(&solve.active)
-                .all(|(&(c, side), &a)| c == a && side == solve.side[a]);
-        if !reuse {
-            solve.matrix.clear();
-            solve.matrix.resize(m * m, 0.0);
-        }
-        solve.right.clear();
-        solve.factors.clear();
-        // Per line, the system's contacts on it with their sign (+1 on the left pin).
-        for list in &mut solve.by_line {
-            list.clear();
-        }
-        for (a, &c) in solve.active.iter().enumerate() {
-            for term in contacts[c].terms() {
-                solve.by_line[term.line].push((a, term.normal));
-            }
-        }
-        for (a, &c) in solve.active.iter().enumerate() {
-            let contact = &contacts[c];
-            let (penetration, rate, force) = (solve.penetration[c], solve.rate[c], solve.force[c]);
-            // A pushing contact's row: F − law(δ(F), δ̇(F)) = 0, linearised; a touching
-            // one's: K δ(F) = 0.
-            let (stiffness, damping, mut right) = match solve.side[c] {
-                Side::Pushing => {
-                    let (k, g) = contact.law.tangent(penetration.max(0.0), rate);
-                    let law = contact.law.force(penetration.max(0.0), rate).force;
-                    (k, g, law - force)
-                }
-                _ => {
-                    let k = if contact.law.stiffness > 0.0 {
-                        contact.law.stiffness
-                    } else {
-                        1.0
-                    };
-                    (k, 0.0, k * penetration)
-                }
-            };
-            let jacobian = |d: usize| {
-                let other = &contacts[d];
-                stiffness * run.coupling(contact, other, false)
-                    + if damping != 0.0 {
-                        damping * run.coupling(contact, other, true)
-                    } else {
-                        0.0
-                    }
-            };
-            for &d in &solve.loaded {
-                if !solve.in_system[d] {
-                    right += jacobian(d) * solve.force[d];
-                }
-            }
-            solve.right.push(right);
-            solve.factors.push((stiffness, damping));
-            if !reuse && solve.side[c] == Side::Pushing {
-                solve.matrix[a * m + a] = 1.0;
-            }
-        }
-        // J_ab += (k_a G(l_a, l_b) + γ_a G'(l_a, l_b)) s_a s_b over the lines both
-        // touch: W = Σ_lines, assembled line by line (contacts couple only there).
-        let mut band = if reuse { solve.factored_band } else { 0 };
-        for list in solve.by_line.iter().filter(|_| !reuse) {
-            for &(a, sign_a) in list {
-                let (stiffness, damping) = solve.factors[a];
-                let level = contacts[solve.active[a]].level * levels;
-                let (g, g_rate) = (
-                    &run.flexibility[level..][..levels],
-                    &run.rate_flexibility[level..][..levels],
-                );
-                for &(b, sign_b) in list {
-                    let other = contacts[solve.active[b]].level;
-                    let value = stiffness * g[other] + damping * g_rate[other];
-                    solve.matrix[a * m + b] += sign_a * sign_b * value;
-                    band = band.max(a.abs_diff(b));
-                }
-            }
-        }
-        if reuse {
-            substitute_banded(&solve.matrix, &mut solve.right, (m, band));
+    }
+}
+
+/// What a contact reads of the lines' shifts at its level: Σ normal × shift(line, l_c).
+#[inline(always)]
+fn read_lines(shift: &[f64], levels: usize, contact: &LaneBodies) -> f64 {
+    contact
+        .terms()
+        .iter()
+        .map(|t| t.normal * shift[t.line * levels + contact.level])
+        .sum()
+}
+
+/// The force F ≥ 0 of one contact whose penetration and rate, `a` and `b` without a
+/// force of its own, fall by w F and w' F under it: open (F = 0: δ = a at most
+/// `floor`, or a law that gives nothing), held at touch (δ = 0 with F ≤ law(0⁺, δ̇),
+/// where the dashpot makes the law jump) or pushing (F = law(δ, δ̇), δ > 0). The
+/// solution is unique: F − law(a − w F, b − w' F) grows with F.
+#[inline(always)]
+fn implicit_force(law: &NormalLaw, (a, b): (f64, f64), (w, w_rate): (f64, f64), floor: f64) -> f64 {
+    if a <= floor {
+        return 0.0;
+    }
+    if w <= 0.0 {
+        // No mode moves the contact: its force does not move it either.
+        return law.force(a, b).force;
+    }
+    let touch = a / w;
+    if law.force(0.0, b - w_rate * touch).force >= touch {
+        return touch;
+    }
+    if law.force(a, b).force <= 0.0 {
+        return 0.0;
+    }
+    if law.is_linear() {
+        let force = (law.stiffness * a + law.damping * b) / (1.0 + law.stiffness * w + law.damping * w_rate);
+        return force.clamp(0.0, touch);
+    }
+    // Newton within the bracket [0, touch) where F − law changes sign.
+    let (mut low, mut high) = (0.0, touch);
+    let mut force = 0.5 * touch;
+    for _ in 0..100 {
+        let (penetration, rate) = ((a - w * force).max(0.0), b - w_rate * force);
+        let residual = force - law.force(penetration, rate).force;
+        if residual > 0.0 {
+            high = force;
         } else {
-            solve.backup.clear();
-            solve.backup.extend_from_slice(&solve.matrix);
-            solve.factored.clear();
-            if factor_banded(&mut solve.matrix, (m, band)) {
-                substitute_banded(&solve.matrix, &mut solve.right, (m, band));
-                solve
-                    .factored
-                    .extend(solve.active.iter().map(|&c| (c, solve.side[c])));
-                solve.factored_band = band;
-            } else {
-                solve.matrix.copy_from_slice(&solve.backup);
-                solve_dense(&mut solve.matrix, &mut solve.right, m);
-            }
+            low = force;
         }
-        for &d in &solve.loaded {
-            if !solve.in_system[d] {
-                solve.force[d] = 0.0;
-            }
+        let (spring, damper) = law.tangent(penetration, rate);
+        let next = force - residual / (1.0 + spring * w + damper * w_rate);
+        let next = if next > low && next < high {
+            next
+        } else {
+            0.5 * (low + high)
+        };
+        if (next - force).abs() <= 1e-15 * touch {
+            return next;
         }
-        for &c in &solve.active {
-            solve.in_system[c] = false;
-        }
-        for (a, &c) in solve.active.iter().enumerate() {
-            solve.force[c] += solve.right[a];
-        }
-        std::mem::swap(&mut solve.loaded, &mut solve.active);
+        force = next;
     }
-    let count = contacts.len();
-    run.solve = solve;
-    if converged {
-        Ok(())
-    } else {
-        Err(NotConverged { contacts: count })
-    }
-}
-
-/// Factors the m × m system `matrix` in place as L U within its band (the multipliers
-/// below the diagonal), without pivoting: the contacts are ordered by the pins they
-/// touch and couple only through a shared pin, and the system (K⁻¹ + W scaled by K, W
-/// the basis's flexibility between the contacts) needs no pivots. False, and `matrix`
-/// spoilt, when a pivot is tiny against its row (the caller then solves with pivots).
-#[inline(always)]
-fn factor_banded(matrix: &mut [f64], (m, band): (usize, usize)) -> bool {
-    for k in 0..m {
-        let end = m.min(k + band + 1);
-        let diagonal = matrix[k * m + k];
-        let size = matrix[k * m..k * m + end]
-            .iter()
-            .fold(0.0_f64, |a, x| a.max(x.abs()));
-        if diagonal.abs() <= 1e-10 * size || diagonal.is_nan() {
-            return false;
-        }
-        let (pivot_row, rest) = matrix[k * m..].split_at_mut(m);
-        let pivot_row = &pivot_row[..end];
-        for i in k + 1..end {
-            let row = &mut rest[(i - k - 1) * m..][..end];
-            let factor = row[k] / diagonal;
-            row[k] = factor;
-            if factor != 0.0 {
-                for j in k + 1..end {
-                    row[j] -= factor * pivot_row[j];
-                }
-            }
-        }
-    }
-    true
-}
-
-/// Solves L U x = `right` in place with the factors of [`factor_banded`].
-#[inline(always)]
-fn substitute_banded(factors: &[f64], right: &mut [f64], (m, band): (usize, usize)) {
-    for i in 0..m {
-        let mut value = right[i];
-        for k in i.saturating_sub(band)..i {
-            value -= factors[i * m + k] * right[k];
-        }
-        right[i] = value;
-    }
-    for k in (0..m).rev() {
-        let end = m.min(k + band + 1);
-        let mut value = right[k];
-        for j in k + 1..end {
-            value -= factors[k * m + j] * right[j];
-        }
-        right[k] = value / factors[k * m + k];
-    }
-}
-
-/// Solves the m × m system `matrix` x = `right` in place (x in `right`) by Gaussian
-/// elimination with partial pivoting (the Newton systems are small: the contacts that
-/// push at one step).
-fn solve_dense(matrix: &mut [f64], right: &mut [f64], m: usize) {
-    for k in 0..m {
-        let pivot = (k..m)
-            .max_by(|&a, &b| matrix[a * m + k].abs().total_cmp(&matrix[b * m + k].abs()))
-            .unwrap_or(k);
-        if pivot != k {
-            for j in 0..m {
-                matrix.swap(k * m + j, pivot * m + j);
-            }
-            right.swap(k, pivot);
-        }
-        let diagonal = matrix[k * m + k];
-        for i in k + 1..m {
-            let factor = matrix[i * m + k] / diagonal;
-            if factor != 0.0 {
-                for j in k..m {
-                    matrix[i * m + j] -= factor * matrix[k * m + j];
-                }
-                right[i] -= factor * right[k];
-            }
-        }
-    }
-    for k in (0..m).rev() {
-        let mut value = right[k];
-        for j in k + 1..m {
-            value -= matrix[k * m + j] * right[j];
-        }
-        right[k] = value / matrix[k * m + k];
-    }
+    force
 }

@@ -74,11 +74,11 @@ pub enum SimulationError {
     },
     #[error(
         "the implicit contact solve of the `exact_modal` scheme did not settle at t = {time:e} s \
-         ({iterations} iterations over {contacts} contacts); use `central_difference`"
+         ({sweeps} sweeps over {contacts} contacts); use `central_difference`"
     )]
     ContactSolveFailed {
         time: f64,
-        iterations: usize,
+        sweeps: usize,
         contacts: usize,
     },
     #[error("the model cannot be integrated: {}", describe(.0))]

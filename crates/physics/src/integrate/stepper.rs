@@ -704,7 +704,7 @@ impl pulp::WithSimd for ExactSteps<'_, '_> {
                 Err(failure) => {
                     return Err(SimulationError::ContactSolveFailed {
                         time: n as f64 * layout.dt,
-                        iterations: exact::MAX_ITERATIONS,
+                        sweeps: exact::MAX_SWEEPS,
                         contacts: failure.contacts,
                     });
                 }
