@@ -30,7 +30,11 @@ fn cantilever(beam: Value, tolerance: f64) -> Value {
 }
 
 async fn results_of(app: &TestApp, body: &Value) -> Value {
-    let response = app.post_execution("cantilever-impact", body).await;
+    results_of_process(app, "cantilever-impact", body).await
+}
+
+async fn results_of_process(app: &TestApp, process: &str, body: &Value) -> Value {
+    let response = app.post_execution(process, body).await;
     let code = response.status();
     let status: Value = response.json().await.unwrap();
     assert_eq!(code, StatusCode::CREATED, "{status}");
@@ -118,4 +122,55 @@ async fn a_bound_no_mesh_can_meet_is_refused_at_elements_with_the_numbers() {
         text.contains("/inputs/beam/modes") && text.contains("auto"),
         "{text}"
     );
+}
+
+/// `examples/bundle-row17-proven.json`: the 17-pin row with `modes` and `elements` at
+/// `auto` (static correction on) under `exact_modal`, check included, is `good`: its
+/// step, basis and mesh all checked. Central difference on the same inputs (its own
+/// step, proven by its own check) is `good` too and finds the same peak contact force
+/// within the verdict's bound for peaks (10 × the default tolerance). The shipped row17
+/// (20 modes, no correction) is not `good`, and its peak is off by more than that bound.
+#[tokio::test]
+async fn the_proven_row17_example_is_good_and_right_where_the_shipped_basis_is_not() {
+    let app = spawn_app_with_shipped_processes_on(Backend::Sqlite).await;
+    let example = |name: &str| -> Value {
+        let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    };
+    let peak = |results: &Value| {
+        results["contacts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["max_force"].as_f64().unwrap())
+            .fold(0.0, f64::max)
+    };
+    let proven_body = example("bundle-row17-proven.json");
+    assert_eq!(proven_body["inputs"]["solver"]["scheme"], "exact_modal");
+    let proven = results_of_process(&app, "bundle-dynamics", &proven_body).await;
+    assert_eq!(proven["quality"]["verdict"], "good", "{}", proven["quality"]);
+    assert_eq!(
+        proven["basis"]["chosen_by"],
+        json!({"modes": "auto", "elements": "auto"})
+    );
+    let mut explicit_body = proven_body.clone();
+    explicit_body["inputs"]["solver"]["scheme"] = json!("central_difference");
+    let explicit = results_of_process(&app, "bundle-dynamics", &explicit_body).await;
+    assert_eq!(explicit["quality"]["verdict"], "good", "{}", explicit["quality"]);
+    let bound = 10.0 * 1e-3;
+    let (exact_peak, explicit_peak) = (peak(&proven), peak(&explicit));
+    assert!(
+        (exact_peak - explicit_peak).abs() <= bound * explicit_peak,
+        "peak {exact_peak} N (exact_modal) vs {explicit_peak} N (central difference)"
+    );
+    assert!(
+        proven["steps"].as_u64().unwrap() * 5 < explicit["steps"].as_u64().unwrap(),
+        "steps {} (exact_modal) vs {} (central difference)",
+        proven["steps"],
+        explicit["steps"]
+    );
+    let shipped = results_of_process(&app, "bundle-dynamics", &example("bundle-row17.json")).await;
+    assert_ne!(shipped["quality"]["verdict"], "good", "{}", shipped["quality"]);
+    let off = (peak(&shipped) - explicit_peak).abs() / explicit_peak;
+    assert!(off > bound, "the shipped basis is off by {off}");
 }

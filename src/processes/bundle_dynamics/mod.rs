@@ -239,6 +239,10 @@ impl Simulation for BundleDynamics {
             body: include_str!("../../../examples/bundle-row17.json"),
         },
         Example {
+            file: "bundle-row17-proven.json",
+            body: include_str!("../../../examples/bundle-row17-proven.json"),
+        },
+        Example {
             file: "bundle-random-gaps.json",
             body: include_str!("../../../examples/bundle-random-gaps.json"),
         },
