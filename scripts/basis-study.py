@@ -10,7 +10,7 @@ mesh, step halving), so that a default run can be compared with refined ones:
       '[{}, {"modes": 40, "elements": 80}, {"modes": 80, "elements": 160}, {"modes": 160, "elements": 160}]'
 
 Each setting is an object whose keys `modes`, `elements`, `static_correction` go to the
-pin (or beam) and `time_step`, `check`, `tolerance` to the solver. A third argument names
+pin (or beam) and `time_step`, `check`, `tolerance`, `scheme` to the solver. A third argument names
 the process (default `bundle-dynamics`).
 """
 import copy
@@ -34,7 +34,7 @@ def main():
         for key in ("modes", "elements", "static_correction"):
             if key in setting:
                 pin[key] = setting[key]
-        for key in ("time_step", "check", "tolerance"):
+        for key in ("time_step", "check", "tolerance", "scheme"):
             if key in setting:
                 inputs.setdefault("solver", {})[key] = setting[key]
         path = Path("/tmp/basis-study-input.json")
