@@ -3,8 +3,6 @@
 //! choice met (10 × the tolerance), a given count is reported as given, and a bound no
 //! mesh can meet is refused up front at `elements` with the numbers.
 
-use std::time::Duration;
-
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
@@ -30,20 +28,7 @@ fn cantilever(beam: Value, tolerance: f64) -> Value {
 }
 
 async fn results_of(app: &TestApp, body: &Value) -> Value {
-    results_of_process(app, "cantilever-impact", body).await
-}
-
-async fn results_of_process(app: &TestApp, process: &str, body: &Value) -> Value {
-    let response = app.post_execution(process, body).await;
-    let code = response.status();
-    let status: Value = response.json().await.unwrap();
-    assert_eq!(code, StatusCode::CREATED, "{status}");
-    let id = status["jobID"].as_str().unwrap().to_owned();
-    let status = app
-        .wait_for(&id, &["successful", "failed"], Duration::from_secs(120))
-        .await;
-    assert_eq!(status["status"], "successful", "{status}");
-    app.get_json(&format!("/jobs/{id}/results")).await
+    app.results_of("cantilever-impact", body).await
 }
 
 #[tokio::test]
@@ -147,7 +132,7 @@ async fn the_proven_row17_example_is_good_and_right_where_the_shipped_basis_is_n
     };
     let proven_body = example("bundle-row17-proven.json");
     assert_eq!(proven_body["inputs"]["solver"]["scheme"], "exact_modal");
-    let proven = results_of_process(&app, "bundle-dynamics", &proven_body).await;
+    let proven = app.results_of("bundle-dynamics", &proven_body).await;
     assert_eq!(proven["quality"]["verdict"], "good", "{}", proven["quality"]);
     assert_eq!(
         proven["basis"]["chosen_by"],
@@ -155,7 +140,7 @@ async fn the_proven_row17_example_is_good_and_right_where_the_shipped_basis_is_n
     );
     let mut explicit_body = proven_body.clone();
     explicit_body["inputs"]["solver"]["scheme"] = json!("central_difference");
-    let explicit = results_of_process(&app, "bundle-dynamics", &explicit_body).await;
+    let explicit = app.results_of("bundle-dynamics", &explicit_body).await;
     assert_eq!(explicit["quality"]["verdict"], "good", "{}", explicit["quality"]);
     let bound = 10.0 * 1e-3;
     let (exact_peak, explicit_peak) = (peak(&proven), peak(&explicit));
@@ -169,7 +154,9 @@ async fn the_proven_row17_example_is_good_and_right_where_the_shipped_basis_is_n
         proven["steps"],
         explicit["steps"]
     );
-    let shipped = results_of_process(&app, "bundle-dynamics", &example("bundle-row17.json")).await;
+    let shipped = app
+        .results_of("bundle-dynamics", &example("bundle-row17.json"))
+        .await;
     assert_ne!(shipped["quality"]["verdict"], "good", "{}", shipped["quality"]);
     let off = (peak(&shipped) - explicit_peak).abs() / explicit_peak;
     assert!(off > bound, "the shipped basis is off by {off}");

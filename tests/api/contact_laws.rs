@@ -60,14 +60,7 @@ async fn refused(app: &TestApp, process: &str, inputs: Value) -> Vec<String> {
 }
 
 async fn results(app: &TestApp, process: &str, inputs: Value) -> Value {
-    let response = app.post_execution(process, &json!({"inputs": inputs})).await;
-    let status = response.status();
-    let body: Value = response.json().await.unwrap();
-    assert_eq!(status, StatusCode::CREATED, "{body}");
-    let id = body["jobID"].as_str().unwrap().to_owned();
-    let status = app.wait_until_finished(&id).await;
-    assert_eq!(status["status"], "successful", "{status}");
-    app.get_json(&format!("/jobs/{id}/results")).await
+    app.results_of(process, &json!({"inputs": inputs})).await
 }
 
 #[tokio::test]

@@ -289,6 +289,27 @@ impl TestApp {
         }
     }
 
+    /// Submits `body` to `process` (a 201) and waits up to two minutes for the job to
+    /// succeed: its id.
+    pub async fn succeed(&self, process: &str, body: &Value) -> String {
+        let response = self.post_execution(process, body).await;
+        let code = response.status();
+        let created: Value = response.json().await.unwrap();
+        assert_eq!(code, StatusCode::CREATED, "{created}");
+        let id = created["jobID"].as_str().unwrap().to_owned();
+        let status = self
+            .wait_for(&id, &["successful", "failed"], Duration::from_secs(120))
+            .await;
+        assert_eq!(status["status"], "successful", "{status}");
+        id
+    }
+
+    /// [`TestApp::succeed`], then the job's results document.
+    pub async fn results_of(&self, process: &str, body: &Value) -> Value {
+        let id = self.succeed(process, body).await;
+        self.get_json(&format!("/jobs/{id}/results")).await
+    }
+
     pub async fn wait_until_finished(&self, job_id: &str) -> Value {
         self.wait_for(
             job_id,

@@ -75,15 +75,7 @@ fn push() -> Value {
 
 /// Runs a job to success; its id.
 async fn succeed(app: &TestApp, process: &str, inputs: Value) -> String {
-    let response = app.post_execution(process, &json!({"inputs": inputs})).await;
-    assert_eq!(response.status(), StatusCode::CREATED, "{process}");
-    let id = response.json::<Value>().await.unwrap()["jobID"]
-        .as_str()
-        .unwrap()
-        .to_owned();
-    let status = app.wait_until_finished(&id).await;
-    assert_eq!(status["status"], "successful", "{status}");
-    id
+    app.succeed(process, &json!({"inputs": inputs})).await
 }
 
 /// Runs a job to success; its results document and `displacements` history.

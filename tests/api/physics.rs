@@ -128,15 +128,7 @@ async fn the_exact_modal_scheme_agrees_with_the_reference_on_the_public_cantilev
     let mut body = cantilever_body(0.1);
     body["inputs"]["solver"]["scheme"] = json!("exact_modal");
     body["inputs"]["solver"]["time_step"] = json!("auto");
-    let response = app.post_execution("cantilever-impact", &body).await;
-    assert_eq!(response.status(), StatusCode::CREATED);
-    let id = response.json::<Value>().await.unwrap()["jobID"]
-        .as_str()
-        .unwrap()
-        .to_owned();
-    let status = app.wait_until_finished(&id).await;
-    assert_eq!(status["status"], "successful", "{status}");
-    let results = app.get_json(&format!("/jobs/{id}/results")).await;
+    let results = app.results_of("cantilever-impact", &body).await;
     // The step is a few milliseconds here (a soft contact): the first impact is
     // interpolated within it.
     let numerical = &results["numerical"];
@@ -179,15 +171,7 @@ async fn the_exact_modal_scheme_runs_the_hexagonal_bundle_and_refuses_friction_a
         body["inputs"]["solver"]["time_step"] = json!("auto");
         body["inputs"]["solver"]["duration"] = json!(0.03);
         body["inputs"]["solver"]["check"] = json!("none");
-        let response = app.post_execution("hex-bundle-dynamics", &body).await;
-        assert_eq!(response.status(), StatusCode::CREATED);
-        let id = response.json::<Value>().await.unwrap()["jobID"]
-            .as_str()
-            .unwrap()
-            .to_owned();
-        let status = app.wait_until_finished(&id).await;
-        assert_eq!(status["status"], "successful", "{status}");
-        let results = app.get_json(&format!("/jobs/{id}/results")).await;
+        let results = app.results_of("hex-bundle-dynamics", &body).await;
         if scheme == "exact_modal" {
             assert!(
                 results["critical_time_step"].is_null(),

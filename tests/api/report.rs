@@ -79,16 +79,7 @@ const NOTE: &str = "ticket <4512> 'rev. C' & <script>alert(1)</script>";
 /// Runs `inputs` with a label and a note full of markup; returns the job id.
 async fn run(app: &TestApp, process: &str, inputs: Value) -> String {
     let body = json!({"inputs": inputs, "labels": [LABEL, "plain"], "note": NOTE});
-    let response = app.post_execution(process, &body).await;
-    let status = response.status();
-    let created: Value = response.json().await.unwrap();
-    assert_eq!(status, StatusCode::CREATED, "{created}");
-    let id = created["jobID"].as_str().unwrap().to_owned();
-    let status = app
-        .wait_for(&id, &["successful", "failed"], Duration::from_secs(120))
-        .await;
-    assert_eq!(status["status"], "successful", "{status}");
-    id
+    app.succeed(process, &body).await
 }
 
 async fn note(app: &TestApp, job: &str) -> String {

@@ -466,14 +466,15 @@ pub(super) fn step<S: Simd>(
                 .map(|t| t.normal * values[offset(t.line, contact.level)])
                 .sum::<f64>()
         };
+        // The penetration and the size of what it is the difference of, in one pass.
         let gap = layout.gaps[contact.lane];
-        solve.predicted[c] = read(levels) - gap;
-        let magnitude = contact
-            .terms()
-            .iter()
-            .map(|t| (t.normal * levels[offset(t.line, contact.level)]).abs())
-            .sum::<f64>()
-            + gap.abs();
+        let (mut deflection, mut magnitude) = (0.0, gap.abs());
+        for t in contact.terms() {
+            let term = t.normal * levels[offset(t.line, contact.level)];
+            deflection += term;
+            magnitude += term.abs();
+        }
+        solve.predicted[c] = deflection - gap;
         solve.floor[c] = ROUNDING * magnitude;
         solve.predicted_rate[c] = if run.rates { read(velocities) } else { 0.0 };
     }
