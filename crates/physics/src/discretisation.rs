@@ -357,9 +357,23 @@ impl BasisErrors {
     }
 }
 
-/// The probe of one contact of `model` ([`ProbeContact::of`]).
-fn probe_contact(model: &Model<'_>, contact: usize) -> Option<ProbeContact> {
-    ProbeContact::of(&model.contacts[contact], model.basis.length())
+/// The probes of one contact of `model` ([`ProbeContact::of`]), each with the kind of
+/// the pin it probes (0: the basis's beam, k + 1: `model.kinds[k]`): one, or one per
+/// kind when it joins pins of two kinds (each meets the spring of the contact).
+fn probe_contact(model: &Model<'_>, pin_kinds: &[usize], contact: usize) -> Vec<(usize, ProbeContact)> {
+    let Some(probe) = ProbeContact::of(&model.contacts[contact], model.basis.length()) else {
+        return Vec::new();
+    };
+    let c = &model.contacts[contact];
+    let mut kinds: Vec<usize> = [c.left, c.right]
+        .iter()
+        .filter_map(|body| match body {
+            Body::Pin(p) => pin_kinds.get(*p).copied(),
+            Body::Wall => None,
+        })
+        .collect();
+    kinds.dedup();
+    kinds.into_iter().map(|kind| (kind, probe)).collect()
 }
 
 /// The distinct probes of the contacts of `model` that pushed in the run (`peaks`: each
@@ -367,9 +381,19 @@ fn probe_contact(model: &Model<'_>, contact: usize) -> Option<ProbeContact> {
 /// no contact pushed. (Probing only the contacts near the largest peak was tried: it
 /// missed a 2.8 % error that the other contacts' probes flag, docs/accuracy.md.)
 pub fn probe_contacts(model: &Model<'_>, peaks: &[f64]) -> Vec<ProbeContact> {
-    let mut candidates: Vec<(f64, ProbeContact)> = (0..model.contacts.len())
-        .filter_map(|c| Some((*peaks.get(c)?, probe_contact(model, c)?)))
+    probe_kind_contacts(model, peaks)
+        .into_iter()
+        .map(|(_, c)| c)
+        .collect()
+}
+
+/// [`probe_contacts`] with the kind of pin each probes.
+fn probe_kind_contacts(model: &Model<'_>, peaks: &[f64]) -> Vec<(usize, ProbeContact)> {
+    let pin_kinds = model.pin_kinds();
+    let mut candidates: Vec<(f64, (usize, ProbeContact))> = (0..model.contacts.len())
+        .filter_map(|c| Some((*peaks.get(c)?, probe_contact(model, &pin_kinds, c))))
         .filter(|(peak, _)| *peak > 0.0)
+        .flat_map(|(peak, probes)| probes.into_iter().map(move |p| (peak, p)))
         .collect();
     // The largest peaks first; each distinct probe once, at most MAX_PROBES of them.
     candidates.sort_by(|a, b| b.0.total_cmp(&a.0));
@@ -379,8 +403,8 @@ pub fn probe_contacts(model: &Model<'_>, peaks: &[f64]) -> Vec<ProbeContact> {
 }
 
 /// Each probe of `contacts` once, in their order, up to one more than [`MAX_PROBES`].
-fn distinct(contacts: impl Iterator<Item = ProbeContact>) -> Vec<ProbeContact> {
-    let mut kept: Vec<ProbeContact> = Vec::new();
+fn distinct<T: PartialEq>(contacts: impl Iterator<Item = T>) -> Vec<T> {
+    let mut kept: Vec<T> = Vec::new();
     for contact in contacts {
         if kept.len() > MAX_PROBES {
             break;
@@ -393,14 +417,27 @@ fn distinct(contacts: impl Iterator<Item = ProbeContact>) -> Vec<ProbeContact> {
 }
 
 /// The probes of `model`'s basis and mesh at the contacts that pushed in the run
-/// (`peaks`: each contact's peak force, N).
+/// (`peaks`: each contact's peak force, N), each on the basis and beam of the kind of
+/// pin it probes.
 pub fn assess(model: &Model<'_>, peaks: &[f64]) -> Result<BasisErrors, ModalError> {
-    let contacts = probe_contacts(model, peaks);
-    let probes = if contacts.is_empty() {
-        Vec::new()
-    } else {
-        probe(model.basis.spec(), model.basis, &contacts)?
-    };
+    let contacts = probe_kind_contacts(model, peaks);
+    let mut probes = Vec::new();
+    for kind in 0..=model.kinds.len() {
+        let of_kind: Vec<ProbeContact> = contacts
+            .iter()
+            .filter(|(k, _)| *k == kind)
+            .map(|(_, c)| *c)
+            .collect();
+        if of_kind.is_empty() {
+            continue;
+        }
+        let basis = if kind == 0 {
+            model.basis
+        } else {
+            model.kinds[kind - 1].basis
+        };
+        probes.extend(probe(basis.spec(), basis, &of_kind)?);
+    }
     Ok(BasisErrors::of(&probes))
 }
 
@@ -408,7 +445,16 @@ pub fn assess(model: &Model<'_>, peaks: &[f64]) -> Result<BasisErrors, ModalErro
 /// which did (on a thread the run leaves free), when there are at most [`MAX_PROBES`]
 /// of them (then the run's probes are among them); `None` otherwise.
 pub fn prepare(model: &Model<'_>) -> Option<Result<Vec<Probe>, ModalError>> {
-    let contacts = distinct((0..model.contacts.len()).filter_map(|c| probe_contact(model, c)));
+    // Bodies of several kinds are probed after the run ([`assess`]).
+    if !model.kinds.is_empty() {
+        return None;
+    }
+    let pin_kinds = model.pin_kinds();
+    let contacts: Vec<ProbeContact> =
+        distinct((0..model.contacts.len()).flat_map(|c| probe_contact(model, &pin_kinds, c)))
+            .into_iter()
+            .map(|(_, c)| c)
+            .collect();
     if contacts.len() > MAX_PROBES {
         return None;
     }

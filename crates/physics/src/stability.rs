@@ -60,21 +60,55 @@ impl Scheme {
     }
 }
 
-/// ω_max (rad/s) of the row of `pins` pins with every contact closed.
-/// `frequencies` are the modal ωᵢ, `contact_shapes[c]` is ψ(z_c) for contact c.
+/// The pins' modes as the stability analysis sees them: each pin's angular frequencies
+/// ωᵢ and the factor s = 1/√μ its shapes take in mass-normalised coordinates (a body of
+/// another kind, of modal mass μ relative to the basis's beam, `crate::integrate::
+/// BodyKind`: K̄ = M̄^{-½} (diag(μ ω²) + Σ Kc b bᵀ) M̄^{-½} has ω² on its diagonal and
+/// s ψ in b on that pin's lines).
+#[derive(Debug, Clone)]
+pub struct PinModes<'a> {
+    pub frequencies: Vec<&'a [f64]>,
+    pub shape_scales: Vec<f64>,
+}
+
+impl<'a> PinModes<'a> {
+    /// `pins` pins of one kind, of these frequencies.
+    pub fn uniform(frequencies: &'a [f64], pins: usize) -> Self {
+        Self {
+            frequencies: vec![frequencies; pins],
+            shape_scales: vec![1.0; pins],
+        }
+    }
+
+    fn pins(&self) -> usize {
+        self.frequencies.len()
+    }
+
+    fn modes(&self) -> usize {
+        self.frequencies.first().map_or(0, |f| f.len())
+    }
+
+    /// ω² of pin p's mode i.
+    fn omega_squared(&self, p: usize, i: usize) -> f64 {
+        self.frequencies[p][i].powi(2)
+    }
+}
+
+/// ω_max (rad/s) of the row of pins `pin_modes` with every contact closed.
+/// `contact_shapes[c]` is ψ(z_c) for contact c (on the basis's beam).
 pub fn max_angular_frequency(
-    frequencies: &[f64],
-    pins: usize,
+    pin_modes: &PinModes<'_>,
     contacts: &[Contact],
     contact_shapes: &[Vec<f64>],
 ) -> f64 {
-    let modes = frequencies.len();
+    let (pins, modes) = (pin_modes.pins(), pin_modes.modes());
+    let scale = &pin_modes.shape_scales;
     let size = pins * modes;
     let eigenvalue = if size <= DENSE_LIMIT {
         let mut stiffness = Mat::<f64>::zeros(size, size);
         for p in 0..pins {
-            for (i, w) in frequencies.iter().enumerate() {
-                stiffness[(p * modes + i, p * modes + i)] = w * w;
+            for i in 0..modes {
+                stiffness[(p * modes + i, p * modes + i)] = pin_modes.omega_squared(p, i);
             }
         }
         for (contact, shape) in contacts.iter().zip(contact_shapes) {
@@ -83,10 +117,10 @@ pub fn max_angular_frequency(
                 let Body::Pin(pa) = body_a else { continue };
                 for (body_b, sign_b) in sides {
                     let Body::Pin(pb) = body_b else { continue };
+                    let k = contact.stability_stiffness() * sign_a * sign_b * scale[pa] * scale[pb];
                     for i in 0..modes {
                         for j in 0..modes {
-                            stiffness[(pa * modes + i, pb * modes + j)] +=
-                                contact.stability_stiffness() * sign_a * sign_b * shape[i] * shape[j];
+                            stiffness[(pa * modes + i, pb * modes + j)] += k * shape[i] * shape[j];
                         }
                     }
                 }
@@ -103,7 +137,7 @@ pub fn max_angular_frequency(
                 parts: [(contact.left, -1.0), (contact.right, 1.0)]
                     .into_iter()
                     .filter_map(|(body, sign)| match body {
-                        Body::Pin(p) => Some((p * modes, sign)),
+                        Body::Pin(p) => Some((p * modes, sign * scale[p])),
                         Body::Wall => None,
                     })
                     .collect(),
@@ -111,12 +145,13 @@ pub fn max_angular_frequency(
             .collect();
         let bound = (0..pins)
             .map(|p| {
-                let mut stiffness =
-                    Mat::<f64>::from_fn(
-                        modes,
-                        modes,
-                        |i, j| if i == j { frequencies[i].powi(2) } else { 0.0 },
-                    );
+                let mut stiffness = Mat::<f64>::from_fn(modes, modes, |i, j| {
+                    if i == j {
+                        pin_modes.omega_squared(p, i)
+                    } else {
+                        0.0
+                    }
+                });
                 for (contact, shape) in contacts.iter().zip(contact_shapes) {
                     let touches = contact.left == Body::Pin(p) || contact.right == Body::Pin(p);
                     if !touches {
@@ -127,16 +162,20 @@ pub fn max_angular_frequency(
                     } else {
                         2.0
                     };
+                    let k = factor * contact.stability_stiffness() * scale[p] * scale[p];
                     for i in 0..modes {
                         for j in 0..modes {
-                            stiffness[(i, j)] += factor * contact.stability_stiffness() * shape[i] * shape[j];
+                            stiffness[(i, j)] += k * shape[i] * shape[j];
                         }
                     }
                 }
                 largest_eigenvalue(&stiffness)
             })
             .fold(0.0, f64::max);
-        largest_eigenvalue_of_springs(frequencies, size, &springs).min(bound)
+        let diagonal: Vec<f64> = (0..size)
+            .map(|k| pin_modes.omega_squared(k / modes, k % modes))
+            .collect();
+        largest_eigenvalue_of_springs(&diagonal, modes, &springs).min(bound)
     };
     eigenvalue.max(0.0).sqrt()
 }
@@ -145,13 +184,13 @@ pub fn max_angular_frequency(
 /// c pushing along the unit normal `normals[c]` (see the module doc); the other
 /// arguments as in [`max_angular_frequency`].
 pub fn max_angular_frequency_in_plane(
-    frequencies: &[f64],
-    pins: usize,
+    pin_modes: &PinModes<'_>,
     contacts: &[Contact],
     contact_shapes: &[Vec<f64>],
     normals: &[[f64; 2]],
 ) -> f64 {
-    let modes = frequencies.len();
+    let (pins, modes) = (pin_modes.pins(), pin_modes.modes());
+    let scale = &pin_modes.shape_scales;
     // The whole system, lines ordered as in the integrator (x lines, then y), or one
     // pin's x and y lines.
     let dense = 2 * pins * modes <= DENSE_LIMIT;
@@ -164,13 +203,14 @@ pub fn max_angular_frequency_in_plane(
             axis * modes
         }
     };
-    let diagonal = || {
-        Mat::<f64>::from_fn(size, size, |i, j| {
-            if i == j {
-                frequencies[i % modes].powi(2)
-            } else {
-                0.0
-            }
+    // ω² of the whole system's coordinate k (lines ordered as in the integrator), or of
+    // pin p's x and y lines alone.
+    let omega_squared = |k: usize| pin_modes.omega_squared((k / modes) % pins, k % modes);
+    let diagonal = |pin: Option<usize>| {
+        Mat::<f64>::from_fn(size, size, |i, j| match (i == j, pin) {
+            (false, _) => 0.0,
+            (true, None) => omega_squared(i),
+            (true, Some(p)) => pin_modes.omega_squared(p, i % modes),
         })
     };
     // Adds factor · Kc b bᵀ for the sides of `contact` that `include` keeps.
@@ -196,11 +236,11 @@ pub fn max_angular_frequency_in_plane(
                 for (direction, spring) in springs.into_iter().filter(|(_, k)| *k > 0.0) {
                     for (axis_a, na) in direction.iter().enumerate() {
                         for (axis_b, nb) in direction.iter().enumerate() {
-                            let scale = factor * spring * sign_a * sign_b * na * nb;
+                            let k = factor * spring * sign_a * sign_b * na * nb * scale[pa] * scale[pb];
                             let (ra, rb) = (line(pa, axis_a), line(pb, axis_b));
                             for i in 0..modes {
                                 for j in 0..modes {
-                                    stiffness[(ra + i, rb + j)] += scale * shape[i] * shape[j];
+                                    stiffness[(ra + i, rb + j)] += k * shape[i] * shape[j];
                                 }
                             }
                         }
@@ -217,7 +257,7 @@ pub fn max_angular_frequency_in_plane(
             .map(|((c, s), n)| (c, s, n))
     };
     let eigenvalue = if dense {
-        let mut stiffness = diagonal();
+        let mut stiffness = diagonal(None);
         for contact in closed() {
             add(&mut stiffness, contact, 1.0, &|_| true);
         }
@@ -238,8 +278,8 @@ pub fn max_angular_frequency_in_plane(
                 let mut parts = Vec::with_capacity(4);
                 for (body, sign) in [(contact.left, -1.0), (contact.right, 1.0)] {
                     if let Body::Pin(p) = body {
-                        parts.push((line(p, 0), sign * direction[0]));
-                        parts.push((line(p, 1), sign * direction[1]));
+                        parts.push((line(p, 0), sign * scale[p] * direction[0]));
+                        parts.push((line(p, 1), sign * scale[p] * direction[1]));
                     }
                 }
                 springs.push(Spring {
@@ -251,7 +291,7 @@ pub fn max_angular_frequency_in_plane(
         }
         let bound = (0..pins)
             .map(|p| {
-                let mut stiffness = diagonal();
+                let mut stiffness = diagonal(Some(p));
                 for contact in closed() {
                     let (left, right) = (contact.0.left, contact.0.right);
                     if left != Body::Pin(p) && right != Body::Pin(p) {
@@ -269,7 +309,8 @@ pub fn max_angular_frequency_in_plane(
                 largest_eigenvalue(&stiffness)
             })
             .fold(0.0, f64::max);
-        largest_eigenvalue_of_springs(frequencies, 2 * pins * modes, &springs).min(bound)
+        let diagonal: Vec<f64> = (0..2 * pins * modes).map(omega_squared).collect();
+        largest_eigenvalue_of_springs(&diagonal, modes, &springs).min(bound)
     };
     eigenvalue.max(0.0).sqrt()
 }
@@ -288,14 +329,14 @@ const LANCZOS_ITERATIONS: usize = 300;
 /// Relative residual of the top Ritz pair at which Lanczos stops.
 const LANCZOS_TOLERANCE: f64 = 1e-10;
 
-/// λ_max of K̄ = diag(ω²) (the modal frequencies repeated on every line of `size`
-/// coordinates) + Σ k b bᵀ over `springs`, by Lanczos with full reorthogonalisation, never
+/// λ_max of K̄ = diag(`diagonal`) + Σ k b bᵀ over `springs` (`diagonal`: each
+/// coordinate's ω², lines of `modes` coordinates), by Lanczos with full reorthogonalisation, never
 /// forming K̄: the top Ritz value plus its residual (see the module doc).
-fn largest_eigenvalue_of_springs(frequencies: &[f64], size: usize, springs: &[Spring]) -> f64 {
-    let modes = frequencies.len();
+fn largest_eigenvalue_of_springs(diagonal: &[f64], modes: usize, springs: &[Spring]) -> f64 {
+    let size = diagonal.len();
     let apply = |x: &[f64], y: &mut [f64]| {
-        for (k, (yk, xk)) in y.iter_mut().zip(x).enumerate() {
-            *yk = frequencies[k % modes].powi(2) * xk;
+        for ((yk, xk), d) in y.iter_mut().zip(x).zip(diagonal) {
+            *yk = d * xk;
         }
         for spring in springs {
             let projection: f64 = spring
@@ -414,7 +455,7 @@ mod tests {
             damping: 0.0,
             law: Law::LINEAR,
         };
-        let omega = max_angular_frequency(&[10.0], 1, &[contact], &[vec![2.0]]);
+        let omega = max_angular_frequency(&PinModes::uniform(&[10.0], 1), &[contact], &[vec![2.0]]);
         assert!((omega - (100.0f64 + 1200.0).sqrt()).abs() < 1e-9, "ω_max {omega}");
     }
 
@@ -431,12 +472,16 @@ mod tests {
             damping: 0.0,
             law: Law::LINEAR,
         };
-        let exact = max_angular_frequency(&[3.0], 2, std::slice::from_ref(&contact), &[vec![1.5]]);
+        let exact = max_angular_frequency(
+            &PinModes::uniform(&[3.0], 2),
+            std::slice::from_ref(&contact),
+            &[vec![1.5]],
+        );
         let expected = (9.0f64 + 2.0 * 50.0 * 2.25).sqrt();
         assert!((exact - expected).abs() < 1e-9, "ω_max {exact} vs {expected}");
         // Force the bound path with a large row of uncoupled pins plus this pair.
         let pins = DENSE_LIMIT + 1;
-        let bound = max_angular_frequency(&[3.0], pins, &[contact], &[vec![1.5]]);
+        let bound = max_angular_frequency(&PinModes::uniform(&[3.0], pins), &[contact], &[vec![1.5]]);
         assert!(bound >= exact - 1e-9, "bound {bound} below exact {exact}");
     }
 
@@ -464,16 +509,18 @@ mod tests {
         ];
         let shapes = vec![vec![1.5]; 3];
         let normals = [normal, tangent, tangent];
-        let exact = max_angular_frequency_in_plane(&[3.0], 2, &contacts, &shapes, &normals);
+        let exact =
+            max_angular_frequency_in_plane(&PinModes::uniform(&[3.0], 2), &contacts, &shapes, &normals);
         let expected = (9.0f64 + 2.0 * 50.0 * 2.25).max(9.0 + 120.0 * 2.25).sqrt();
         assert!((exact - expected).abs() < 1e-9, "ω_max {exact} vs {expected}");
-        let row = max_angular_frequency(&[3.0], 2, &contacts, &shapes);
+        let row = max_angular_frequency(&PinModes::uniform(&[3.0], 2), &contacts, &shapes);
         assert!(
             row > exact + 1.0,
             "the row {row} stacks what the plane splits {exact}"
         );
         let pins = DENSE_LIMIT;
-        let bound = max_angular_frequency_in_plane(&[3.0], pins, &contacts, &shapes, &normals);
+        let bound =
+            max_angular_frequency_in_plane(&PinModes::uniform(&[3.0], pins), &contacts, &shapes, &normals);
         assert!(bound >= exact - 1e-9, "bound {bound} below exact {exact}");
     }
 
@@ -540,8 +587,12 @@ mod tests {
         }
         let modes = frequencies.len();
         assert!(2 * pins * modes > DENSE_LIMIT);
-        let lanczos =
-            max_angular_frequency_in_plane(&frequencies, pins, &contacts, &shapes(contacts.len()), &normals);
+        let lanczos = max_angular_frequency_in_plane(
+            &PinModes::uniform(&frequencies, pins),
+            &contacts,
+            &shapes(contacts.len()),
+            &normals,
+        );
 
         let size = 2 * pins * modes;
         let mut dense = Mat::<f64>::from_fn(size, size, |i, j| {
@@ -592,7 +643,7 @@ mod tests {
             .collect();
         let shape = vec![0.9, -1.1, 0.4];
         let shapes = vec![shape.clone(); contacts.len()];
-        let lanczos = max_angular_frequency(&frequencies, pins, &contacts, &shapes);
+        let lanczos = max_angular_frequency(&PinModes::uniform(&frequencies, pins), &contacts, &shapes);
         let size = pins * 3;
         let mut dense =
             Mat::<f64>::from_fn(

@@ -435,6 +435,7 @@ mod tests {
                     values: vec![-1.0, -1.0],
                 },
             }],
+            kinds: Vec::new(),
         };
         let corrected = model(&basis);
         let critical = critical_time_step(&corrected, Scheme::CentralDifference);
@@ -503,6 +504,7 @@ mod tests {
             walls: None,
             plane: None,
             point_forces: vec![],
+            kinds: Vec::new(),
         }
     }
 

@@ -86,6 +86,7 @@ fn row_model<'a>(
             .iter()
             .map(|f| f.physics())
             .collect(),
+        kinds: Vec::new(),
     }
 }
 

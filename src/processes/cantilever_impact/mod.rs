@@ -215,6 +215,7 @@ fn tip_model<'a>(inputs: &CantileverInputs, basis: &'a ModalBasis, contact_stiff
         walls: None,
         plane: None,
         point_forces: vec![],
+        kinds: Vec::new(),
     }
 }
 

@@ -118,6 +118,7 @@ fn plane_model<'a>(
             normals: normals.to_vec(),
             base_acceleration_y: y.clone(),
         }),
+        kinds: Vec::new(),
     }
 }
 

@@ -394,6 +394,7 @@ fn row_model(basis: &ModalBasis) -> Model<'_> {
         point_forces: vec![],
         plane: None,
         walls: None,
+        kinds: Vec::new(),
     }
 }
 

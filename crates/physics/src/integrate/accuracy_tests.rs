@@ -102,6 +102,7 @@ impl Row {
             walls: None,
             plane: None,
             point_forces: vec![],
+            kinds: Vec::new(),
         }
     }
 

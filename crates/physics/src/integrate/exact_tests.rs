@@ -389,6 +389,7 @@ fn triangle<'a>(basis: &'a ModalBasis, heights: &[f64], friction: Friction) -> M
             }),
         }),
         point_forces: vec![],
+        kinds: Vec::new(),
     }
 }
 
@@ -465,6 +466,7 @@ fn three_pin_model<'a>(basis: &'a ModalBasis, heights: &[f64]) -> Model<'a> {
         walls: None,
         plane: None,
         point_forces: vec![],
+        kinds: Vec::new(),
     }
 }
 
@@ -514,6 +516,7 @@ fn stiff_contacts_with_dashpots_rattle_to_central_differences_peak() {
         walls: None,
         plane: None,
         point_forces: vec![],
+        kinds: Vec::new(),
     };
     let (exact, explicit) = exact_and_converged_explicit(&model, 0.04);
     assert_dissipative_rattling_matches(&exact, &explicit, 10);

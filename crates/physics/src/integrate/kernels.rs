@@ -505,6 +505,9 @@ pub(super) struct ModalCoefficients<'a, S: Simd> {
     pub factor: &'a [S::f64s],
     /// Γᵢ.
     pub participation: &'a [S::f64s],
+    /// 1/μ of the lines' kind ([`super::kinds`]): their loads are divided by their mass
+    /// relative to the basis's beam (1 for the basis's).
+    pub inverse_mass: f64,
 }
 
 /// Sums the modal update accumulates: Σ 2ξω v² and Σ Γ v over every pin and mode.
@@ -520,7 +523,7 @@ pub(super) type ModalState<'a, V> = (&'a [V], &'a mut [V], &'a mut [V], &'a mut 
 /// Accumulators of the power sums (independent dependency chains).
 const SUMS: usize = 4;
 
-/// With f the contact and point loads: a = (f − Γ·base − ω² q − 2ξω v)·factor, then
+/// With f the contact and point loads: a = (f/μ − Γ·base − ω² q − 2ξω v)·factor, then
 /// v += `half_step`·a (0 for Tchamwa, whose velocity was advanced before the forces),
 /// and f is zeroed for the next step; returns the power sums at the new v.
 #[inline(always)]
@@ -534,10 +537,11 @@ pub(super) fn modal_update<S: Simd>(
     let n = coefficients.stiffness.len();
     let (k, c) = (coefficients.stiffness, &coefficients.damping[..n]);
     let (x, g) = (&coefficients.factor[..n], &coefficients.participation[..n]);
-    let (half, load, zero) = (
+    let (half, load, zero, inverse_mass) = (
         simd.splat_f64s(half_step),
         simd.splat_f64s(-base),
         simd.splat_f64s(0.0),
+        simd.splat_f64s(coefficients.inverse_mass),
     );
     let mut damping_power = [zero; SUMS];
     let mut participation_velocity = [zero; SUMS];
@@ -548,7 +552,7 @@ pub(super) fn modal_update<S: Simd>(
         .zip(f.chunks_exact_mut(n))
     {
         for i in 0..n {
-            let force = simd.mul_add_e_f64s(load, g[i], f[i]);
+            let force = simd.mul_add_e_f64s(load, g[i], simd.mul_f64s(f[i], inverse_mass));
             f[i] = zero;
             let elastic = simd.mul_f64s(k[i], q[i]);
             let viscous = simd.mul_f64s(c[i], v[i]);
@@ -740,6 +744,7 @@ mod tests {
             damping: vectors::<S>(&damping),
             factor: vectors::<S>(&factor),
             participation: vectors::<S>(&participation),
+            inverse_mass: 0.8,
         };
         let (q, f0) = (values(pins * row, 0.29), values(pins * row, 0.31));
         let (mut v, mut a, mut f) = (values(pins * row, 0.41), vec![0.0; pins * row], f0.clone());
@@ -759,7 +764,7 @@ mod tests {
         let (mut damping_power, mut participation_velocity) = (0.0, 0.0);
         for k in 0..pins * row {
             let i = k % row;
-            let load = f0[k] - 0.7 * participation[i];
+            let load = f0[k] * 0.8 - 0.7 * participation[i];
             let acceleration = (load - stiffness[i] * q[k] - damping[i] * v0[k]) * factor[i];
             let velocity = v0[k] + 0.5 * acceleration;
             assert!(close(a[k], acceleration) && close(v[k], velocity) && f[k] == 0.0);

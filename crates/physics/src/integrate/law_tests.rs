@@ -48,6 +48,7 @@ fn one_pin<'a>(basis: &'a ModalBasis, contacts: Vec<Contact>, tip: f64, kind: Lo
         walls: None,
         plane: None,
         point_forces: vec![],
+        kinds: Vec::new(),
     };
     match kind {
         Loop::Row => {}
@@ -426,6 +427,7 @@ fn clamped_in_the_plane(
             base_acceleration_y: None,
         }),
         point_forces: vec![],
+        kinds: Vec::new(),
     };
     let settings = Settings {
         threads,

@@ -39,12 +39,22 @@ pub(super) struct Layout<'m> {
     pub lines: usize,
     /// Slots per block of the block-major deflections: `[wall, line 0, …, line n−1, wall]`.
     pub stride: usize,
-    /// Per mode (padded to `row`): ωᵢ², 2ξᵢωᵢ, and for central difference 1/(1 + ξᵢωᵢΔt).
+    /// Per mode of the basis's beam (padded to `row`): ωᵢ² and 2ξᵢωᵢ (the exact scheme's
+    /// propagators; every loop's modal update reads [`Layout::kinds`]).
     pub omega_squared: Vec<f64>,
     pub damping: Vec<f64>,
-    pub implicit_damping_factor: Vec<f64>,
     /// Γᵢ, padded to `row`.
     pub participation: Vec<f64>,
+    /// Per kind of body (the basis's first, [`super::BodyKind`]): its coefficients as
+    /// above and its mass; the basis's are `omega_squared`, `damping` and
+    /// `implicit_damping_factor`.
+    pub kinds: Vec<LineKind>,
+    /// The lines as runs of consecutive lines of one kind (the x lines' runs, then the
+    /// y lines'): one run over each direction's lines when every pin is the basis's.
+    pub runs: Vec<LineRun>,
+    /// The same with the runs of one kind on either side of the x/y boundary merged (what
+    /// the energies sum over: one run over every line when every pin is the basis's).
+    pub energy_runs: Vec<LineRun>,
     /// The dashpots see ṽ = v + `dashpot_lookahead` · a right after the first half of
     /// the update: ½Δt for central difference (ṽ = v½ + ½Δt aₙ), 0 for Tchamwa.
     pub dashpot_lookahead: f64,
@@ -123,6 +133,79 @@ impl LaneContact {
             NormalLaw::linear(self.stiffness, self.dashpot).force(penetration, rate)
         }
     }
+}
+
+/// One kind of body's modal coefficients (padded to `row`): ωᵢ², 2ξᵢωᵢ and the implicit
+/// damping factor, and its mass μ relative to the basis's beam (its lines' loads are
+/// divided by it, their energies multiplied: [`super::kinds`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct LineKind {
+    pub omega_squared: Vec<f64>,
+    pub damping: Vec<f64>,
+    pub implicit_damping_factor: Vec<f64>,
+    pub mass: f64,
+    pub inverse_mass: f64,
+}
+
+/// Consecutive lines `first..first + lines` of one kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct LineRun {
+    pub first: usize,
+    pub lines: usize,
+    pub kind: usize,
+}
+
+impl LineKind {
+    fn new(scale: &super::KindScale<'_>, row: usize, scheme: Scheme, dt: f64) -> Self {
+        let damping: Vec<f64> = scale
+            .frequencies
+            .iter()
+            .zip(scale.damping_ratios)
+            .map(|(w, xi)| 2.0 * xi * w)
+            .collect();
+        Self {
+            omega_squared: padded(
+                &scale.frequencies.iter().map(|w| w * w).collect::<Vec<_>>(),
+                row,
+                0.0,
+            ),
+            implicit_damping_factor: padded(
+                &damping
+                    .iter()
+                    .map(|c| match scheme {
+                        Scheme::CentralDifference => 1.0 / (1.0 + 0.5 * c * dt),
+                        Scheme::Tchamwa { .. } | Scheme::ExactModal => 1.0,
+                    })
+                    .collect::<Vec<_>>(),
+                row,
+                1.0,
+            ),
+            damping: padded(&damping, row, 0.0),
+            mass: scale.mass,
+            inverse_mass: 1.0 / scale.mass,
+        }
+    }
+}
+
+/// The runs of consecutive lines of one kind, `kinds` giving each pin's: the x lines,
+/// then in the plane the y lines.
+fn line_runs(kinds: &[usize], plane: bool) -> Vec<LineRun> {
+    let pins = kinds.len();
+    let mut runs: Vec<LineRun> = Vec::new();
+    for direction in 0..(if plane { 2 } else { 1 }) {
+        for (pin, kind) in kinds.iter().enumerate() {
+            let line = direction * pins + pin;
+            match runs.last_mut() {
+                Some(run) if run.kind == *kind && run.first + run.lines == line && pin > 0 => run.lines += 1,
+                _ => runs.push(LineRun {
+                    first: line,
+                    lines: 1,
+                    kind: *kind,
+                }),
+            }
+        }
+    }
+    runs
 }
 
 /// What the contacts need besides [`LaneContact`]: nothing for the row, where every
@@ -210,12 +293,20 @@ impl<'m> Layout<'m> {
         let basis = model.basis;
         let (pins, modes) = (model.pins, basis.modes());
         let row = modes.div_ceil(lanes) * lanes;
-        let omega = basis.angular_frequencies();
-        let damping: Vec<f64> = omega
+        let kinds: Vec<LineKind> = model
+            .kind_scales()
             .iter()
-            .zip(&model.damping_ratios)
-            .map(|(w, xi)| 2.0 * xi * w)
+            .map(|scale| LineKind::new(scale, row, settings.scheme, dt))
             .collect();
+        let pin_kinds = model.pin_kinds();
+        let runs = line_runs(&pin_kinds, model.plane.is_some());
+        let mut energy_runs: Vec<LineRun> = Vec::new();
+        for run in &runs {
+            match energy_runs.last_mut() {
+                Some(last) if last.kind == run.kind => last.lines += run.lines,
+                _ => energy_runs.push(*run),
+            }
+        }
 
         let mut heights: Vec<f64> = Vec::new();
         let mut contact_level: Vec<usize> = model
@@ -346,20 +437,12 @@ impl<'m> Layout<'m> {
             row,
             lines,
             stride,
-            omega_squared: padded(&omega.iter().map(|w| w * w).collect::<Vec<_>>(), row, 0.0),
-            implicit_damping_factor: padded(
-                &damping
-                    .iter()
-                    .map(|c| match settings.scheme {
-                        Scheme::CentralDifference => 1.0 / (1.0 + 0.5 * c * dt),
-                        Scheme::Tchamwa { .. } | Scheme::ExactModal => 1.0,
-                    })
-                    .collect::<Vec<_>>(),
-                row,
-                1.0,
-            ),
-            damping: padded(&damping, row, 0.0),
+            omega_squared: kinds[0].omega_squared.clone(),
+            damping: kinds[0].damping.clone(),
             participation: padded(basis.participation(), row, 0.0),
+            kinds,
+            runs,
+            energy_runs,
             dashpot_lookahead: match settings.scheme {
                 Scheme::CentralDifference => 0.5 * dt,
                 Scheme::Tchamwa { .. } | Scheme::ExactModal => 0.0,

@@ -47,6 +47,7 @@ pub use super::statistics::{
 };
 use crate::InputIssue;
 pub use crate::impacts::{ImpactCounting, ImpactHistogram, ImpactStatistics, ImpactTable};
+pub use kinds::{BodyKind, KindScale, SHAPE_TOLERANCE, relative_mass};
 pub use model::{Model, NORMAL_LENGTH_TOLERANCE, Plane, Settings, TimeStep, WallMotion};
 pub use plan::Plan;
 pub use quality::{Check, Quality, StepComparison, StepHalving, Verdict};
@@ -188,6 +189,7 @@ pub(crate) fn simulate(
 
 mod exact;
 mod kernels;
+mod kinds;
 mod layout;
 mod model;
 mod plan;
@@ -225,6 +227,8 @@ mod thread_tests;
 mod bending_tests;
 #[cfg(test)]
 mod exact_tests;
+#[cfg(test)]
+mod kind_tests;
 #[cfg(test)]
 mod law_tests;
 #[cfg(test)]

@@ -12,6 +12,7 @@ use crate::modal::ModalBasis;
 use crate::stability::Scheme;
 use crate::{InputIssue, require_non_negative, require_positive};
 
+use super::kinds::{self, BodyKind, KindScale};
 use super::quality::Check;
 
 /// The pins being integrated: a row (every pin bends along x, every contact normal is
@@ -43,6 +44,9 @@ pub struct Model<'a> {
     /// `None`: the walls (the wrapper in the plane) and the pins' top supports move with
     /// the feet. `Some`: they have their own motion ([`WallMotion`]).
     pub walls: Option<WallMotion>,
+    /// Pins of other kinds than the basis's beam (another section, material, mass or
+    /// damping: [`BodyKind`]); empty when every pin is the basis's.
+    pub kinds: Vec<BodyKind<'a>>,
 }
 
 /// The walls' own motion (and the wrapper's in the plane), distinct from the feet's.
@@ -181,6 +185,7 @@ impl Model<'_> {
                     .map(|i| i.within(&prefix)),
             );
         }
+        issues.extend(kinds::validate(&self.kinds, self.basis, pins));
         self.validate_laws(&mut issues);
         self.validate_release(&mut issues);
         if let Some(base) = &self.base_acceleration {
@@ -233,11 +238,55 @@ impl Model<'_> {
     /// foot, where no mode moves.
     pub fn reduced_mass(&self, contact: &Contact) -> f64 {
         let shape = self.basis.deflection_at(contact.height);
-        let pin_mass = 1.0 / shape.iter().map(|phi| phi * phi).sum::<f64>();
+        let apparent = 1.0 / shape.iter().map(|phi| phi * phi).sum::<f64>();
+        let scales = self.kind_scales();
+        let kinds = self.pin_kinds();
+        let mass = |pin: usize| apparent * scales[kinds[pin]].mass;
         match (contact.left, contact.right) {
-            (Body::Pin(_), Body::Pin(_)) => 0.5 * pin_mass,
-            _ => pin_mass,
+            (Body::Pin(left), Body::Pin(right)) => {
+                let (a, b) = (mass(left), mass(right));
+                if a.is_finite() && b.is_finite() {
+                    a * b / (a + b)
+                } else {
+                    a.min(b)
+                }
+            }
+            (Body::Pin(pin), Body::Wall) | (Body::Wall, Body::Pin(pin)) => mass(pin),
+            (Body::Wall, Body::Wall) => f64::INFINITY,
         }
+    }
+
+    /// The kind of every pin: 0 for the basis's beam, k + 1 for `kinds[k]`.
+    pub fn pin_kinds(&self) -> Vec<usize> {
+        kinds::pin_kinds(&self.kinds, self.pins)
+    }
+
+    /// Per kind (the basis's first, then `kinds`): its mass relative to the basis's beam,
+    /// its frequencies and damping ratios. A kind refused by [`Model::validate`] counts
+    /// as the basis's.
+    pub fn kind_scales(&self) -> Vec<KindScale<'_>> {
+        std::iter::once(KindScale {
+            mass: 1.0,
+            frequencies: self.basis.angular_frequencies(),
+            damping_ratios: &self.damping_ratios,
+        })
+        .chain(
+            self.kinds
+                .iter()
+                .map(|kind| match kinds::relative_mass(self.basis, kind.basis) {
+                    Ok(mass) => KindScale {
+                        mass,
+                        frequencies: kind.basis.angular_frequencies(),
+                        damping_ratios: &kind.damping_ratios,
+                    },
+                    Err(_) => KindScale {
+                        mass: 1.0,
+                        frequencies: self.basis.angular_frequencies(),
+                        damping_ratios: &self.damping_ratios,
+                    },
+                }),
+        )
+        .collect()
     }
 
     /// Laws the model can carry: a restitution whose bodies have a finite mass (or one
@@ -334,7 +383,14 @@ impl Model<'_> {
         let model = self.basis.model();
         let top_dof = 2 * model.elements;
         if !model.free_dofs.contains(&top_dof) {
-            if self.basis.support_transport().is_none() {
+            if !self.kinds.is_empty() {
+                issues.push(InputIssue::new(
+                    "kinds",
+                    "pins held at both ends have their top support on walls with their own \
+                     motion: that transport is not available with bodies of several kinds; \
+                     let the walls move with the feet",
+                ));
+            } else if self.basis.support_transport().is_none() {
                 issues.push(InputIssue::new(
                     "walls",
                     "the pins' top support cannot follow the walls: held by the top alone, \
@@ -561,6 +617,7 @@ mod tests {
             }],
             walls: None,
             plane: None,
+            kinds: Vec::new(),
         }
     }
 

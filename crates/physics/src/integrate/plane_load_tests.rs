@@ -48,6 +48,7 @@ fn lone_pin(basis: &ModalBasis, plane: bool) -> Model<'_> {
             normals: vec![],
             base_acceleration_y: None,
         }),
+        kinds: Vec::new(),
     }
 }
 

@@ -25,9 +25,8 @@
 use pulp::Simd;
 
 use super::kernels::{
-    ContactLanes, ContactState, LevelShapes, ModalCoefficients, PlaneGroups, UpdateSums, advance_positions,
-    level_deflections_of_groups, list_closed, modal_update, penetration_rate, plane_penetrations_of_words,
-    row_axpy,
+    ContactLanes, ContactState, LevelShapes, PlaneGroups, UpdateSums, advance_positions,
+    level_deflections_of_groups, list_closed, penetration_rate, plane_penetrations_of_words, row_axpy,
 };
 use super::layout::{LaneContact, Layout, PlaneLane};
 use super::recorder::record_closed_contact;
@@ -403,10 +402,10 @@ pub(super) struct Loads<'a> {
     pub walls: Option<(&'a WallLayout, &'a WallState)>,
 }
 
-/// The modal update of a half: its coefficients, the second half of the step (Δt/2,
-/// or 0 for Tchamwa) and, if the next step's first half is taken with it, that first
-/// half's (Δt, half step, curvature) ([`advance_positions`]).
-pub(super) type Update<'a, S> = (&'a ModalCoefficients<'a, S>, f64, Option<(f64, f64, f64)>);
+/// The modal update of a half: the second half of the step (Δt/2, or 0 for Tchamwa)
+/// and, if the next step's first half is taken with it, that first half's (Δt, half
+/// step, curvature) ([`advance_positions`]).
+pub(super) type Update = (f64, Option<(f64, f64, f64)>);
 
 /// Both halves' contact loads (and the walls' transport loads); with `update`, their
 /// modal update with `second_half` too (and with a first half, the first half of the
@@ -417,7 +416,7 @@ pub(super) fn update_halves<S: Simd>(
     simd: S,
     loads: &Loads<'_>,
     halves: [Half<'_>; 2],
-    update: Option<Update<'_, S>>,
+    update: Option<Update>,
     threads: usize,
 ) -> [Option<UpdateSums>; 2] {
     let [x, y] = halves;
@@ -441,7 +440,7 @@ fn update_half<S: Simd>(
     simd: S,
     loads: &Loads<'_>,
     half: Half<'_>,
-    update: Option<Update<'_, S>>,
+    update: Option<Update>,
 ) -> Option<UpdateSums> {
     simd.vectorize(
         #[inline(always)]
@@ -479,15 +478,17 @@ fn update_half<S: Simd>(
             if let Some((walls, wall)) = loads.walls {
                 wall.add_transport_load(walls, half.force, layout.row, usize::from(half.y));
             }
-            update.map(|(coefficients, second_half, next)| {
+            update.map(|(second_half, next)| {
                 let (q, v, a) = (
                     S::as_mut_simd_f64s(half.q).0,
                     S::as_mut_simd_f64s(half.v).0,
                     S::as_mut_simd_f64s(half.a).0,
                 );
-                let sums = modal_update(
+                let first = if half.y { layout.model.pins } else { 0 };
+                let sums = super::stepper::update_lines(
                     simd,
-                    coefficients,
+                    layout,
+                    first,
                     half.base,
                     second_half,
                     (q, v, a, S::as_mut_simd_f64s(half.force).0),

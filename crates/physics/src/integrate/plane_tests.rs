@@ -62,6 +62,7 @@ fn shaken_row(basis: &ModalBasis, amplitude: f64) -> Model<'_> {
         point_forces: vec![],
         walls: None,
         plane: None,
+        kinds: Vec::new(),
     }
 }
 
@@ -315,6 +316,7 @@ fn triangle(basis: &ModalBasis) -> Model<'_> {
                 cycles: 2.0,
             }),
         }),
+        kinds: Vec::new(),
     }
 }
 
@@ -392,6 +394,7 @@ fn a_contact_between_two_pins_exchanges_equal_and_opposite_impulses() {
             normals: vec![normal, [normal[1], normal[0]]],
             base_acceleration_y: None,
         }),
+        kinds: Vec::new(),
     };
     let result = run(&model, &settings(2e-6, 0.05));
     let impacts: u64 = result.contact_statistics.iter().map(|s| s.impacts).sum();
@@ -635,6 +638,7 @@ fn the_planes_critical_step_matches_brute_force_divergence() {
             normals: vec![[0.6, 0.8]],
             base_acceleration_y: None,
         }),
+        kinds: Vec::new(),
     };
     let critical = critical_time_step(&model, Scheme::CentralDifference);
     let row = Model {
@@ -737,6 +741,7 @@ fn large_plane_speed() {
                 duration: 0.005,
             }),
         }),
+        kinds: Vec::new(),
     };
     let settings = Settings {
         time_step: TimeStep::Auto,
@@ -809,6 +814,7 @@ fn one_pin_in_the_wrapper_shaken_sixty_degrees_further_gives_the_turned_response
                 duration: 0.01,
             }),
         }),
+        kinds: Vec::new(),
     };
     let theta = 0.2;
     let settings = settings(2e-5, 0.05);

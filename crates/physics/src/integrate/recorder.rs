@@ -428,7 +428,7 @@ impl Recorder {
         steps: u64,
         output_interval: f64,
     ) -> Simulation {
-        self.energy.kinetic = 0.5 * state.v.iter().map(|v| v * v).sum::<f64>();
+        self.energy.kinetic = state.kinetic_energy(layout);
         self.energy.contact = state.contact_energy(layout);
         self.energy.strain =
             state.mechanical_energy(arch, layout) - self.energy.kinetic - self.energy.contact;

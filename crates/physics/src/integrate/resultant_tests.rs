@@ -74,6 +74,7 @@ fn oblique_pair(basis: &ModalBasis, law: Law) -> Model<'_> {
                 duration: 0.007,
             }),
         }),
+        kinds: Vec::new(),
     }
 }
 
@@ -202,6 +203,7 @@ fn equal_preloads_from_both_sides_cancel() {
         point_forces: vec![],
         walls: None,
         plane: None,
+        kinds: Vec::new(),
     };
     let run = run(&model, &settings(1e-5, 0.01));
     for stats in &run.contact_statistics {

@@ -85,13 +85,37 @@ impl State {
         }
     }
 
+    /// Kinetic energy now (J): μ ½ Σ v² per run of lines of one kind.
+    pub fn kinetic_energy(&self, layout: &Layout<'_>) -> f64 {
+        let row = layout.row;
+        layout
+            .energy_runs
+            .iter()
+            .map(|run| {
+                let v = &self.v[run.first * row..(run.first + run.lines) * row];
+                layout.kinds[run.kind].mass * 0.5 * v.iter().map(|v| v * v).sum::<f64>()
+            })
+            .sum()
+    }
+
     /// Kinetic + strain + contact energy now (J).
     pub fn mechanical_energy(&self, arch: pulp::Arch, layout: &Layout<'_>) -> f64 {
-        let modal = arch.dispatch(ModalEnergyOp {
-            stiffness: &layout.omega_squared,
-            q: &self.q,
-            v: &self.v,
-        });
+        // Per run of lines of one kind: μ ½ Σ (v² + ω² q²).
+        let row = layout.row;
+        let modal: f64 = layout
+            .energy_runs
+            .iter()
+            .map(|run| {
+                let kind = &layout.kinds[run.kind];
+                let rows = run.first * row..(run.first + run.lines) * row;
+                kind.mass
+                    * arch.dispatch(ModalEnergyOp {
+                        stiffness: &kind.omega_squared,
+                        q: &self.q[rows.clone()],
+                        v: &self.v[rows],
+                    })
+            })
+            .sum();
         modal + self.contact_energy(layout)
     }
 

@@ -32,7 +32,7 @@
 
 use super::{Model, Settings, SimulationError, TimeStep};
 use crate::loads::BaseAcceleration;
-use crate::stability::{Scheme, max_angular_frequency, max_angular_frequency_in_plane};
+use crate::stability::{PinModes, Scheme, max_angular_frequency, max_angular_frequency_in_plane};
 
 /// Steps per period of the fastest motion at the default tolerance (10⁻³).
 pub const STEPS_PER_PERIOD: f64 = 50.0;
@@ -263,12 +263,18 @@ pub fn max_frequency(model: &Model<'_>) -> f64 {
         .iter()
         .map(|c| model.basis.deflection_at(c.height))
         .collect();
-    let frequencies = model.basis.angular_frequencies();
+    let scales = model.kind_scales();
+    let pins = PinModes {
+        frequencies: model.pin_kinds().iter().map(|k| scales[*k].frequencies).collect(),
+        shape_scales: model
+            .pin_kinds()
+            .iter()
+            .map(|k| 1.0 / scales[*k].mass.sqrt())
+            .collect(),
+    };
     match &model.plane {
-        None => max_angular_frequency(frequencies, model.pins, &model.contacts, &shapes),
-        Some(plane) => {
-            max_angular_frequency_in_plane(frequencies, model.pins, &model.contacts, &shapes, &plane.normals)
-        }
+        None => max_angular_frequency(&pins, &model.contacts, &shapes),
+        Some(plane) => max_angular_frequency_in_plane(&pins, &model.contacts, &shapes, &plane.normals),
     }
 }
 

@@ -45,8 +45,8 @@ use pulp::Simd;
 
 use super::exact::{self, ExactRun};
 use super::kernels::{
-    self, ContactState, ModalCoefficients, advance_positions, axpy, lanes, level_deflections, modal_update,
-    penetration_rate, penetrations, plane_penetrations, row_axpy,
+    self, ContactState, ModalCoefficients, ModalState, UpdateSums, advance_positions, axpy, lanes,
+    level_deflections, modal_update, penetration_rate, penetrations, plane_penetrations, row_axpy,
 };
 use super::layout::{ContactModel, Layout, PlaneContacts};
 use super::plane_step::{self, ClosedPass, Half, LaneOutputs, Loads};
@@ -273,6 +273,7 @@ impl<'m> Integrator<'m> {
             // over each step).
             *exact = Some(ExactRun::new(layout, state.force.clone()));
         }
+        let pin_kinds = model.pin_kinds();
         for (line, ((a, f), q)) in state
             .a
             .chunks_exact_mut(row)
@@ -282,8 +283,10 @@ impl<'m> Integrator<'m> {
         {
             // The x lines come first; y lines only exist in the plane.
             let base = if line < pins { base_x } else { base_y };
+            let kind = &layout.kinds[pin_kinds[line % pins]];
             for k in 0..row {
-                a[k] = f[k] - base * layout.participation[k] - layout.omega_squared[k] * q[k];
+                a[k] =
+                    f[k] * kind.inverse_mass - base * layout.participation[k] - kind.omega_squared[k] * q[k];
                 f[k] = 0.0;
             }
         }
@@ -555,13 +558,6 @@ impl<'m> Integrator<'m> {
             Scheme::CentralDifference | Scheme::ExactModal => half,
             Scheme::Tchamwa { .. } => 0.0,
         };
-        let n = vectors;
-        let coefficients = ModalCoefficients::<S> {
-            stiffness: &S::as_simd_f64s(&layout.omega_squared).0[..n],
-            damping: &S::as_simd_f64s(&layout.damping).0[..n],
-            factor: &S::as_simd_f64s(&layout.implicit_damping_factor).0[..n],
-            participation: &S::as_simd_f64s(&layout.participation).0[..n],
-        };
         // A step shared between threads adds the closed contacts' loads with the update.
         let shared = PLANE && *threads > 1;
         // The transport's inertial load −Γᴾ r joins the contact and point loads.
@@ -578,7 +574,7 @@ impl<'m> Integrator<'m> {
                     S::as_mut_simd_f64s(&mut state.force).0,
                 );
                 let base = layout.model.base_acceleration.as_ref().map_or(0.0, |b| b.at(t));
-                let sums = modal_update(simd, &coefficients, base, second_half, (q, v, a, f));
+                let sums = update_lines(simd, layout, 0, base, second_half, (q, v, a, f));
                 (sums.damping_power, -base * sums.participation_velocity)
             }
             (true, ContactModel::Plane(_)) if !shared => {
@@ -594,8 +590,9 @@ impl<'m> Integrator<'m> {
                 let (v_x, v_y) = v.split_at_mut(x_lines);
                 let (a_x, a_y) = a.split_at_mut(x_lines);
                 let (f_x, f_y) = f.split_at_mut(x_lines);
-                let x = modal_update(simd, &coefficients, base_x, second_half, (q_x, v_x, a_x, f_x));
-                let y = modal_update(simd, &coefficients, base_y, second_half, (q_y, v_y, a_y, f_y));
+                let pins = layout.model.pins;
+                let x = update_lines(simd, layout, 0, base_x, second_half, (q_x, v_x, a_x, f_x));
+                let y = update_lines(simd, layout, pins, base_y, second_half, (q_y, v_y, a_y, f_y));
                 (
                     x.damping_power + y.damping_power,
                     -base_x * x.participation_velocity - base_y * y.participation_velocity,
@@ -611,7 +608,7 @@ impl<'m> Integrator<'m> {
                 let advance = more && layout.model.point_forces.is_empty() && layout.walls.is_none();
                 state.advanced = advance;
                 let (halves, loads) = plane_split(layout, state, bases, true);
-                let update = Some((&coefficients, second_half, advance.then_some(first_half)));
+                let update = Some((second_half, advance.then_some(first_half)));
                 let [x, y] = plane_step::update_halves(simd, &loads, halves, update, *threads)
                     .map(|sums| sums.expect("an update was asked"));
                 (
@@ -725,6 +722,55 @@ fn transport_outputs(layout: &Layout<'_>, walls: &WallLayout, wall: &WallState, 
             deflections[offset + line * lanes] += psi * d;
         }
     }
+}
+
+/// The modal update ([`modal_update`]) of the lines from `first` on that `q`, `v`, `a`
+/// and `f` hold (whole rows, whole runs of [`Layout::runs`]), each run of one kind with
+/// its coefficients and mass; the power sums weighted by each kind's mass (the basis's
+/// alone: one update of every line, as without kinds).
+#[inline(always)]
+pub(super) fn update_lines<S: Simd>(
+    simd: S,
+    layout: &Layout<'_>,
+    first: usize,
+    base: f64,
+    second_half: f64,
+    (q, v, a, f): ModalState<'_, S::f64s>,
+) -> UpdateSums {
+    let n = layout.row / layout.lanes;
+    let lines = q.len() / n;
+    let participation = &S::as_simd_f64s(&layout.participation).0[..n];
+    let mut sums = UpdateSums::default();
+    for run in layout
+        .runs
+        .iter()
+        .filter(|r| (first..first + lines).contains(&r.first))
+    {
+        let kind = &layout.kinds[run.kind];
+        let coefficients = ModalCoefficients::<S> {
+            stiffness: &S::as_simd_f64s(&kind.omega_squared).0[..n],
+            damping: &S::as_simd_f64s(&kind.damping).0[..n],
+            factor: &S::as_simd_f64s(&kind.implicit_damping_factor).0[..n],
+            participation,
+            inverse_mass: kind.inverse_mass,
+        };
+        let rows = (run.first - first) * n..(run.first - first + run.lines) * n;
+        let run_sums = modal_update(
+            simd,
+            &coefficients,
+            base,
+            second_half,
+            (
+                &q[rows.clone()],
+                &mut v[rows.clone()],
+                &mut a[rows.clone()],
+                &mut f[rows],
+            ),
+        );
+        sums.damping_power += kind.mass * run_sums.damping_power;
+        sums.participation_velocity += kind.mass * run_sums.participation_velocity;
+    }
+    sums
 }
 
 /// The plane's state as [`plane_step::update_halves`] takes it: the x and the y lines

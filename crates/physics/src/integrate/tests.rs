@@ -27,6 +27,7 @@ pub(super) fn free_model(basis: &ModalBasis, xi: f64, tip: f64) -> Model<'_> {
         walls: None,
         plane: None,
         point_forces: vec![],
+        kinds: Vec::new(),
     }
 }
 
@@ -272,6 +273,7 @@ pub(super) fn shaken_two_pin_row(basis: &ModalBasis) -> Model<'_> {
         walls: None,
         plane: None,
         point_forces: vec![],
+        kinds: Vec::new(),
     }
 }
 

@@ -88,6 +88,7 @@ fn bundle(basis: &ModalBasis) -> Model<'_> {
             normals,
             base_acceleration_y: shake(-20.0, 0.004),
         }),
+        kinds: Vec::new(),
     }
 }
 

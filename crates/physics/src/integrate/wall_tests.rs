@@ -105,6 +105,7 @@ fn opposite_wall_motions_give_a_mirror_symmetric_response() {
         }),
         plane: None,
         point_forces: vec![],
+        kinds: Vec::new(),
     };
     let result = run(
         &model,
@@ -157,6 +158,7 @@ fn a_pin_held_at_both_ends_follows_its_moving_top_support_quasi_statically() {
         walls: Some(WallMotion::rigid(Some(sine(amplitude, 1.0 / period, 1.0)), None)),
         plane: None,
         point_forces: vec![],
+        kinds: Vec::new(),
     };
     let middle = 0.5 * spec.length;
     let result = run(

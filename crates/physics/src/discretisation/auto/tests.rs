@@ -104,6 +104,7 @@ fn shock_peak(basis: &ModalBasis, tolerance: f64) -> f64 {
         walls: None,
         plane: None,
         point_forces: vec![],
+        kinds: Vec::new(),
     };
     let settings = Settings {
         scheme: Scheme::CentralDifference,
@@ -211,6 +212,7 @@ impl Shock {
             walls: None,
             plane: None,
             point_forces: vec![],
+            kinds: Vec::new(),
         };
         let settings = Settings {
             scheme: Scheme::CentralDifference,
