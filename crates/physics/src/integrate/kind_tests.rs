@@ -136,6 +136,7 @@ fn a_kind_that_is_the_basis_beam_changes_nothing_on_every_loop() {
             basis: &same,
             damping_ratios: plain.damping_ratios.clone(),
             pins: vec![1],
+            envelope_weight: 1.0,
         }];
         assert!(kinds.validate().is_empty(), "{:?}", kinds.validate());
         let settings = Settings {
@@ -186,6 +187,7 @@ fn a_pin_of_another_kind_moves_as_a_model_of_that_kind_alone_on_every_loop() {
             basis: &tubes,
             damping_ratios: vec![0.03; tubes.modes()],
             pins: vec![1],
+            envelope_weight: 1.0,
         }];
         assert!(mixed.validate().is_empty(), "{:?}", mixed.validate());
         let alone_contacts = vec![
@@ -248,6 +250,7 @@ fn a_rod_pressed_against_a_guide_tube_shares_the_load_as_statics_says_on_every_l
             basis: &tubes,
             damping_ratios: vec![0.1; tubes.modes()],
             pins: vec![1],
+            envelope_weight: 1.0,
         }];
         pair.point_forces = vec![PointForce {
             line: 0,
@@ -305,6 +308,7 @@ fn the_critical_step_of_two_kinds_is_that_of_their_masses_and_stiffnesses() {
         basis: &tubes,
         damping_ratios: vec![0.0; 3],
         pins: vec![1],
+        envelope_weight: 1.0,
     }];
     // K̄ in η: diag(ω_r², μ ω_t²) + Kc b bᵀ, M̄ = diag(1, μ); b = (ψ(L), −ψ(L)).
     let psi = rods.deflection_at(1.0);
@@ -377,6 +381,7 @@ fn kinds_that_are_not_the_basis_beam_scaled_and_pins_without_a_kind_are_refused(
             basis,
             damping_ratios: vec![0.01; ratios],
             pins,
+            envelope_weight: 1.0,
         }];
         let issues = pair.validate();
         assert!(
@@ -392,6 +397,7 @@ fn kinds_that_are_not_the_basis_beam_scaled_and_pins_without_a_kind_are_refused(
         basis: &tubes,
         damping_ratios: vec![0.01; 4],
         pins: vec![1],
+        envelope_weight: 1.0,
     }];
     let exact = Settings {
         time_step: TimeStep::Auto,
@@ -401,4 +407,35 @@ fn kinds_that_are_not_the_basis_beam_scaled_and_pins_without_a_kind_are_refused(
         Plan::new(&pair, &exact),
         Err(SimulationError::InvalidSettings(_))
     ));
+}
+
+/// The bending envelope compares pins by their curvature times their kind's weight (its
+/// stress per unit curvature) and reports the chosen pin's own curvature: a guide tube
+/// bent half as much as a rod but five times as stressed per unit curvature is the one
+/// at the foot.
+#[test]
+fn the_bending_envelope_holds_the_pin_its_weights_make_the_most_stressed() {
+    let rods = ModalBasis::compute(&default_tube(20), 3).expect("valid beam");
+    let tubes = ModalBasis::compute(&guide_tube(20), 3).expect("valid beam");
+    for (weight, expected) in [(1.0, 0), (5.0, 1)] {
+        let mut pair = model(&rods, 2, vec![], vec![2e-3, 1e-3], Loop::Row);
+        pair.base_acceleration = None;
+        pair.kinds = vec![BodyKind {
+            basis: &tubes,
+            damping_ratios: vec![0.0; 3],
+            pins: vec![1],
+            envelope_weight: weight,
+        }];
+        let result = run(
+            &pair,
+            &Settings {
+                output_interval: Some(1e-4),
+                ..settings(Scheme::CentralDifference, 2e-6, 0.05)
+            },
+        );
+        let foot = result.curvature_envelope[0];
+        assert_eq!(foot.pin, expected, "weight {weight}: {foot:?}");
+        let own = result.pin_curvatures[expected].curvature;
+        assert!((foot.curvature - own).abs() <= 1e-12 * own, "{foot:?} vs {own}");
+    }
 }

@@ -35,6 +35,12 @@ pub struct BodyKind<'a> {
     /// The pins of this kind (each at most once in every kind); the others are the
     /// basis's.
     pub pins: Vec<usize>,
+    /// The factor its curvatures take where the bending envelope compares pins at a
+    /// height ([`super::Simulation::curvature_envelope`]): its outer-fibre stress per
+    /// unit curvature E c relative to the basis's beam's, so that the envelope holds the
+    /// most stressed pin; 1 compares curvatures. The envelope reports the pin's own
+    /// curvature.
+    pub envelope_weight: f64,
 }
 
 /// How far a kind's mass-scaled shapes may be from the basis's (relative to the largest
@@ -135,6 +141,7 @@ pub fn validate(kinds: &[BodyKind<'_>], basis: &ModalBasis, pins: usize) -> Vec<
                 ),
             ));
         }
+        crate::require_positive(&mut issues, &field("envelope_weight"), kind.envelope_weight);
         for (i, xi) in kind.damping_ratios.iter().enumerate() {
             crate::require_non_negative(&mut issues, &field(&format!("damping_ratios/{i}")), *xi);
         }

@@ -78,6 +78,9 @@ pub(super) struct Recorder {
     curvature_envelope: Vec<CurvaturePeak>,
     /// The square of each node's envelope curvature (the comparisons' operand).
     envelope_squares: Vec<f64>,
+    /// Per pin, the square of its kind's [`super::BodyKind::envelope_weight`] (1 for the
+    /// basis's beam): what the envelope compares is the weighted curvature.
+    envelope_weights: Vec<f64>,
     pin_curvatures: Vec<CurvaturePeak>,
     /// Scratch: every line's deflection or curvature at every node, line after line.
     node_columns: Vec<f64>,
@@ -153,6 +156,18 @@ impl Recorder {
                 })
                 .collect(),
             envelope_squares: vec![0.0; node_heights.len()],
+            envelope_weights: {
+                let weights: Vec<f64> = std::iter::once(1.0)
+                    .chain(
+                        layout
+                            .model
+                            .kinds
+                            .iter()
+                            .map(|k| k.envelope_weight * k.envelope_weight),
+                    )
+                    .collect();
+                layout.model.pin_kinds().iter().map(|k| weights[*k]).collect()
+            },
             node_columns: vec![0.0; lines * node_heights.len()],
             node_heights,
             resultants: Resultants::new(layout),
@@ -334,8 +349,9 @@ impl Recorder {
                 if squared > largest.0 {
                     largest = (squared, Some(node));
                 }
-                if squared > self.envelope_squares[node] {
-                    self.envelope_squares[node] = squared;
+                let weighted = squared * self.envelope_weights[pin];
+                if weighted > self.envelope_squares[node] {
+                    self.envelope_squares[node] = weighted;
                     self.curvature_envelope[node] = CurvaturePeak {
                         curvature: squared.sqrt(),
                         pin,
