@@ -59,6 +59,39 @@ impl Flexure {
     }
 }
 
+/// The flexure of every pin: one per kind of body (`kinds`, the pin's first), and the
+/// kind of each pin (none: every pin the first's).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Flexures {
+    kinds: Vec<Flexure>,
+    pin_kinds: Vec<usize>,
+}
+
+impl Flexures {
+    /// Every pin of `flexure`.
+    pub fn uniform(flexure: Flexure) -> Self {
+        Self {
+            kinds: vec![flexure],
+            pin_kinds: Vec::new(),
+        }
+    }
+
+    /// `kinds[k]` for the pins `pin_kinds` gives kind k.
+    pub fn by_kind(kinds: Vec<Flexure>, pin_kinds: Vec<usize>) -> Self {
+        Self { kinds, pin_kinds }
+    }
+
+    /// Pin `pin`'s.
+    pub fn of_pin(&self, pin: usize) -> &Flexure {
+        &self.kinds[self.pin_kinds.get(pin).copied().unwrap_or(0)]
+    }
+
+    /// The bending of `peak`, on its pin.
+    pub fn bending(&self, peak: &CurvaturePeak) -> Bending {
+        self.of_pin(peak.pin).bending(peak)
+    }
+}
+
 /// The largest bending at one place over the output samples: at a height (over every
 /// pin), of a pin (over its height), or of the run.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ToSchema)]
@@ -90,26 +123,37 @@ pub struct BendingReport {
 }
 
 impl BendingReport {
-    /// The bending of `run`, on pins of `flexure`.
-    pub fn of(run: &Simulation, flexure: &Flexure) -> Self {
+    /// The bending of `run`, each pin of its flexure in `flexures`: the envelope's pin at
+    /// each node is the most stressed there (the run compares pins of several kinds by
+    /// their stress per unit curvature, [`crate::physics::integrate::BodyKind`]), and the
+    /// largest bending the most stressed of the envelope (the largest moment where a
+    /// stress is unknown).
+    pub fn of(run: &Simulation, flexures: &Flexures) -> Self {
         let envelope: Vec<Bending> = (run.curvature_envelope.iter())
-            .map(|peak| flexure.bending(peak))
+            .map(|peak| flexures.bending(peak))
             .collect();
-        let worst = (run.curvature_envelope.iter())
-            .max_by(|a, b| a.curvature.total_cmp(&b.curvature))
+        let severity = |b: &Bending| b.stress.unwrap_or(b.moment);
+        let worst = (envelope.iter())
+            .max_by(|a, b| severity(a).total_cmp(&severity(b)))
             .copied()
-            .unwrap_or_default();
+            .unwrap_or_else(|| flexures.bending(&CurvaturePeak::default()));
         Self {
-            max_bending: flexure.bending(&worst),
+            max_bending: worst,
             bending_envelope: envelope,
         }
     }
 }
 
 /// The moment histories: per output height and line (the order of the run's
-/// deflections), EI κ per sample (N·m, signed as the curvature).
-pub fn moment_columns(run: &Simulation, flexure: &Flexure) -> Vec<Vec<f64>> {
-    (run.curvatures.iter().flatten())
-        .map(|line| line.iter().map(|k| flexure.moment(*k)).collect())
+/// deflections), EI κ per sample (N·m, signed as the curvature), each line of its pin's
+/// flexure.
+pub fn moment_columns(run: &Simulation, flexures: &Flexures) -> Vec<Vec<f64>> {
+    let pins = run.pin_curvatures.len();
+    (run.curvatures.iter())
+        .flat_map(|per_line| per_line.iter().enumerate())
+        .map(|(line, history)| {
+            let flexure = flexures.of_pin(line % pins.max(1));
+            history.iter().map(|k| flexure.moment(*k)).collect()
+        })
         .collect()
 }

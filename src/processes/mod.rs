@@ -27,6 +27,8 @@ pub mod excitation;
 pub mod excitation_record;
 pub mod impact_report;
 pub mod input_schema;
+/// Pins of several kinds in one model (`kinds`).
+pub mod kinds;
 /// Allowables and the utilisation ratios they give (docs/margins.md).
 pub mod margins;
 pub mod metrics;

@@ -8,7 +8,7 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
-use super::bending::{self, BendingReport, Flexure};
+use super::bending::{self, BendingReport, Flexures};
 use super::contact_law;
 use super::excitation_record::{Excitations, GeneratedRecord};
 use super::impact_report::{self, ContactImpacts, ImpactSummary};
@@ -183,11 +183,11 @@ impl RunSummary {
         settings: &Settings,
         (allowables, allowable_stress): (&[Option<f64>], Option<f64>),
         (basis, frequencies_hz): (BasisReport, Vec<f64>),
-        flexure: &Flexure,
+        flexures: &Flexures,
         excitations: &Excitations,
     ) -> Self {
         let peaks: Vec<f64> = run.contact_statistics.iter().map(|s| s.max_force).collect();
-        let bending = BendingReport::of(run, flexure);
+        let bending = BendingReport::of(run, flexures);
         Self {
             max_contact_force: run
                 .contact_statistics
@@ -260,10 +260,10 @@ pub fn histories(
     run: Simulation,
     contacts: &[String],
     deflections: &[String],
-    flexure: &Flexure,
+    flexures: &Flexures,
     excitations: &Excitations,
 ) -> Vec<History> {
-    let moments = bending::moment_columns(&run, flexure);
+    let moments = bending::moment_columns(&run, flexures);
     let named = |names: &[String], columns: Vec<Vec<f64>>| -> Vec<(String, Vec<f64>)> {
         names.iter().cloned().zip(columns).collect()
     };

@@ -27,6 +27,7 @@ mod full_disk;
 mod hex_loads;
 mod idempotency;
 mod impacts;
+mod kinds;
 mod limits;
 mod listing;
 mod load;

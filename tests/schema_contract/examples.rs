@@ -152,11 +152,20 @@ pub fn bundle() -> Vec<Value> {
                                 "allowables": {"contact_force": {"pin_pin": 5.0, "pin_wall": 6.0},
                                                "stress": 1e8}});
     explicit["warnings"] = json!("on");
+    // A guide tube among the pins (docs/kinds.md).
+    explicit["kinds"] = json!([{"name": "guide_tube", "pins": [1], "young_modulus": 1.9e11, "density": 6500.0,
+                                "section": {"type": "tube", "outer_diameter": 0.0124, "inner_diameter": 0.0114},
+                                "added_mass_per_length": 0.2, "damping_ratio": 0.02}]);
     let mut explicit_section = explicit_row();
     explicit_section["pin"] = explicit_beam(1.0);
     explicit_section["solver"] = tchamwa(0.01);
     explicit_section["initial"] = json!({"tip_displacements": [0.0, 0.001]});
     explicit_section["output"] = json!({"allowables": {"contact_force": 5.0}});
+    // A kind of the Timoshenko pin scaled: twice its area and inertia (the same shear
+    // and rotary proportions, so the same shapes), another material.
+    explicit_section["kinds"] = json!([{"name": "thick", "pins": [0], "young_modulus": 1.5e11, "density": 6000.0,
+                                        "section": {"type": "explicit", "area": 3.4306e-5, "inertia": 3.6676e-10},
+                                        "damping_ratio": [0.02, 0.03]}]);
     let generator = |gaps: Value, base: Value| {
         json!({"pin": tube_beam(1.0),
                "bundle": {"pins": 3, "levels": {"first": 0.5, "spacing": 0.5, "count": 2},

@@ -13,6 +13,7 @@ use crate::processes::contact_law::{Families, LawInput};
 use crate::processes::excitation::BaseAccelerationInput;
 use crate::processes::impact_report::ImpactsInput;
 use crate::processes::input_schema::{NonNegativeNumber, PositiveNumber};
+use crate::processes::kinds::KindInput;
 use crate::processes::margins::{AllowablesInput, Family, LawAllowable};
 use crate::processes::random_gaps::DistributionInput;
 use crate::processes::warnings::WarningsInput;
@@ -21,8 +22,14 @@ use crate::processes::warnings::WarningsInput;
 #[derive(Debug, Clone, PartialEq, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BundleInputs {
-    /// The pin shared by the whole row (one modal basis).
+    /// The pin of the row: every pin of no kind in `kinds`.
     pub pin: BeamInput,
+    /// Pins of other kinds (a guide tube, a stiffer tube): another section, material,
+    /// added mass and damping on the pin's length, supports, mesh, modes and static
+    /// correction (docs/kinds.md); absent, every pin is `pin`.
+    #[serde(default)]
+    #[schema(default = json!([]))]
+    pub kinds: Vec<KindInput>,
     /// Explicit form: number of pins, numbered 0.. from the left wall.
     #[schema(minimum = 1, maximum = 2000)]
     pub pins: Option<usize>,

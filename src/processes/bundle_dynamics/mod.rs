@@ -10,13 +10,14 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
-use super::bending::{Bending, Flexure};
+use super::bending::{Bending, Flexures};
 use super::columns;
 use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::LawInput;
 use super::excitation::BaseAccelerationInput;
 use super::excitation_record::{self, Excitations};
 use super::impact_report;
+use super::kinds;
 use super::margins::PinUtilisation;
 use super::model_check::{self, StandIn};
 use super::resultants::PinResultants;
@@ -42,6 +43,8 @@ pub struct Plan {
     pins: usize,
     contacts: Vec<Contact>,
     basis: ModalBasis,
+    /// The modal basis of each of `inputs.kinds`.
+    kind_bases: Vec<ModalBasis>,
     /// What `auto` chose for the mesh and the basis; `None` when both were given.
     basis_choice: Option<BasisChoice>,
     settings: Settings,
@@ -54,21 +57,27 @@ impl Plan {
         Excitations::of(self.inputs.excitation.accelerations())
     }
 
-    fn flexure(&self) -> Flexure {
-        Flexure::of(&self.inputs.pin, None)
+    fn flexure(&self) -> Flexures {
+        kinds::flexures(&self.inputs.kinds, &self.inputs.pin, self.pins, None)
     }
 
     fn model(&self) -> Model<'_> {
-        row_model(&self.inputs, self.pins, &self.contacts, &self.basis)
+        row_model(
+            &self.inputs,
+            self.pins,
+            &self.contacts,
+            (&self.basis, Some(&self.kind_bases)),
+        )
     }
 }
 
-/// The row as the integrator sees it.
+/// The row as the integrator sees it, on the pin's basis and each kind's (the pin's
+/// for every kind when they are not built yet: the model's checks).
 fn row_model<'a>(
     inputs: &BundleInputs,
     pins: usize,
     contacts: &[Contact],
-    basis: &'a ModalBasis,
+    (basis, kind_bases): (&'a ModalBasis, Option<&'a [ModalBasis]>),
 ) -> Model<'a> {
     Model {
         basis,
@@ -86,7 +95,7 @@ fn row_model<'a>(
             .iter()
             .map(|f| f.physics())
             .collect(),
-        kinds: Vec::new(),
+        kinds: kinds::body_kinds(&inputs.kinds, &inputs.pin, kind_bases, basis, None),
     }
 }
 
@@ -101,6 +110,7 @@ fn pointer_of(inputs: &BundleInputs, path: &str, pins_refused: bool) -> Option<S
         ("pins", None, "") if generated => "/inputs/bundle/pins".to_owned(),
         ("pins", None, "") => "/inputs/pins".to_owned(),
         ("damping_ratios", mode, _) => model_check::damping_ratio_pointer(&inputs.pin, "/inputs/pin", mode),
+        ("kinds", Some(k), rest) => return kinds::pointer("/inputs/kinds", k, rest),
         ("contacts", Some(k), rest) if generated && (rest == "law" || rest.starts_with("law/")) => {
             let generator = inputs.bundle.as_ref().expect("generated");
             // Expanded level by level: wall–0, 0–1, …, (n−1)–wall.
@@ -189,6 +199,9 @@ pub struct ContactResult {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 pub struct PinResult {
     pub pin: usize,
+    /// Its kind's name (`kinds`); absent for `pin`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kind: Option<String>,
     #[serde(flatten)]
     pub extremes: LineExtremes,
     /// Its largest bending over its height and the output samples.
@@ -399,7 +412,8 @@ impl Simulation for BundleDynamics {
                 )]));
             }
         };
-        let fibre = Flexure::fibre(&inputs.pin, None).is_some();
+        let fibre = super::bending::Flexure::fibre(&inputs.pin, None).is_some();
+        kinds::check(&inputs.kinds, &inputs.pin, "/inputs/kinds", &mut errors);
         inputs.check_allowables(&contacts, fibre, &mut errors);
         if inputs.bundle.is_some() && pins > MAX_PINS {
             errors.push(FieldError::new(
@@ -453,7 +467,7 @@ impl Simulation for BundleDynamics {
         let pins_refused = errors.iter().any(|e| e.pointer.ends_with("/pins"));
         model_check::check(
             &stand_in,
-            &row_model(&inputs, pins, &contacts, &stand_in.basis),
+            &row_model(&inputs, pins, &contacts, (&stand_in.basis, None)),
             &settings,
             |path| pointer_of(&inputs, path, pins_refused),
             &mut errors,
@@ -468,12 +482,22 @@ impl Simulation for BundleDynamics {
             inputs
                 .pin
                 .basis(&contacts, &contact_heights, settings.tolerance, 0, "/inputs/pin")?;
-        let step = common_inputs::resolve_step(&row_model(&inputs, pins, &contacts, &basis), &settings)?;
+        let kind_bases = kinds::bases(
+            &inputs.kinds,
+            &inputs.pin,
+            &basis,
+            &contact_heights,
+            "/inputs/kinds",
+        )
+        .map_err(InvalidInputs)?;
+        let model = row_model(&inputs, pins, &contacts, (&basis, Some(&kind_bases)));
+        let step = common_inputs::resolve_step(&model, &settings)?;
         Ok(Plan {
             inputs,
             pins,
             contacts,
             basis,
+            kind_bases,
             basis_choice,
             settings,
             step,
@@ -548,6 +572,7 @@ impl Simulation for BundleDynamics {
                     .map(|c| c.statistics.utilisation);
                 PinResult {
                     pin: p,
+                    kind: kinds::name_of(&plan.inputs.kinds, p),
                     extremes: LineExtremes::of_line(&simulation, heights, p),
                     utilisation: PinUtilisation::of(&bending, allowable_stress, on_pin),
                     bending,

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
-use super::bending::{BendingReport, Flexure};
+use super::bending::{BendingReport, Flexure, Flexures};
 use super::columns::{self, Column};
 use super::common_inputs::{self, BeamInput, SolverDefaults, SolverInput, SupportInput, TimeStepInput, at};
 use super::contact_law::LawInput;
@@ -692,7 +692,10 @@ impl Simulation for CantileverImpact {
         let given = &plan.inputs.output.allowables;
         let allowable_force = contact.law.allowable().or(given.contact_force);
         let utilisation = margins::ratio(stats.max_force, allowable_force);
-        let bending = BendingReport::of(&simulation, &Flexure::of(&plan.inputs.beam, None));
+        let bending = BendingReport::of(
+            &simulation,
+            &Flexures::uniform(Flexure::of(&plan.inputs.beam, None)),
+        );
         let max_stress_utilisation = StressUtilisation::of(&bending.max_bending, given.stress);
         let results = CantileverResults {
             model: CantileverModel {

@@ -15,7 +15,7 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
-use super::bending::{Bending, Flexure};
+use super::bending::{Bending, Flexure, Flexures};
 use super::columns;
 use super::common_inputs::{self, SolverDefaults, at};
 use super::contact_law::{FrictionReport, LawInput, WearDepth, WearReport};
@@ -74,8 +74,8 @@ impl Plan {
     }
 
     /// The pins' flexure: D may be given apart from an explicit section.
-    fn flexure(&self) -> Flexure {
-        Flexure::of(&self.inputs.pin, self.inputs.pin_diameter())
+    fn flexure(&self) -> Flexures {
+        Flexures::uniform(Flexure::of(&self.inputs.pin, self.inputs.pin_diameter()))
     }
 
     fn model(&self) -> Model<'_> {

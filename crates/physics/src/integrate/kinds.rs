@@ -166,9 +166,15 @@ pub fn validate(kinds: &[BodyKind<'_>], basis: &ModalBasis, pins: usize) -> Vec<
 /// The kind of every pin: 0 for the basis's, k + 1 for `kinds[k]` (pins out of range
 /// ignored: [`validate`] refuses them).
 pub fn pin_kinds(kinds: &[BodyKind<'_>], pins: usize) -> Vec<usize> {
+    pin_kinds_of(kinds.iter().map(|k| &k.pins[..]), pins)
+}
+
+/// The kind of every pin from each kind's list of pins (kind k + 1 for the k-th list, 0
+/// for a pin in none; the last list naming a pin wins, pins out of range ignored).
+pub fn pin_kinds_of<'p>(lists: impl IntoIterator<Item = &'p [usize]>, pins: usize) -> Vec<usize> {
     let mut of = vec![0; pins];
-    for (k, kind) in kinds.iter().enumerate() {
-        for pin in &kind.pins {
+    for (k, list) in lists.into_iter().enumerate() {
+        for pin in list {
             if let Some(slot) = of.get_mut(*pin) {
                 *slot = k + 1;
             }

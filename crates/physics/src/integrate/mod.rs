@@ -47,7 +47,7 @@ pub use super::statistics::{
 };
 use crate::InputIssue;
 pub use crate::impacts::{ImpactCounting, ImpactHistogram, ImpactStatistics, ImpactTable};
-pub use kinds::{BodyKind, KindScale, SHAPE_TOLERANCE, relative_mass};
+pub use kinds::{BodyKind, KindScale, SHAPE_TOLERANCE, pin_kinds_of, relative_mass};
 pub use model::{Model, NORMAL_LENGTH_TOLERANCE, Plane, Settings, TimeStep, WallMotion};
 pub use plan::Plan;
 pub use quality::{Check, Quality, StepComparison, StepHalving, Verdict};
