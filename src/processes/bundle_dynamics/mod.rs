@@ -257,6 +257,10 @@ impl Simulation for BundleDynamics {
             body: include_str!("../../../examples/bundle-row17-proven.json"),
         },
         Example {
+            file: "bundle-guide-tube.json",
+            body: include_str!("../../../examples/bundle-guide-tube.json"),
+        },
+        Example {
             file: "bundle-random-gaps.json",
             body: include_str!("../../../examples/bundle-random-gaps.json"),
         },
