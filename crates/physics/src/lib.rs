@@ -21,8 +21,10 @@ pub mod impacts;
 pub mod integrate;
 pub mod loads;
 pub mod modal;
-/// Elementary functions from `+ − × ÷` only: the same bits on every machine.
 pub mod portable;
+/// Elementary functions from `+ − × ÷` only: the same bits on every machine.
+/// PWR fuel assemblies: the square lattice of rods, guide tubes and the instrumentation tube.
+pub mod pwr;
 /// A seeded, bit-reproducible random stream and its samplers (gaps, sweep sampling).
 pub mod random;
 /// Exact (up to modal truncation) cantilever / tip-spring impact solution (paper §2).
