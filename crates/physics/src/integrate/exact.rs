@@ -190,10 +190,14 @@ impl LaneBodies {
         &self.terms[..self.count]
     }
 
-    /// Σ of its normal coefficients squared (its terms read distinct lines): W_cc =
-    /// this × G(l, l).
-    fn self_coupling(&self) -> f64 {
-        self.terms().iter().map(|t| t.normal * t.normal).sum()
+    /// Σ of its normal coefficients squared over the terms whose line `of` keeps (its
+    /// terms read distinct lines): W_cc = this × G(l, l) for the lines of one kind.
+    fn self_coupling(&self, of: impl Fn(usize) -> bool) -> f64 {
+        self.terms()
+            .iter()
+            .filter(|t| of(t.line))
+            .map(|t| t.normal * t.normal)
+            .sum()
     }
 }
 
@@ -201,15 +205,20 @@ impl LaneBodies {
 /// of the basis between contact levels over a step, and the loads the next step starts
 /// from.
 pub(super) struct ExactRun {
-    /// Per entry of a row (padded modes have ω = 0 and ψ = 0, and stay 0), the
-    /// propagator's coefficients one array each (`q[k][i]`: mode i's coefficient k of
-    /// its position), so that the updates run in vectors.
-    q_coefficients: [Vec<f64>; 4],
-    v_coefficients: [Vec<f64>; 4],
-    /// G(l, l') and G'(l, l') over one step (levels × levels).
+    /// Per kind of body ([`Layout::kinds`]) and entry of a row (padded modes have ω = 0
+    /// and ψ = 0, and stay 0), the propagator's coefficients one array each
+    /// (`q[k][i]`: mode i's coefficient k of its position), so that the updates run in
+    /// vectors.
+    q_coefficients: Vec<[Vec<f64>; 4]>,
+    v_coefficients: Vec<[Vec<f64>; 4]>,
+    /// Per kind, G(l, l') and G'(l, l') over one step (levels × levels), its loads
+    /// divided by its mass.
     levels: usize,
-    flexibility: Vec<f64>,
-    rate_flexibility: Vec<f64>,
+    flexibility: Vec<Vec<f64>>,
+    rate_flexibility: Vec<Vec<f64>>,
+    /// The kind of each line, and each kind's 1/μ.
+    line_kinds: Vec<usize>,
+    inverse_masses: Vec<f64>,
     /// Every contact, by lane (one that cannot push never does: its law gives 0).
     contacts: Vec<LaneBodies>,
     /// Contact and point loads on each line's modes at the current time (lines × row),
@@ -230,31 +239,43 @@ impl ExactRun {
     /// For the layout's step; `loads` are the contact and point loads at t = 0.
     pub fn new(layout: &Layout<'_>, loads: Vec<f64>) -> Self {
         let (row, h) = (layout.row, layout.dt);
-        let propagators: Vec<Propagator> = (0..row)
-            .map(|i| {
-                let omega = layout.omega_squared[i].sqrt();
-                let xi = if omega > 0.0 {
-                    layout.damping[i] / (2.0 * omega)
-                } else {
-                    0.0
-                };
-                Propagator::new(omega, xi, h)
+        let propagators: Vec<Vec<Propagator>> = layout
+            .kinds
+            .iter()
+            .map(|kind| {
+                (0..row)
+                    .map(|i| {
+                        let omega = kind.omega_squared[i].sqrt();
+                        let xi = if omega > 0.0 {
+                            kind.damping[i] / (2.0 * omega)
+                        } else {
+                            0.0
+                        };
+                        Propagator::new(omega, xi, h)
+                    })
+                    .collect()
             })
             .collect();
         let levels = layout.level_shapes.len() / row;
         let shape = |l: usize| &layout.level_shapes[l * row..][..row];
-        let mut flexibility = vec![0.0; levels * levels];
-        let mut rate_flexibility = vec![0.0; levels * levels];
-        for a in 0..levels {
-            for b in 0..levels {
-                let (psi_a, psi_b) = (shape(a), shape(b));
-                for i in 0..row {
-                    let product = psi_a[i] * psi_b[i];
-                    flexibility[a * levels + b] += product * propagators[i].q[3];
-                    rate_flexibility[a * levels + b] += product * propagators[i].v[3];
+        let mut flexibility = vec![vec![0.0; levels * levels]; layout.kinds.len()];
+        let mut rate_flexibility = flexibility.clone();
+        for (k, kind) in layout.kinds.iter().enumerate() {
+            for a in 0..levels {
+                for b in 0..levels {
+                    let (psi_a, psi_b) = (shape(a), shape(b));
+                    for i in 0..row {
+                        let product = psi_a[i] * psi_b[i] * kind.inverse_mass;
+                        flexibility[k][a * levels + b] += product * propagators[k][i].q[3];
+                        rate_flexibility[k][a * levels + b] += product * propagators[k][i].v[3];
+                    }
                 }
             }
         }
+        let pin_kinds = layout.model.pin_kinds();
+        let line_kinds: Vec<usize> = (0..layout.lines)
+            .map(|line| pin_kinds[line % layout.model.pins])
+            .collect();
         let vectors = row / layout.lanes;
         let pins = layout.model.pins;
         let line = |offset: usize| (offset != layout.wall_row).then_some(offset / vectors);
@@ -297,21 +318,40 @@ impl ExactRun {
             .collect();
         let size = loads.len();
         let rates = contacts.iter().any(|c| c.law.needs_rate()) || layout.model.plane.is_some();
-        let column = |get: &dyn Fn(&Propagator) -> f64| propagators.iter().map(get).collect::<Vec<f64>>();
+        let column = |kind: &[Propagator], get: &dyn Fn(&Propagator) -> f64| {
+            kind.iter().map(get).collect::<Vec<f64>>()
+        };
         let own = contacts
             .iter()
             .map(|c| {
+                // W_cc = Σ over the kinds of its lines of (Σ normal²) G_kind(l, l).
                 let g = c.level * levels + c.level;
-                let coupling = c.self_coupling();
-                (coupling * flexibility[g], coupling * rate_flexibility[g])
+                let mut kinds: Vec<usize> = c.terms().iter().map(|t| line_kinds[t.line]).collect();
+                kinds.sort_unstable();
+                kinds.dedup();
+                kinds.iter().fold((0.0, 0.0), |(w, w_rate), &kind| {
+                    let coupling = c.self_coupling(|line| line_kinds[line] == kind);
+                    (
+                        w + coupling * flexibility[kind][g],
+                        w_rate + coupling * rate_flexibility[kind][g],
+                    )
+                })
             })
             .collect();
         Self {
             own,
             rates,
             level_velocities: vec![0.0; layout.level_deflections_len()],
-            q_coefficients: [0, 1, 2, 3].map(|k| column(&|p: &Propagator| p.q[k])),
-            v_coefficients: [0, 1, 2, 3].map(|k| column(&|p: &Propagator| p.v[k])),
+            q_coefficients: propagators
+                .iter()
+                .map(|kind| [0, 1, 2, 3].map(|k| column(kind, &|p: &Propagator| p.q[k])))
+                .collect(),
+            v_coefficients: propagators
+                .iter()
+                .map(|kind| [0, 1, 2, 3].map(|k| column(kind, &|p: &Propagator| p.v[k])))
+                .collect(),
+            line_kinds,
+            inverse_masses: layout.kinds.iter().map(|k| k.inverse_mass).collect(),
             levels,
             flexibility,
             rate_flexibility,
@@ -411,11 +451,8 @@ pub(super) fn step<S: Simd>(
         (at(base_y, t0), at(base_y, t)),
     ];
     let pins = model.pins;
-    // Every mode without contact force at the step's end.
-    let ([q0, q1, q2, q3], [v0, v1, v2, v3]) = (&run.q_coefficients, &run.v_coefficients);
-    // One length for every row, so that the loop runs in vectors without bounds checks.
-    let (q0, q1, q2, q3) = (&q0[..row], &q1[..row], &q2[..row], &q3[..row]);
-    let (v0, v1, v2, v3) = (&v0[..row], &v1[..row], &v2[..row], &v3[..row]);
+    // Every mode without contact force at the step's end, each line with its kind's
+    // propagator and its loads divided by its kind's mass.
     let gamma = &layout.participation[..row];
     for (((q, v), (f0, f1)), line) in state
         .q
@@ -425,9 +462,18 @@ pub(super) fn step<S: Simd>(
         .zip(0..layout.lines)
     {
         let (base0, base1) = bases[usize::from(line >= pins)];
+        let kind = run.line_kinds[line];
+        let ([q0, q1, q2, q3], [v0, v1, v2, v3]) = (&run.q_coefficients[kind], &run.v_coefficients[kind]);
+        // One length for every row, so that the loop runs in vectors without bounds checks.
+        let (q0, q1, q2, q3) = (&q0[..row], &q1[..row], &q2[..row], &q3[..row]);
+        let (v0, v1, v2, v3) = (&v0[..row], &v1[..row], &v2[..row], &v3[..row]);
+        let inverse_mass = run.inverse_masses[kind];
         let (q, v, f0, f1) = (&mut q[..row], &mut v[..row], &f0[..row], &f1[..row]);
         for i in 0..row {
-            let (load0, load1) = (f0[i] - gamma[i] * base0, f1[i] - gamma[i] * base1);
+            let (load0, load1) = (
+                f0[i] * inverse_mass - gamma[i] * base0,
+                f1[i] * inverse_mass - gamma[i] * base1,
+            );
             let (qi, vi) = (q[i], v[i]);
             q[i] = q0[i] * qi + q1[i] * vi + q2[i] * load0 + q3[i] * load1;
             v[i] = v0[i] * qi + v1[i] * vi + v2[i] * load0 + v3[i] * load1;
@@ -497,7 +543,7 @@ pub(super) fn step<S: Simd>(
             );
         }
     }
-    for (((q, v), (loads, next)), _) in state
+    for (((q, v), (loads, next)), line) in state
         .q
         .chunks_exact_mut(row)
         .zip(state.v.chunks_exact_mut(row))
@@ -508,12 +554,14 @@ pub(super) fn step<S: Simd>(
         )
         .zip(0..layout.lines)
     {
-        let ([.., q3], [.., v3]) = (&run.q_coefficients, &run.v_coefficients);
+        let kind = run.line_kinds[line];
+        let ([.., q3], [.., v3]) = (&run.q_coefficients[kind], &run.v_coefficients[kind]);
+        let inverse_mass = run.inverse_masses[kind];
         let (q3, v3, q, v) = (&q3[..row], &v3[..row], &mut q[..row], &mut v[..row]);
         let (loads, next) = (&loads[..row], &mut next[..row]);
         for i in 0..row {
-            q[i] += q3[i] * loads[i];
-            v[i] += v3[i] * loads[i];
+            q[i] += q3[i] * (loads[i] * inverse_mass);
+            v[i] += v3[i] * (loads[i] * inverse_mass);
             next[i] += loads[i];
         }
     }
@@ -580,12 +628,13 @@ pub(super) fn step<S: Simd>(
     recorder.track_deflection_peaks(layout, &state.level_deflections);
     let (mut modal_damping, mut external) = (0.0, 0.0);
     for (line, v) in state.v[..layout.lines * row].chunks_exact(row).enumerate() {
+        let kind = &layout.kinds[run.line_kinds[line]];
         let mut participation_velocity = 0.0;
         for i in 0..row {
-            modal_damping += layout.damping[i] * v[i] * v[i];
+            modal_damping += kind.mass * kind.damping[i] * v[i] * v[i];
             participation_velocity += layout.participation[i] * v[i];
         }
-        external -= bases[usize::from(line >= pins)].1 * participation_velocity;
+        external -= bases[usize::from(line >= pins)].1 * kind.mass * participation_velocity;
     }
     for (point, shape) in model.point_forces.iter().zip(&layout.point_force_shapes) {
         let velocity = kernels::dot(simd, shape, &state.v[point.line * row..][..row]);
@@ -619,7 +668,10 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
     // the velocities where they are read.
     // (Functions, not closures: a closure is not inlined into the step's SIMD context.)
     let rate_flexibility = run.rates.then_some(rate_flexibility.as_slice());
-    let (flexibilities, moved) = ((flexibility.as_slice(), rate_flexibility), read_lines);
+    let (flexibilities, moved) = (
+        (flexibility.as_slice(), rate_flexibility, &run.line_kinds[..]),
+        read_lines,
+    );
     // The sweeps start from the last step's forces.
     solve.shift.fill(0.0);
     solve.rate_shift.fill(0.0);
@@ -707,29 +759,39 @@ fn contact_forces(run: &mut ExactRun) -> Result<(), NotConverged> {
     Ok(())
 }
 
+/// Per kind, the flexibilities G and G' (where velocities are read), and each line's
+/// kind.
+type Flexibilities<'a> = (&'a [Vec<f64>], Option<&'a [Vec<f64>]>, &'a [usize]);
+
 /// Moves the lines by a contact's force: their deflections through G, their velocities
 /// through G' where they are read.
 #[inline(always)]
 fn add(
     shift: &mut [f64],
     rate_shift: &mut [f64],
-    (g, g_rate): (&[f64], Option<&[f64]>),
+    (g, g_rate, kinds): Flexibilities<'_>,
     levels: usize,
     source: &LaneBodies,
     force: f64,
 ) {
-    shift_lines(shift, g, levels, source, force);
+    shift_lines(shift, (g, kinds), levels, source, force);
     if let Some(g_rate) = g_rate {
-        shift_lines(rate_shift, g_rate, levels, source, force);
+        shift_lines(rate_shift, (g_rate, kinds), levels, source, force);
     }
 }
 
-/// Moves every line a contact reads, at every level, by its force F through the
+/// Moves every line a contact reads, at every level, by its force F through its kind's
 /// flexibility `g` (levels × levels): shift(line, l) −= normal F g(l_c, l).
 #[inline(always)]
-fn shift_lines(shift: &mut [f64], g: &[f64], levels: usize, source: &LaneBodies, force: f64) {
-    let g = &g[source.level * levels..][..levels];
+fn shift_lines(
+    shift: &mut [f64],
+    (g, kinds): (&[Vec<f64>], &[usize]),
+    levels: usize,
+    source: &LaneBodies,
+    force: f64,
+) {
     for term in source.terms() {
+        let g = &g[kinds[term.line]][source.level * levels..][..levels];
         let sign = -term.normal * force;
         let shift = &mut shift[term.line * levels..][..levels];
         for (s, g) in shift.iter_mut().zip(g) {

@@ -39,15 +39,10 @@ pub(super) struct Layout<'m> {
     pub lines: usize,
     /// Slots per block of the block-major deflections: `[wall, line 0, …, line n−1, wall]`.
     pub stride: usize,
-    /// Per mode of the basis's beam (padded to `row`): ωᵢ² and 2ξᵢωᵢ (the exact scheme's
-    /// propagators; every loop's modal update reads [`Layout::kinds`]).
-    pub omega_squared: Vec<f64>,
-    pub damping: Vec<f64>,
     /// Γᵢ, padded to `row`.
     pub participation: Vec<f64>,
-    /// Per kind of body (the basis's first, [`super::BodyKind`]): its coefficients as
-    /// above and its mass; the basis's are `omega_squared`, `damping` and
-    /// `implicit_damping_factor`.
+    /// Per kind of body (the basis's first, [`super::BodyKind`]): its modal
+    /// coefficients and its mass.
     pub kinds: Vec<LineKind>,
     /// The lines as runs of consecutive lines of one kind (the x lines' runs, then the
     /// y lines'): one run over each direction's lines when every pin is the basis's.
@@ -437,8 +432,6 @@ impl<'m> Layout<'m> {
             row,
             lines,
             stride,
-            omega_squared: kinds[0].omega_squared.clone(),
-            damping: kinds[0].damping.clone(),
             participation: padded(basis.participation(), row, 0.0),
             kinds,
             runs,

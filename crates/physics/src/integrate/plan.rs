@@ -407,12 +407,6 @@ fn check(model: &Model<'_>, settings: &Settings) -> Result<(), SimulationError> 
                 "`exact_modal` does not take friction; use `central_difference`",
             ));
         }
-        if !model.kinds.is_empty() {
-            issues.push(InputIssue::new(
-                "scheme",
-                "`exact_modal` does not take bodies of several kinds; use `central_difference`",
-            ));
-        }
     }
     if !issues.is_empty() {
         return Err(SimulationError::InvalidSettings(issues));
