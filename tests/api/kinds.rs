@@ -139,7 +139,24 @@ async fn kinds_the_row_cannot_take_are_refused_at_their_members() {
     let mut sheared = row(json!([guide_tube(json!([1]))]));
     sheared["pin"]["timoshenko"] = json!({"poisson_ratio": 0.3});
     assert_eq!(refused(&app, sheared).await, ["/inputs/kinds/0"]);
-    let mut exact = row(json!([guide_tube(json!([1]))]));
+}
+
+/// The exact modal scheme takes kinds: its peaks agree with central difference's.
+#[tokio::test]
+async fn a_guide_tube_row_under_exact_modal_agrees_with_central_difference() {
+    let app = spawn().await;
+    let inputs = row(json!([guide_tube(json!([1]))]));
+    let mut exact = inputs.clone();
     exact["solver"]["scheme"] = json!("exact_modal");
-    assert_eq!(refused(&app, exact).await, ["/inputs/solver/scheme"]);
+    let explicit = app
+        .results_of("bundle-dynamics", &json!({"inputs": inputs}))
+        .await;
+    let exact = app.results_of("bundle-dynamics", &json!({"inputs": exact})).await;
+    let peak = |r: &Value| number(&r["max_contact_force"]["force"]);
+    let (a, b) = (peak(&explicit), peak(&exact));
+    assert!(
+        a > 0.0 && (a - b).abs() < 0.02 * a,
+        "central difference {a} N, exact {b} N"
+    );
+    assert!(number(&exact["steps"]) < number(&explicit["steps"]));
 }
