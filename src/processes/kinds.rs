@@ -148,7 +148,8 @@ pub fn bases(
 
 /// The kinds as the physics takes them, on `bases` ([`bases`]; the pin's basis when
 /// absent, so that the model's checks run before the bases are built), with
-/// `diameter` the pins' outer diameter where an explicit section does not give it.
+/// `diameter` the outer diameter of every pin where an explicit section does not give
+/// it (a hexagonal bundle's D, which its kinds keep).
 pub fn body_kinds<'a>(
     kinds: &[KindInput],
     pin: &BeamInput,
@@ -163,7 +164,7 @@ pub fn body_kinds<'a>(
         .map(|(k, kind)| {
             let basis = bases.and_then(|b| b.get(k)).unwrap_or(fallback);
             let beam = kind.beam(pin);
-            let own = Flexure::of(&beam, None);
+            let own = Flexure::of(&beam, diameter);
             BodyKind {
                 basis,
                 damping_ratios: beam.damping_ratios_for(basis.modes()),
@@ -183,14 +184,15 @@ fn stress_weight(kind: &Flexure, pin: &Flexure) -> f64 {
     }
 }
 
-/// The flexure of every pin of a model of `pins` pins with `kinds`.
+/// The flexure of every pin of a model of `pins` pins with `kinds` (`diameter` as in
+/// [`body_kinds`]).
 pub fn flexures(kinds: &[KindInput], pin: &BeamInput, pins: usize, diameter: Option<f64>) -> Flexures {
     if kinds.is_empty() {
         return Flexures::uniform(Flexure::of(pin, diameter));
     }
     Flexures::by_kind(
         std::iter::once(Flexure::of(pin, diameter))
-            .chain(kinds.iter().map(|kind| Flexure::of(&kind.beam(pin), None)))
+            .chain(kinds.iter().map(|kind| Flexure::of(&kind.beam(pin), diameter)))
             .collect(),
         pin_kinds(kinds, pins),
     )

@@ -160,3 +160,65 @@ async fn a_guide_tube_row_under_exact_modal_agrees_with_central_difference() {
     );
     assert!(number(&exact["steps"]) < number(&explicit["steps"]));
 }
+
+/// Seven wire-wrapped pins with `kinds`, pressed together and shaken.
+fn hex(kinds: Value) -> Value {
+    json!({"pin": pin(), "kinds": kinds,
+           "bundle": {"rings": 1, "pitch": 0.0107, "wire_diameter": 0.001, "wire_lead": 0.3,
+                      "wrapper_flat_to_flat": 0.0305},
+           "contact": {"stiffness": 2e5},
+           "gaps": {"type": "uniform", "pin_pin": 0.0, "pin_wall": 0.0},
+           "excitation": {"base_acceleration": {"type": "sine", "amplitude": 20.0, "frequency": 30.0, "cycles": 2},
+                          "direction": 30.0},
+           "solver": {"duration": 0.03, "check": "none"}})
+}
+
+/// The centre pin of a hexagonal bundle of another kind (a thicker clad of the same
+/// diameter, heavier): its stress over moment is c/I of its own section, and a kind of
+/// another clad diameter, or of a pin the bundle does not have, is refused.
+#[tokio::test]
+async fn a_hexagonal_bundle_takes_kinds_of_its_clad_diameter() {
+    let app = spawn().await;
+    let thick = (ROD.0, 0.0075);
+    let kind = json!({"name": "absorber", "pins": [0], "young_modulus": 2.0e11, "density": 8000.0,
+                      "section": {"type": "tube", "outer_diameter": thick.0, "inner_diameter": thick.1},
+                      "added_mass_per_length": 1.2});
+    let results = app
+        .results_of(
+            "hex-bundle-dynamics",
+            &json!({"inputs": hex(json!([kind.clone()]))}),
+        )
+        .await;
+    let pins = results["pins"].as_array().unwrap();
+    for (p, section) in [(0, thick), (1, ROD)] {
+        let bending = &pins[p]["bending"];
+        let ratio = number(&bending["stress"]) / number(&bending["moment"]);
+        let expected = section.0 / 2.0 / inertia(section);
+        assert!(
+            (ratio - expected).abs() < 1e-9 * expected,
+            "pin {p}: σ/M {ratio} vs c/I {expected}"
+        );
+    }
+    assert_eq!(pins[0]["kind"], "absorber");
+    let mut wider = kind.clone();
+    wider["section"]["outer_diameter"] = json!(0.0105);
+    wider["pins"] = json!([0, 9]);
+    let response = app
+        .post_execution("hex-bundle-dynamics", &json!({"inputs": hex(json!([wider]))}))
+        .await;
+    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
+    let pointers: Vec<&str> = problem["errors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["pointer"].as_str().unwrap())
+        .collect();
+    assert_eq!(pointers, ["/inputs/kinds/0/section"]);
+    let mut missing = kind;
+    missing["pins"] = json!([0, 9]);
+    let response = app
+        .post_execution("hex-bundle-dynamics", &json!({"inputs": hex(json!([missing]))}))
+        .await;
+    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
+    assert_eq!(problem["errors"][0]["pointer"], "/inputs/kinds/0/pins/1");
+}

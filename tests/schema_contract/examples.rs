@@ -287,6 +287,10 @@ pub fn hex() -> Vec<Value> {
     first["output"]["allowables"] =
         json!({"contact_force": {"pin_pin": 5.0, "pin_wall": 6.0}, "stress": 1e8});
     first["warnings"] = json!("on");
+    // An absorber pin at the centre: the clad diameter D, a thicker wall, heavier.
+    first["kinds"] = json!([{"name": "absorber", "pins": [0], "young_modulus": 2.0e11, "density": 8000.0,
+                             "section": {"type": "tube", "outer_diameter": 0.0097, "inner_diameter": 0.0075},
+                             "added_mass_per_length": 1.2, "damping_ratio": 0.02}]);
     let mut explicit_section = hex_example(
         gap_states[4].clone(),
         json!({"base_acceleration": bases[0]}),
@@ -295,6 +299,9 @@ pub fn hex() -> Vec<Value> {
     explicit_section["pin"] = explicit_beam(PIN_LENGTH);
     explicit_section["solver"] = tchamwa(0.005);
     explicit_section["output"]["allowables"] = json!({"contact_force": 5.0, "stress": 1e8});
+    explicit_section["kinds"] = json!([{"name": "thick", "pins": [1], "young_modulus": 1.5e11, "density": 6000.0,
+                                        "section": {"type": "explicit", "area": 3.4306e-5, "inertia": 3.6676e-10},
+                                        "damping_ratio": [0.02, 0.03]}]);
     // Moved by loads alone: the centre pin released along 45°, point forces along a
     // direction and along x (the default).
     let mut loaded = hex_example(gap_states[0].clone(), json!({}), selections[4].clone());

@@ -27,6 +27,13 @@ pub struct HexInputs {
     /// The pin shared by every pin of the bundle: one modal basis, used for the bending
     /// along x and along y. A tube section's outer diameter is the clad diameter D.
     pub pin: BeamInput,
+    /// Pins of other kinds (an instrumented pin, an absorber pin): another material,
+    /// section, added mass and damping on the pin's length, supports, mesh, modes and
+    /// static correction, and the same clad diameter D (the wire-wrap geometry's)
+    /// (docs/kinds.md); absent, every pin is `pin`.
+    #[serde(default)]
+    #[schema(default = json!([]))]
+    pub kinds: Vec<crate::processes::kinds::KindInput>,
     /// The bundle's geometry: rings, pitch, wires, wrapper.
     pub bundle: HexGeometryInput,
     /// Penalty laws of the wire contacts.

@@ -15,14 +15,16 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::basis_report::BasisReport;
-use super::bending::{Bending, Flexure, Flexures};
+use super::bending::{Bending, Flexures};
 use super::columns;
-use super::common_inputs::{self, SolverDefaults, at};
+use super::common_inputs::{self, SectionInput, SolverDefaults, at};
 use super::contact_law::{FrictionReport, LawInput, WearDepth, WearReport};
 use super::excitation::{PlaneSignal, plane_signal};
 use super::excitation_record::{self, Excitations};
 use super::impact_report;
+use super::kinds;
 use super::margins::PinUtilisation;
+use super::model_check;
 use super::resultants::PinResultants;
 use super::run_report::{self, ContactStatistics, LineExtremes, RunSize, RunSummary};
 use super::simulation::{HistoryKind, HistoryOutput, Output, Simulation};
@@ -61,6 +63,8 @@ pub struct Plan {
     walls: Option<WallMotion>,
     loads: PlaneLoads,
     basis: ModalBasis,
+    /// The modal basis of each of `inputs.kinds`.
+    kind_bases: Vec<ModalBasis>,
     /// What `auto` chose for the mesh and the basis; `None` when both were given.
     basis_choice: Option<BasisChoice>,
     settings: Settings,
@@ -75,7 +79,12 @@ impl Plan {
 
     /// The pins' flexure: D may be given apart from an explicit section.
     fn flexure(&self) -> Flexures {
-        Flexures::uniform(Flexure::of(&self.inputs.pin, self.inputs.pin_diameter()))
+        kinds::flexures(
+            &self.inputs.kinds,
+            &self.inputs.pin,
+            self.bundle.pin_count(),
+            self.inputs.pin_diameter(),
+        )
     }
 
     fn model(&self) -> Model<'_> {
@@ -85,7 +94,7 @@ impl Plan {
             (&self.contacts, &self.normals),
             (&self.excitation, &self.walls),
             &self.loads,
-            &self.basis,
+            (&self.basis, &self.kind_bases),
         )
     }
 }
@@ -102,7 +111,7 @@ fn plane_model<'a>(
         &Option<WallMotion>,
     ),
     loads: &PlaneLoads,
-    basis: &'a ModalBasis,
+    (basis, kind_bases): (&'a ModalBasis, &'a [ModalBasis]),
 ) -> Model<'a> {
     Model {
         basis,
@@ -118,7 +127,13 @@ fn plane_model<'a>(
             normals: normals.to_vec(),
             base_acceleration_y: y.clone(),
         }),
-        kinds: Vec::new(),
+        kinds: kinds::body_kinds(
+            &inputs.kinds,
+            &inputs.pin,
+            Some(kind_bases),
+            basis,
+            inputs.pin_diameter(),
+        ),
     }
 }
 
@@ -217,6 +232,9 @@ pub struct HexContactResult {
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 pub struct HexPinResult {
     pub pin: usize,
+    /// Its kind's name (`kinds`); absent for `pin`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kind: Option<String>,
     /// Ring (0 = the centre pin).
     pub ring: usize,
     /// Centre (x, y) in the wrapper (m).
@@ -391,6 +409,22 @@ impl Simulation for HexBundleDynamics {
             }
         });
         errors.extend(contact_law_errors(&inputs));
+        kinds::check(&inputs.kinds, &inputs.pin, "/inputs/kinds", &mut errors);
+        // The wire-wrap geometry is the pin's clad diameter: a kind keeps it.
+        for (k, kind) in inputs.kinds.iter().enumerate() {
+            if let (SectionInput::Tube { outer_diameter, .. }, Some(d)) = (kind.section, diameter)
+                && (outer_diameter - d).abs() > 1e-9 * d
+            {
+                errors.push(FieldError::new(
+                    format!("/inputs/kinds/{k}/section"),
+                    format!(
+                        "its outer_diameter must be the pins' clad diameter D = {} m: the wire-wrap \
+                         geometry is the pin's (another inner diameter, material or mass is a kind)",
+                        crate::physics::number(d)
+                    ),
+                ));
+            }
+        }
         // D is required above: without it, the stress is refused there, not here.
         let allowables = &inputs.output.allowables;
         allowables.check(
@@ -468,14 +502,30 @@ impl Simulation for HexBundleDynamics {
                 heights,
             )
         };
+        let kind_bases = kinds::bases(&inputs.kinds, &inputs.pin, &basis, &levels, "/inputs/kinds")
+            .map_err(InvalidInputs)?;
         let model = plane_model(
             &inputs,
             bundle.pin_count(),
             (&contacts, &normals),
             (&excitation, &walls),
             &loads,
-            &basis,
+            (&basis, &kind_bases),
         );
+        // The kinds' pins and damping (the physics' checks), at their members.
+        let refused: Vec<FieldError> = model
+            .validate()
+            .into_iter()
+            .filter(|issue| issue.field.starts_with("kinds/"))
+            .filter_map(|issue| {
+                let (_, k, rest) = model_check::split(&issue.field);
+                kinds::pointer("/inputs/kinds", k?, rest)
+                    .map(|pointer| FieldError::new(pointer, issue.reason))
+            })
+            .collect();
+        if !refused.is_empty() {
+            return Err(InvalidInputs(refused));
+        }
         // The pins' supports the wrapper's motion cannot carry (a pin held by its top
         // alone): the wrapper's, said at its member.
         if walls.is_some() {
@@ -500,6 +550,7 @@ impl Simulation for HexBundleDynamics {
             walls,
             loads,
             basis,
+            kind_bases,
             basis_choice,
             settings,
             step,
@@ -616,6 +667,7 @@ impl Simulation for HexBundleDynamics {
                     .map(|c| c.statistics.utilisation);
                 HexPinResult {
                     pin: p,
+                    kind: kinds::name_of(&plan.inputs.kinds, p),
                     ring: plan.bundle.lattice().ring(p),
                     position: [position.x, position.y],
                     x: LineExtremes::of_line(&simulation, heights, p),
