@@ -3,12 +3,11 @@
 //! reports utilisations, friction and Archard wear that follow from its own numbers by
 //! their definitions (peak over allowable, K P t and the geometry's depth).
 
-use reqwest::StatusCode;
 use serde_json::{Value, json};
 
 use chocmodal::processes::Registry;
 
-use crate::helpers::{TestApp, assert_problem, spawn_app_with_processes};
+use crate::helpers::{TestApp, spawn_app_with_processes};
 
 async fn spawn() -> TestApp {
     spawn_app_with_processes(Registry::builtin().all().to_vec(), |_| {}).await
@@ -47,16 +46,7 @@ fn row(law: Value) -> Value {
 }
 
 async fn refused(app: &TestApp, process: &str, inputs: Value) -> Vec<String> {
-    let response = app.post_execution(process, &json!({"inputs": inputs})).await;
-    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
-    let mut pointers: Vec<String> = problem["errors"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| e["pointer"].as_str().unwrap().to_owned())
-        .collect();
-    pointers.sort();
-    pointers
+    app.refused_pointers(process, &inputs).await
 }
 
 async fn results(app: &TestApp, process: &str, inputs: Value) -> Value {

@@ -304,6 +304,23 @@ impl TestApp {
         id
     }
 
+    /// Submits `inputs` to `process`, which must refuse them with a 422: the pointers
+    /// of its errors, sorted.
+    pub async fn refused_pointers(&self, process: &str, inputs: &Value) -> Vec<String> {
+        let response = self
+            .post_execution(process, &serde_json::json!({"inputs": inputs}))
+            .await;
+        let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
+        let mut pointers: Vec<String> = problem["errors"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e["pointer"].as_str().unwrap().to_owned())
+            .collect();
+        pointers.sort();
+        pointers
+    }
+
     /// [`TestApp::succeed`], then the job's results document.
     pub async fn results_of(&self, process: &str, body: &Value) -> Value {
         let id = self.succeed(process, body).await;

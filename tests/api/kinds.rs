@@ -2,12 +2,11 @@
 //! changes nothing, a guide tube bends with its own section, and kinds the row cannot
 //! take are refused at their members.
 
-use reqwest::StatusCode;
 use serde_json::{Value, json};
 
 use chocmodal::processes::Registry;
 
-use crate::helpers::{TestApp, assert_problem, spawn_app_with_processes};
+use crate::helpers::{TestApp, spawn_app_with_processes};
 
 async fn spawn() -> TestApp {
     spawn_app_with_processes(Registry::builtin().all().to_vec(), |_| {}).await
@@ -44,18 +43,21 @@ fn inertia((outer, inner): (f64, f64)) -> f64 {
 }
 
 async fn refused(app: &TestApp, inputs: Value) -> Vec<String> {
-    let response = app
-        .post_execution("bundle-dynamics", &json!({"inputs": inputs}))
-        .await;
-    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
-    let mut pointers: Vec<String> = problem["errors"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| e["pointer"].as_str().unwrap().to_owned())
-        .collect();
-    pointers.sort();
-    pointers
+    app.refused_pointers("bundle-dynamics", &inputs).await
+}
+
+/// Each pin's bending stress over its moment is c/I of its section (`sections`: the
+/// pin's number and its tube's diameters).
+fn assert_bends_with_own_section(pins: &[Value], sections: &[(usize, (f64, f64))]) {
+    for (p, section) in sections {
+        let bending = &pins[*p]["bending"];
+        let ratio = number(&bending["stress"]) / number(&bending["moment"]);
+        let expected = section.0 / 2.0 / inertia(*section);
+        assert!(
+            (ratio - expected).abs() < 1e-9 * expected,
+            "pin {p}: σ/M {ratio} vs c/I {expected}"
+        );
+    }
 }
 
 fn number(value: &Value) -> f64 {
@@ -99,14 +101,8 @@ async fn a_guide_tube_in_a_row_bends_with_its_own_section() {
         )
         .await;
     let pins = results["pins"].as_array().unwrap();
-    for (p, section) in [(0, ROD), (1, TUBE), (2, ROD)] {
-        let bending = &pins[p]["bending"];
-        let ratio = number(&bending["stress"]) / number(&bending["moment"]);
-        let expected = section.0 / 2.0 / inertia(section);
-        assert!(
-            (ratio - expected).abs() < 1e-9 * expected,
-            "pin {p}: σ/M {ratio} vs c/I {expected}"
-        );
+    assert_bends_with_own_section(pins, &[(0, ROD), (1, TUBE), (2, ROD)]);
+    for p in 0..3 {
         assert_eq!(
             pins[p].get("kind").and_then(Value::as_str),
             (p == 1).then_some("guide_tube")
@@ -190,35 +186,19 @@ async fn a_hexagonal_bundle_takes_kinds_of_its_clad_diameter() {
         )
         .await;
     let pins = results["pins"].as_array().unwrap();
-    for (p, section) in [(0, thick), (1, ROD)] {
-        let bending = &pins[p]["bending"];
-        let ratio = number(&bending["stress"]) / number(&bending["moment"]);
-        let expected = section.0 / 2.0 / inertia(section);
-        assert!(
-            (ratio - expected).abs() < 1e-9 * expected,
-            "pin {p}: σ/M {ratio} vs c/I {expected}"
-        );
-    }
+    assert_bends_with_own_section(pins, &[(0, thick), (1, ROD)]);
     assert_eq!(pins[0]["kind"], "absorber");
     let mut wider = kind.clone();
     wider["section"]["outer_diameter"] = json!(0.0105);
     wider["pins"] = json!([0, 9]);
-    let response = app
-        .post_execution("hex-bundle-dynamics", &json!({"inputs": hex(json!([wider]))}))
+    let pointers = app
+        .refused_pointers("hex-bundle-dynamics", &hex(json!([wider])))
         .await;
-    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
-    let pointers: Vec<&str> = problem["errors"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| e["pointer"].as_str().unwrap())
-        .collect();
     assert_eq!(pointers, ["/inputs/kinds/0/section"]);
     let mut missing = kind;
     missing["pins"] = json!([0, 9]);
-    let response = app
-        .post_execution("hex-bundle-dynamics", &json!({"inputs": hex(json!([missing]))}))
+    let pointers = app
+        .refused_pointers("hex-bundle-dynamics", &hex(json!([missing])))
         .await;
-    let problem = assert_problem(response, StatusCode::UNPROCESSABLE_ENTITY, "/invalid-inputs").await;
-    assert_eq!(problem["errors"][0]["pointer"], "/inputs/kinds/0/pins/1");
+    assert_eq!(pointers, ["/inputs/kinds/0/pins/1"]);
 }

@@ -144,6 +144,15 @@ pub struct Table {
 }
 
 impl Table {
+    /// A ramp from 0 at t = 0 to `value` at `rise` (s), then held (to a time far past
+    /// any run).
+    pub fn ramp_and_hold(rise: f64, value: f64) -> Self {
+        Self {
+            time: vec![0.0, rise, 1e3 + rise],
+            values: vec![0.0, value, value],
+        }
+    }
+
     /// `signal` sampled every `interval` (s) from 0 to `end` (s) included (the last
     /// interval shorter when `end` is not a multiple).
     pub fn sample(signal: impl Fn(f64) -> f64, interval: f64, end: f64) -> Self {

@@ -8,36 +8,17 @@
 //! calibrated with ([`Model::reduced_mass`]). Its contact springs are ~300 times
 //! stiffer than its own, so each impact is that of a free body (to ~(ω₁/ω_c)²).
 
-use super::tests::{basis, run, settings, shaken_two_pin_row};
+use super::tests::{LOOPS, Loop, basis, on_loop, run, settings, shaken_two_pin_row, threads};
 use super::*;
 use crate::contact::{Body, Contact, Law, NormalLaw, Restitution};
 use crate::loads::{PointForce, Table};
 use crate::modal::ModalBasis;
 use crate::stability::Scheme;
 
-/// A step loop of the integrator.
-#[derive(Debug, Clone, Copy)]
-enum Loop {
-    /// Pins bending along x, walls moving with the feet.
-    Row,
-    /// Pins in the transverse plane, on one thread or on two.
-    Plane { threads: usize },
-    /// The row, with walls of their own motion (standing still in space here).
-    Walls,
-}
-
-const LOOPS: [Loop; 4] = [
-    Loop::Row,
-    Loop::Plane { threads: 1 },
-    Loop::Plane { threads: 2 },
-    Loop::Walls,
-];
-
 /// One pin of `basis` with `contacts` (their normals +x in the plane) and a release of
 /// its tip by `tip` (m) along x, on `kind`.
 fn one_pin<'a>(basis: &'a ModalBasis, contacts: Vec<Contact>, tip: f64, kind: Loop) -> Model<'a> {
-    let normals = vec![[1.0, 0.0]; contacts.len()];
-    let mut model = Model {
+    let model = Model {
         basis,
         pins: 1,
         damping_ratios: vec![0.0; basis.modes()],
@@ -50,25 +31,7 @@ fn one_pin<'a>(basis: &'a ModalBasis, contacts: Vec<Contact>, tip: f64, kind: Lo
         point_forces: vec![],
         kinds: Vec::new(),
     };
-    match kind {
-        Loop::Row => {}
-        Loop::Plane { .. } => {
-            model.plane = Some(Plane {
-                normals,
-                base_acceleration_y: None,
-            });
-            model.initial_tip_displacements = vec![tip, 0.0];
-        }
-        Loop::Walls => model.walls = Some(WallMotion::rigid(None, None)),
-    }
-    model
-}
-
-fn threads(kind: Loop) -> usize {
-    match kind {
-        Loop::Plane { threads } => threads,
-        _ => 1,
-    }
+    on_loop(model, kind)
 }
 
 /// The wall on the pin's left at its tip: δ = −w − gap.
@@ -302,10 +265,7 @@ fn a_preloaded_clamp_holds_below_its_preload_and_opens_above_it_on_every_loop() 
             model.point_forces = vec![PointForce {
                 line: 0,
                 height: 1.0,
-                force: Table {
-                    time: vec![0.0, ramp, 1e3],
-                    values: vec![0.0, load, load],
-                },
+                force: Table::ramp_and_hold(ramp, load),
             }];
             assert!(model.validate().is_empty(), "{:?}", model.validate());
             let dt = std::f64::consts::TAU / omega_contact / 40.0;

@@ -46,6 +46,52 @@ pub(super) fn settings(scheme: Scheme, dt: f64, duration: f64) -> Settings {
     }
 }
 
+/// A step loop of the integrator.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Loop {
+    /// Pins bending along x, walls moving with the feet.
+    Row,
+    /// Pins in the transverse plane, on one thread or on two.
+    Plane { threads: usize },
+    /// The row, with walls of their own motion (standing still in space here).
+    Walls,
+}
+
+pub(super) const LOOPS: [Loop; 4] = [
+    Loop::Row,
+    Loop::Plane { threads: 1 },
+    Loop::Plane { threads: 2 },
+    Loop::Walls,
+];
+
+/// The threads `kind` runs on.
+pub(super) fn threads(kind: Loop) -> usize {
+    match kind {
+        Loop::Plane { threads } => threads,
+        _ => 1,
+    }
+}
+
+/// A row `model` run on `kind`: in the plane every contact normal +x and the releases
+/// along x (the y lines at rest), or with walls of their own motion.
+pub(super) fn on_loop(mut model: Model<'_>, kind: Loop) -> Model<'_> {
+    match kind {
+        Loop::Row => {}
+        Loop::Plane { .. } => {
+            model.plane = Some(Plane {
+                normals: vec![[1.0, 0.0]; model.contacts.len()],
+                base_acceleration_y: None,
+            });
+            if !model.initial_tip_displacements.is_empty() {
+                let pins = model.pins;
+                model.initial_tip_displacements.resize(2 * pins, 0.0);
+            }
+        }
+        Loop::Walls => model.walls = Some(WallMotion::rigid(None, None)),
+    }
+    model
+}
+
 pub(super) fn run(model: &Model<'_>, settings: &Settings) -> Simulation {
     simulate(model, settings, &mut |_| ControlFlow::Continue(())).expect("run succeeds")
 }

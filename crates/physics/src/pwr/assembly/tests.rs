@@ -220,10 +220,7 @@ fn a_rod_clamped_by_a_preloaded_cell_moves_with_its_grid_below_the_load_that_unl
         model.point_forces = vec![PointForce {
             line: 0,
             height: 0.5,
-            force: Table {
-                time: vec![0.0, ramp, 1e3],
-                values: vec![0.0, load, load],
-            },
+            force: Table::ramp_and_hold(ramp, load),
         }];
         assert!(model.validate().is_empty(), "{:?}", model.validate());
         let dt = 0.5 * crate::integrate::critical_time_step(&model, Scheme::CentralDifference);
