@@ -790,8 +790,10 @@ fn shift_lines(
     source: &LaneBodies,
     force: f64,
 ) {
+    // One kind (every model without `kinds`): its row of G read once for every term.
+    let single = (g.len() == 1).then(|| &g[0][source.level * levels..][..levels]);
     for term in source.terms() {
-        let g = &g[kinds[term.line]][source.level * levels..][..levels];
+        let g = single.unwrap_or_else(|| &g[kinds[term.line]][source.level * levels..][..levels]);
         let sign = -term.normal * force;
         let shift = &mut shift[term.line * levels..][..levels];
         for (s, g) in shift.iter_mut().zip(g) {
