@@ -525,9 +525,10 @@ const SUMS: usize = 4;
 
 /// With f the contact and point loads: a = (f/μ − Γ·base − ω² q − 2ξω v)·factor, then
 /// v += `half_step`·a (0 for Tchamwa, whose velocity was advanced before the forces),
-/// and f is zeroed for the next step; returns the power sums at the new v.
+/// and f is zeroed for the next step; returns the power sums at the new v. `SCALED`:
+/// whether μ ≠ 1 (the basis's own lines skip the multiply).
 #[inline(always)]
-pub(super) fn modal_update<S: Simd>(
+pub(super) fn modal_update<S: Simd, const SCALED: bool>(
     simd: S,
     coefficients: &ModalCoefficients<'_, S>,
     base: f64,
@@ -552,7 +553,12 @@ pub(super) fn modal_update<S: Simd>(
         .zip(f.chunks_exact_mut(n))
     {
         for i in 0..n {
-            let force = simd.mul_add_e_f64s(load, g[i], simd.mul_f64s(f[i], inverse_mass));
+            let loads = if SCALED {
+                simd.mul_f64s(f[i], inverse_mass)
+            } else {
+                f[i]
+            };
+            let force = simd.mul_add_e_f64s(load, g[i], loads);
             f[i] = zero;
             let elastic = simd.mul_f64s(k[i], q[i]);
             let viscous = simd.mul_f64s(c[i], v[i]);
@@ -749,7 +755,7 @@ mod tests {
         let (q, f0) = (values(pins * row, 0.29), values(pins * row, 0.31));
         let (mut v, mut a, mut f) = (values(pins * row, 0.41), vec![0.0; pins * row], f0.clone());
         let v0 = v.clone();
-        let sums = modal_update(
+        let sums = modal_update::<S, true>(
             simd,
             &coefficients,
             0.7,

@@ -340,6 +340,7 @@ impl Recorder {
             add_transport(&mut self.node_columns, curvature, by, pins);
         }
         for (pin, extreme) in self.pin_curvatures.iter_mut().enumerate() {
+            let weight = self.envelope_weights[pin];
             let x = &self.node_columns[pin * nodes..(pin + 1) * nodes];
             let y =
                 (lines > pins).then(|| &self.node_columns[(pins + pin) * nodes..(pins + pin + 1) * nodes]);
@@ -349,7 +350,7 @@ impl Recorder {
                 if squared > largest.0 {
                     largest = (squared, Some(node));
                 }
-                let weighted = squared * self.envelope_weights[pin];
+                let weighted = squared * weight;
                 if weighted > self.envelope_squares[node] {
                     self.envelope_squares[node] = weighted;
                     self.curvature_envelope[node] = CurvaturePeak {

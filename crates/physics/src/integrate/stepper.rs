@@ -740,6 +740,17 @@ pub(super) fn update_lines<S: Simd>(
     let n = layout.row / layout.lanes;
     let lines = q.len() / n;
     let participation = &S::as_simd_f64s(&layout.participation).0[..n];
+    if let [kind] = &layout.kinds[..] {
+        // Every line the basis's: one update, as without kinds.
+        let coefficients = ModalCoefficients::<S> {
+            stiffness: &S::as_simd_f64s(&kind.omega_squared).0[..n],
+            damping: &S::as_simd_f64s(&kind.damping).0[..n],
+            factor: &S::as_simd_f64s(&kind.implicit_damping_factor).0[..n],
+            participation,
+            inverse_mass: 1.0,
+        };
+        return modal_update::<S, false>(simd, &coefficients, base, second_half, (q, v, a, f));
+    }
     let mut sums = UpdateSums::default();
     for run in layout
         .runs
@@ -755,18 +766,17 @@ pub(super) fn update_lines<S: Simd>(
             inverse_mass: kind.inverse_mass,
         };
         let rows = (run.first - first) * n..(run.first - first + run.lines) * n;
-        let run_sums = modal_update(
-            simd,
-            &coefficients,
-            base,
-            second_half,
-            (
-                &q[rows.clone()],
-                &mut v[rows.clone()],
-                &mut a[rows.clone()],
-                &mut f[rows],
-            ),
+        let state = (
+            &q[rows.clone()],
+            &mut v[rows.clone()],
+            &mut a[rows.clone()],
+            &mut f[rows],
         );
+        let run_sums = if kind.inverse_mass == 1.0 {
+            modal_update::<S, false>(simd, &coefficients, base, second_half, state)
+        } else {
+            modal_update::<S, true>(simd, &coefficients, base, second_half, state)
+        };
         sums.damping_power += kind.mass * run_sums.damping_power;
         sums.participation_velocity += kind.mass * run_sums.participation_velocity;
     }
