@@ -513,8 +513,11 @@ impl Simulation for HexBundleDynamics {
             (&basis, &kind_bases),
         );
         // The kinds' pins and damping (the physics' checks), at their members.
-        let refused: Vec<FieldError> = model
-            .validate()
+        let kind_issues = match inputs.kinds.is_empty() {
+            true => Vec::new(),
+            false => model.validate(),
+        };
+        let refused: Vec<FieldError> = kind_issues
             .into_iter()
             .filter(|issue| issue.field.starts_with("kinds/"))
             .filter_map(|issue| {

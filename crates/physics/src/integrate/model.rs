@@ -239,13 +239,17 @@ impl Model<'_> {
     pub fn reduced_mass(&self, contact: &Contact) -> f64 {
         let shape = self.basis.deflection_at(contact.height);
         let apparent = 1.0 / shape.iter().map(|phi| phi * phi).sum::<f64>();
-        let scales = self.kind_scales();
-        let kinds = self.pin_kinds();
-        let mass = |pin: usize| apparent * scales[kinds[pin]].mass;
+        // A pin's kind's μ (1 for the basis's), computed only for the two pins here.
+        let mass = |pin: usize| match self.kinds.iter().find(|k| k.pins.contains(&pin)) {
+            Some(kind) => apparent * kinds::relative_mass(self.basis, kind.basis).unwrap_or(1.0),
+            None => apparent,
+        };
         match (contact.left, contact.right) {
             (Body::Pin(left), Body::Pin(right)) => {
                 let (a, b) = (mass(left), mass(right));
-                if a.is_finite() && b.is_finite() {
+                if a == b {
+                    0.5 * a
+                } else if a.is_finite() && b.is_finite() {
                     a * b / (a + b)
                 } else {
                     a.min(b)

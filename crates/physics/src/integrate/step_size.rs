@@ -263,14 +263,10 @@ pub fn max_frequency(model: &Model<'_>) -> f64 {
         .iter()
         .map(|c| model.basis.deflection_at(c.height))
         .collect();
-    let scales = model.kind_scales();
+    let (scales, kinds) = (model.kind_scales(), model.pin_kinds());
     let pins = PinModes {
-        frequencies: model.pin_kinds().iter().map(|k| scales[*k].frequencies).collect(),
-        shape_scales: model
-            .pin_kinds()
-            .iter()
-            .map(|k| 1.0 / scales[*k].mass.sqrt())
-            .collect(),
+        frequencies: kinds.iter().map(|k| scales[*k].frequencies).collect(),
+        shape_scales: kinds.iter().map(|k| 1.0 / scales[*k].mass.sqrt()).collect(),
     };
     match &model.plane {
         None => max_angular_frequency(&pins, &model.contacts, &shapes),

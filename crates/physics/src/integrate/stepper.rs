@@ -48,7 +48,7 @@ use super::kernels::{
     self, ContactState, ModalCoefficients, ModalState, UpdateSums, advance_positions, axpy, lanes,
     level_deflections, modal_update, penetration_rate, penetrations, plane_penetrations, row_axpy,
 };
-use super::layout::{ContactModel, Layout, PlaneContacts};
+use super::layout::{ContactModel, Layout, LineKind, PlaneContacts};
 use super::plane_step::{self, ClosedPass, Half, LaneOutputs, Loads};
 use super::recorder::{Powers, Recorder, record_closed_contact};
 use super::state::State;
@@ -742,13 +742,7 @@ pub(super) fn update_lines<S: Simd>(
     let participation = &S::as_simd_f64s(&layout.participation).0[..n];
     if let [kind] = &layout.kinds[..] {
         // Every line the basis's: one update, as without kinds.
-        let coefficients = ModalCoefficients::<S> {
-            stiffness: &S::as_simd_f64s(&kind.omega_squared).0[..n],
-            damping: &S::as_simd_f64s(&kind.damping).0[..n],
-            factor: &S::as_simd_f64s(&kind.implicit_damping_factor).0[..n],
-            participation,
-            inverse_mass: 1.0,
-        };
+        let coefficients = coefficients_of::<S>(kind, participation, n);
         return modal_update::<S, false>(simd, &coefficients, base, second_half, (q, v, a, f));
     }
     let mut sums = UpdateSums::default();
@@ -758,13 +752,7 @@ pub(super) fn update_lines<S: Simd>(
         .filter(|r| (first..first + lines).contains(&r.first))
     {
         let kind = &layout.kinds[run.kind];
-        let coefficients = ModalCoefficients::<S> {
-            stiffness: &S::as_simd_f64s(&kind.omega_squared).0[..n],
-            damping: &S::as_simd_f64s(&kind.damping).0[..n],
-            factor: &S::as_simd_f64s(&kind.implicit_damping_factor).0[..n],
-            participation,
-            inverse_mass: kind.inverse_mass,
-        };
+        let coefficients = coefficients_of::<S>(kind, participation, n);
         let rows = (run.first - first) * n..(run.first - first + run.lines) * n;
         let state = (
             &q[rows.clone()],
@@ -781,6 +769,22 @@ pub(super) fn update_lines<S: Simd>(
         sums.participation_velocity += kind.mass * run_sums.participation_velocity;
     }
     sums
+}
+
+/// `kind`'s modal coefficients as vectors of rows of `n` vectors, with `participation`.
+#[inline(always)]
+fn coefficients_of<'a, S: Simd>(
+    kind: &'a LineKind,
+    participation: &'a [S::f64s],
+    n: usize,
+) -> ModalCoefficients<'a, S> {
+    ModalCoefficients {
+        stiffness: &S::as_simd_f64s(&kind.omega_squared).0[..n],
+        damping: &S::as_simd_f64s(&kind.damping).0[..n],
+        factor: &S::as_simd_f64s(&kind.implicit_damping_factor).0[..n],
+        participation,
+        inverse_mass: kind.inverse_mass,
+    }
 }
 
 /// The plane's state as [`plane_step::update_halves`] takes it: the x and the y lines
